@@ -17,6 +17,33 @@ from .grid import Grid
 LAYOUTS = ("regular", "jittered", "random")
 
 
+class PositivityError(ArithmeticError):
+    """A particle lost positivity of density or internal energy."""
+
+    def __init__(self, quantity: str, particle: int, x: float, value: float, step: int | None = None, t: float | None = None):
+        self.quantity, self.particle, self.x, self.value = quantity, particle, x, value
+        self.step, self.t = step, t
+        super().__init__(self._message())
+
+    def _message(self) -> str:
+        where = "" if self.step is None else f"at step {self.step} (t={self.t:.6g}) "
+        return (
+            f"positivity lost {where}in particle {self.particle} at x={self.x:.6g}: "
+            f"{self.quantity} = {self.value:.6g}; reduce the CFL number"
+        )
+
+    def at(self, step: int, t: float) -> "PositivityError":
+        return PositivityError(self.quantity, self.particle, self.x, self.value, step, t)
+
+
+def check_positive(quantity: str, value: np.ndarray, x: np.ndarray) -> None:
+    """Raise :class:`PositivityError` for the first particle whose ``value`` is not > 0 (or NaN)."""
+    bad = ~(value > 0)
+    if bad.any():
+        p = int(np.flatnonzero(bad)[0])
+        raise PositivityError(quantity, p, float(x[p]), float(value[p]))
+
+
 @dataclass(frozen=True, eq=False)
 class Particles:
     """State of n_p particles; every field is an (n_p,) float array."""

@@ -37,13 +37,15 @@ class Shape:
     """``S_ip`` and ``G_ip`` of n_p particles on a grid of ``n_nodes`` nodes.
 
     ``nodes`` (n_p, k) int: the nodes particle p touches; ``S``, ``G`` (n_p, k): the weights.
-    Entries with zero weight may repeat a node; they contribute nothing.
+    Entries with zero weight may repeat a node; they contribute nothing. ``cell`` (n_p,): the cell
+    that holds each particle's position.
     """
 
     nodes: np.ndarray
     S: np.ndarray
     G: np.ndarray
     n_nodes: int
+    cell: np.ndarray
 
     def scatter(self, q: np.ndarray) -> np.ndarray:
         """Particles -> grid: ``sum_p q_p S_ip`` (n_nodes,)."""
@@ -98,7 +100,7 @@ def point_shape(grid: Grid, x: np.ndarray) -> Shape:
     nodes = np.stack((cell, cell + 1), axis=1)
     S = np.stack((1.0 - xi, xi), axis=1)
     G = np.stack((-inv_h, inv_h), axis=1)
-    return Shape(nodes, S, G, grid.n_nodes)
+    return Shape(nodes, S, G, grid.n_nodes, cell)
 
 
 def _hat_and_integral(grid: Grid, i: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -136,7 +138,7 @@ def gimp_shape(grid: Grid, x: np.ndarray, volume: np.ndarray) -> Shape:
         p = int(np.flatnonzero(~(volume > 0))[0])
         raise ValueError(f"GIMP needs positive particle volumes; particle {p} has V={volume[p]!r}")
     a, b = grid.nodes[0], grid.nodes[-1]
-    locate(grid, x)  # raises for points outside
+    cell, _ = locate(grid, x)
     lo = np.maximum(x - 0.5 * volume, a)
     hi = np.minimum(x + 0.5 * volume, b)
     c_lo, _ = locate(grid, lo)
@@ -151,7 +153,7 @@ def gimp_shape(grid: Grid, x: np.ndarray, volume: np.ndarray) -> Shape:
     length = (hi - lo)[:, None]
     S = np.where(dup, 0.0, (phi_hi - phi_lo) / length)
     G = np.where(dup, 0.0, (s_hi - s_lo) / length)
-    return Shape(nodes, S, G, grid.n_nodes)
+    return Shape(nodes, S, G, grid.n_nodes, cell)
 
 
 def make_shape(grid: Grid, x: np.ndarray, volume: np.ndarray | None = None, basis: str = "mpm") -> Shape:

@@ -1,0 +1,1 @@
+"""Problem set-ups: settings with their defaults in one place, initial particles, exact solutions."""

@@ -1,0 +1,137 @@
+"""Viscous Burgers ``v_t + v v_x = eps v_xx`` on [0, 2] up to T = 0.5 (slides, "Burgers' Problem").
+
+Initial data, Dirichlet data at both ends and the exact acceleration ``Dv/Dt = eps v_xx`` come
+from an exact solution (``baselines.exact.burgers``), so the error at T is exact:
+
+    e_p = v_p - v(x_p, T)  over particles (weights V_p);   e_i = v_i - v(x_i, T)  over nodes.
+
+Particles leave through the ends; a reservoir outside each end feeds new particles in, spaced
+``h / N_p`` like the initial layout, so that the domain never empties (the pitfall of STUDY.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from baselines.exact import burgers as exact_burgers
+
+from ..errors import norms
+from ..grid import Grid, uniform_grid
+from ..models.burgers import ViscousBurgers
+from ..particles import LAYOUTS, Particles, make_particles, seed_positions
+from ..solve import Problem, Result, run
+from ..step import ACCELERATIONS, Dirichlet, Stages
+
+
+@dataclass(frozen=True)
+class BurgersSettings:
+    """Every setting of a Burgers run, with the CLI's defaults."""
+
+    h: float = 0.01
+    eps: float = 0.045
+    solution: str = "rarefaction"
+    acceleration: str = "calculated"
+    ppc: int = 4
+    T: float = 0.5
+    cfl: float = 0.5
+    mass: str = "lumped"
+    basis: str = "mpm"
+    scheme: str = "usl"
+    layout: str = "regular"
+    seed: int = 0
+
+    def __post_init__(self):
+        if not (np.isfinite(self.eps) and self.eps > 0):
+            raise ValueError(f"the viscosity eps must be positive, got {self.eps}")
+        uniform_grid(*self.exact.domain, self.h)  # raises unless h divides the domain
+        if self.layout not in LAYOUTS:
+            raise ValueError(f"unknown particle layout {self.layout!r}; choose one of {', '.join(LAYOUTS)}")
+        if isinstance(self.ppc, bool) or not isinstance(self.ppc, int) or self.ppc < 1:
+            raise ValueError(f"particles per cell must be an integer >= 1, got {self.ppc!r}")
+        if not (np.isfinite(self.T) and self.T >= 0):
+            raise ValueError(f"the final time T must be >= 0, got {self.T}")
+        if not (0 < self.cfl <= 1):
+            raise ValueError(f"the CFL number must lie in (0, 1], got {self.cfl}")
+        if self.acceleration not in ACCELERATIONS:
+            raise ValueError(f"unknown acceleration {self.acceleration!r}; choose one of {', '.join(ACCELERATIONS)}")
+        self.stages  # validates mass, basis, scheme
+
+    @property
+    def exact(self):
+        """The exact solution object (``v``, ``v_x``, ``v_xx``, ``v_t``, ``domain``)."""
+        return exact_burgers.make_solution(self.solution, self.eps)
+
+    @property
+    def stages(self) -> Stages:
+        return Stages(basis=self.basis, mass=self.mass, acceleration=self.acceleration, scheme=self.scheme)
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class Reservoir:
+    """Removes particles that left ``[a, b]``; feeds in particles spaced ``spacing`` at each end.
+
+    A gap between an end and the nearest particle wider than ``spacing`` is filled with particles
+    ``spacing`` apart, counted from that particle, carrying the exact velocity and volume ``spacing``.
+    """
+
+    spacing: float
+    velocity: object  # callable (x, t) -> v
+
+    def __call__(self, particles: Particles, grid: Grid, t: float) -> Particles:
+        a, b = grid.domain
+        inside = (particles.x >= a) & (particles.x <= b)
+        if not inside.all():
+            particles = particles.take(inside)
+        if particles.n == 0:
+            raise RuntimeError("every particle left the domain")
+        s = self.spacing
+        k_left = int(np.floor((particles.x.min() - a) / s))
+        k_right = int(np.floor((b - particles.x.max()) / s))
+        new = []
+        if k_left > 0:
+            new.append(particles.x.min() - s * np.arange(k_left, 0, -1))
+        if k_right > 0:
+            new.append(particles.x.max() + s * np.arange(1, k_right + 1))
+        if not new:
+            return particles
+        x = np.concatenate(new)
+        fed = make_particles(x, s, 1.0, self.velocity(x, t))
+        return particles.join(fed)
+
+
+def initial_particles(settings: BurgersSettings, grid: Grid) -> Particles:
+    """Unit-density particles carrying ``v(x_p, 0)``."""
+    x, volume = seed_positions(grid, settings.ppc, settings.layout, settings.seed)
+    return make_particles(x, volume, 1.0, settings.exact.v(x, 0.0))
+
+
+def simulate(settings: BurgersSettings = BurgersSettings(), progress: bool | None = None, observer=None) -> Result:
+    """Run MPM on viscous Burgers with ``settings``."""
+    solution = settings.exact
+    grid = uniform_grid(*solution.domain, settings.h)
+    problem = Problem(
+        model=ViscousBurgers(settings.eps),
+        boundary=Dirichlet(solution.v),
+        T=settings.T,
+        cfl=settings.cfl,
+        exact_acceleration=lambda x, t: settings.eps * solution.v_xx(x, t),
+        particle_boundary=Reservoir(settings.h / settings.ppc, solution.v),
+    )
+    return run(problem, grid, initial_particles(settings, grid), settings.stages, progress, observer)
+
+
+def errors(settings: BurgersSettings, result: Result) -> dict:
+    """Velocity errors at T over particles and over grid nodes."""
+    P, g = result.particles, result.grid
+    v = settings.exact.v
+    return {
+        "velocity": {
+            "particles": norms(P.velocity - v(P.x, result.t), P.volume),
+            "nodes": norms(result.nodal_velocity - v(g.nodes, result.t), g.lumped_mass),
+        }
+    }

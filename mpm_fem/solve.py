@@ -1,0 +1,136 @@
+"""The time loop: ``run(problem, grid, particles, stages) -> Result``.
+
+Steps :func:`mpm_fem.step.explicit_step` from ``t = 0`` to ``T`` with ``dt = model.stable_dt``
+(the last step shortened to land on ``T``). Every step is checked: lost positivity raises
+:class:`~mpm_fem.particles.PositivityError` naming the step, and a non-finite particle state raises
+:class:`FloatingPointError` naming the step and the particle: a run never returns NaN.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from .grid import Grid
+from .particles import Particles, PositivityError
+from .shape import make_shape
+from .step import Boundary, GridState, Model, Stages, explicit_step
+from .transfer import grid_values, nodal_mass, nodal_momentum
+
+Observer = Callable[[int, float, Particles, Particles, GridState], None]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """What the time loop needs besides the particles.
+
+    ``particle_boundary(particles, grid, t) -> particles`` removes particles that left the grid
+    and adds inflow particles (Burgers); ``exact_acceleration(x_i, t)`` serves the exact stage.
+    """
+
+    model: Model
+    boundary: Boundary
+    T: float
+    cfl: float
+    exact_acceleration: Callable[[np.ndarray, float], np.ndarray] | None = None
+    particle_boundary: Callable[[Particles, Grid, float], Particles] | None = None
+
+    def __post_init__(self):
+        if not (np.isfinite(self.T) and self.T >= 0):
+            raise ValueError(f"the final time T must be >= 0, got {self.T}")
+        if not (0 < self.cfl <= 1):
+            raise ValueError(f"the CFL number must lie in (0, 1], got {self.cfl}")
+
+
+@dataclass(frozen=True, eq=False)
+class Result:
+    """Final particles, the grid fields projected from them, and run statistics."""
+
+    particles: Particles
+    grid: Grid
+    t: float
+    steps: int
+    wall_s: float
+    nodal_mass: np.ndarray = field(repr=False)
+    nodal_velocity: np.ndarray = field(repr=False)
+    dt_min: float = 0.0
+    dt_max: float = 0.0
+
+    @property
+    def nodal_density(self) -> np.ndarray:
+        """``m_i / int S_i dx``: the grid density seen by the projection."""
+        return self.nodal_mass / self.grid.lumped_mass
+
+
+def project(grid: Grid, particles: Particles, stages: Stages) -> tuple[np.ndarray, np.ndarray]:
+    """Nodal mass ``m_i`` and velocity ``v_i`` of the particles (no boundary condition imposed)."""
+    shape = make_shape(grid, particles.x, particles.volume, stages.basis)
+    m_i = nodal_mass(shape, particles.mass)
+    P_i = nodal_momentum(shape, particles.mass, particles.velocity)
+    return m_i, grid_values(shape, particles.mass, m_i, P_i, stages.mass)
+
+
+def _check_finite(particles: Particles, step: int, t: float) -> None:
+    for name in ("x", "velocity", "density", "energy", "pressure", "volume"):
+        a = getattr(particles, name)
+        bad = ~np.isfinite(a)
+        if bad.any():
+            p = int(np.flatnonzero(bad)[0])
+            raise FloatingPointError(f"non-finite {name} at step {step} (t={t:.6g}) in particle {p}")
+
+
+def run(
+    problem: Problem,
+    grid: Grid,
+    particles: Particles,
+    stages: Stages = Stages(),
+    progress: bool | None = None,
+    observer: Observer | None = None,
+    max_steps: int = 10_000_000,
+) -> Result:
+    """Integrate to ``problem.T``. ``progress=None`` shows a bar on a terminal for runs over 2 s."""
+    start = time.perf_counter()
+    t, steps = 0.0, 0
+    dts = []
+    disable = {True: False, False: True, None: None}[progress]  # None: only on a terminal
+    bar = tqdm(total=problem.T, disable=disable, delay=2.0, leave=False,
+               bar_format="{l_bar}{bar}| t={n:.4g}/{total:.4g} [{elapsed}<{remaining}]")
+    try:
+        while t < problem.T * (1 - 1e-12):
+            dt = min(problem.model.stable_dt(particles, grid, problem.cfl), problem.T - t)
+            if not (dt > 0 and np.isfinite(dt)):
+                raise FloatingPointError(f"time step {dt!r} at step {steps} (t={t:.6g}) is not positive and finite")
+            if steps >= max_steps:
+                raise RuntimeError(f"{max_steps} steps did not reach T={problem.T} (t={t:.6g})")
+            try:
+                new, state = explicit_step(grid, particles, problem.model, problem.boundary, t, dt, stages, problem.exact_acceleration)
+            except PositivityError as err:
+                raise err.at(steps, t) from None
+            if problem.particle_boundary is not None:
+                new = problem.particle_boundary(new, grid, t + dt)
+            _check_finite(new, steps, t)
+            if observer is not None:
+                observer(steps, t, particles, new, state)
+            particles = new
+            t += dt
+            steps += 1
+            dts.append(dt)
+            bar.update(dt)
+    finally:
+        bar.close()
+    m_i, v_i = project(grid, particles, stages)
+    return Result(
+        particles=particles,
+        grid=grid,
+        t=t,
+        steps=steps,
+        wall_s=time.perf_counter() - start,
+        nodal_mass=m_i,
+        nodal_velocity=v_i,
+        dt_min=min(dts, default=0.0),
+        dt_max=max(dts, default=0.0),
+    )
