@@ -83,7 +83,7 @@ def locate(grid: Grid, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if bad.any():
         p = int(np.flatnonzero(bad)[0])
         raise OutsideGridError(
-            f"particle {p} at x={x[p]!r} lies outside the grid [{a}, {b}] "
+            f"particle {p} at x={float(x[p])!r} lies outside the grid [{float(a)}, {float(b)}] "
             f"({int(bad.sum())} such particles)"
         )
     cell = np.searchsorted(grid.nodes, x, side="right") - 1

@@ -63,16 +63,19 @@ def solve_consistent(shape: Shape, mass: np.ndarray, rhs: np.ndarray) -> np.ndar
     out = np.zeros_like(rhs)
     Ma = M[active][:, active]
     n = Ma.shape[0]
-    off = Ma.diagonal(1)
-    if shape.nodes.shape[1] == 2 and Ma.nnz <= 3 * n:
-        ab = np.zeros((3, n))
-        ab[0, 1:] = off
-        ab[1] = Ma.diagonal()
-        ab[2, :-1] = Ma.diagonal(-1)
-        out[active] = solve_banded((1, 1), ab, rhs[active])
-    else:
-        out[active] = spsolve(Ma.tocsc(), rhs[active])
-    if not np.all(np.isfinite(out)):
+    try:
+        if shape.nodes.shape[1] == 2 and Ma.nnz <= 3 * n:
+            ab = np.zeros((3, n))
+            ab[0, 1:] = Ma.diagonal(1)
+            ab[1] = Ma.diagonal()
+            ab[2, :-1] = Ma.diagonal(-1)
+            out[active] = solve_banded((1, 1), ab, rhs[active])
+        else:
+            out[active] = spsolve(Ma.tocsc(), rhs[active])
+        singular = not np.all(np.isfinite(out))
+    except np.linalg.LinAlgError:
+        singular = True
+    if singular:
         raise FloatingPointError(
             "the consistent particle mass matrix is singular (too few particles in some cells); "
             "use the lumped mass or more particles per cell"
