@@ -85,7 +85,30 @@ def build_parser() -> argparse.ArgumentParser:
     burgers = sub.add_parser("burgers", help="MPM on viscous Burgers against an exact solution",
                              description="MPM on viscous Burgers v_t + v v_x = eps v_xx on [0,2], T=0.5.")
     _add_settings_options(burgers, BurgersSettings, {"solution": tuple(SOLUTIONS)})
+
+    from studies import STUDIES
+
+    study = sub.add_parser("study", help="run one study: tables and figures into figures/<name>/",
+                           description="Run one study of the error analysis; results are cached per case.")
+    study.add_argument("name", choices=STUDIES, help="which study")
+    _add_study_options(study)
+    reproduce = sub.add_parser("reproduce", help="run every study and write figures/REPORT.md",
+                               description="Regenerate every table and figure and figures/REPORT.md.")
+    size = reproduce.add_mutually_exclusive_group()
+    size.add_argument("--quick", dest="quick", action="store_true", default=True,
+                      help="a subset of meshes, a few minutes on 2 cores (default)")
+    size.add_argument("--full", dest="quick", action="store_false", help="every mesh of every study")
+    _add_study_options(reproduce, quick_flag=False)
     return parser
+
+
+def _add_study_options(parser: argparse.ArgumentParser, quick_flag: bool = True) -> None:
+    if quick_flag:
+        parser.add_argument("--quick", action="store_true", help="the subset of meshes of the quick reproduction")
+    parser.add_argument("--jobs", type=int, default=None, help="worker processes (default: the number of cores)")
+    parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler, tcp://HOST:PORT")
+    parser.add_argument("--out", default="figures", help="figures folder (default: figures)")
+    parser.add_argument("--quiet", action="store_true", help="no progress output")
 
 
 def _settings(cls, args):
@@ -166,7 +189,37 @@ def cmd_burgers(args) -> dict:
     return {"summary": summary, "line": line}
 
 
-COMMANDS = {"sod": cmd_sod, "burgers": cmd_burgers}
+def _study_options(args):
+    from .study import StudyOptions
+
+    if args.jobs is not None and args.jobs < 1:
+        raise UsageError(f"--jobs must be >= 1, got {args.jobs}")
+    try:
+        out = output.ensure_writable_dir(args.out)
+    except PermissionError as err:
+        raise UsageError(str(err)) from None
+    return StudyOptions(quick=args.quick, jobs=args.jobs, scheduler=args.scheduler, out=out,
+                        progress=False if args.quiet else None)
+
+
+def cmd_study(args) -> dict:
+    import importlib
+
+    options = _study_options(args)
+    module = importlib.import_module(f"studies.{args.name}")
+    module.run(options)
+    return {"line": f"study {args.name} written to {options.folder(args.name)}"}
+
+
+def cmd_reproduce(args) -> dict:
+    from .report import reproduce
+
+    options = _study_options(args)
+    path = reproduce(options)
+    return {"line": f"report written to {path}"}
+
+
+COMMANDS = {"sod": cmd_sod, "burgers": cmd_burgers, "study": cmd_study, "reproduce": cmd_reproduce}
 
 
 def main(argv=None) -> int:

@@ -1,0 +1,77 @@
+"""What every study shares: where it writes, how it writes a table, and its run options.
+
+A study writes ``figures/<name>/<table>.csv`` (one row per measurement), a ``<table>.json`` with
+the exact settings and the package versions beside it, and its ``.png`` figures. The cache of
+finished cases lives in ``figures/<name>/.cache/`` (git-ignored).
+"""
+
+from __future__ import annotations
+
+import csv
+import sys
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+from .output import versions, write_atomic, write_json
+from .sweep import code_version, run_cases
+
+
+@dataclass(frozen=True)
+class StudyOptions:
+    """``quick``: the subset of meshes the README's default run uses; ``jobs``: worker processes;
+    ``scheduler``: a Dask scheduler address; ``out``: the figures folder (``figures/``)."""
+
+    quick: bool = False
+    jobs: int | None = None
+    scheduler: str | None = None
+    out: Path = Path("figures")
+    progress: bool | None = None
+
+    def folder(self, name: str) -> Path:
+        path = Path(self.out) / name
+        path.mkdir(parents=True, exist_ok=True)
+        return path
+
+    def sweep(self, name: str, fn, cases: list[dict], desc: str | None = None) -> list[dict]:
+        """Run ``fn`` over ``cases`` with this study's cache, workers and progress."""
+        return run_cases(fn, cases, jobs=self.jobs, cache_dir=self.folder(name) / ".cache", desc=desc or name,
+                         scheduler=self.scheduler, progress=self.progress)
+
+
+def write_table(folder: Path, table: str, rows: list[dict], settings: dict) -> Path:
+    """``<folder>/<table>.csv`` from ``rows`` (dicts with the same keys) and ``<table>.json``
+    holding ``settings``, the package versions and the code hash. Returns the CSV path."""
+    if not rows:
+        raise ValueError(f"table {table!r} has no rows")
+    columns = list(rows[0])
+    for row in rows[1:]:
+        columns += [c for c in row if c not in columns]
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=columns, lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: _fmt(v) for k, v in row.items()})
+    path = Path(folder) / f"{table}.csv"
+    write_atomic(path, buffer.getvalue())
+    write_json(Path(folder) / f"{table}.json", {"settings": settings, "versions": versions(), "code": code_version()})
+    return path
+
+
+def read_table(path: Path) -> list[dict]:
+    """Rows of a CSV table written by :func:`write_table` (values as strings)."""
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def _fmt(value):
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return value
+
+
+def script_main(name: str, argv=None) -> int:
+    """Entry point of ``python studies/<name>.py``: the same options as ``mpm-fem study <name>``."""
+    from .cli import main
+
+    return main(["study", name, *(sys.argv[1:] if argv is None else argv)])
