@@ -1,0 +1,222 @@
+"""Fixed-mesh Galerkin FEM for the viscous Burgers equation, on scikit-fem.
+
+The baseline that MPM is compared with on the same mesh (STUDY.md, C13, C15 and E3). The equation
+
+    v_t + (v^2 / 2)_x = eps v_xx       on [a, b] = solution.domain,  0 < t <= T,
+    v(x, 0) = v_exact(x, 0),  v(a, t) = v_exact(a, t),  v(b, t) = v_exact(b, t),
+
+is discretised with P1 elements (hat functions ``S_i``), ``v_h = sum_j v_j S_j``, and the
+Galerkin equations for the interior nodes ``i``
+
+    sum_j M_ij dv_j/dt = R_i(v),
+    R_i(v) = - int S_i v_h (v_h)_x dx - eps int (v_h)_x S_i' dx,
+
+with the nonlinear term integrated exactly (it is a cubic on each cell). Cell by cell
+(``e = [x_a, x_b]``, ``h_e = x_b - x_a``) this is
+
+    R_a += -(v_b - v_a)(2 v_a + v_b)/6 + eps (v_b - v_a)/h_e,
+    R_b += -(v_b - v_a)(v_a + 2 v_b)/6 - eps (v_b - v_a)/h_e,
+
+the two convective parts adding up to ``-(v_b^2 - v_a^2)/2`` (conservative). ``M`` is the
+consistent mass ``int S_i S_j dx`` (scikit-fem) or its row sums (lumped). The Dirichlet values
+``g(t)`` are imposed strongly at both end nodes; with the consistent mass the interior rows
+read ``M_II dv_I/dt = R_I - M_IB g'(t)``, with ``g' = v_t`` of the exact solution (the lumped
+mass has ``M_IB = 0``). ``M_II`` is factorised once.
+
+Time: SSP-RK3 (Shu-Osher) with the fixed step
+
+    dt = min(cfl h / max_x |v(x, 0)|,  cfl_visc h^2 / (2 eps)),   shortened so that T = steps dt,
+
+and the boundary values of each stage taken at the stage time (t, t + dt, t + dt/2). For the
+consistent mass the explicit diffusion limit is ``dt <= 2.51 h^2 / (12 eps)``, i.e.
+``cfl_visc <= 0.42`` (lumped: 1.25); the default 0.3 is stable for both.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse.linalg import splu
+
+from mpm_fem.grid import Grid, GridError, uniform_grid
+
+MASS_KINDS = ("consistent", "lumped")
+
+
+@dataclass(frozen=True)
+class BurgersFEMResult:
+    """Nodal values ``v`` (n_nodes,) at ``nodes`` and time ``t`` after ``steps`` steps of ``dt``."""
+
+    nodes: np.ndarray
+    v: np.ndarray
+    t: float
+    steps: int
+    dt: float
+    settings: dict
+
+
+@dataclass(frozen=True, eq=False)
+class _Operators:
+    """Cell connectivity, cell sizes, lumped mass, and the solve with ``M_II``."""
+
+    a: np.ndarray
+    b: np.ndarray
+    h: np.ndarray
+    n_nodes: int
+    interior: np.ndarray
+    boundary: np.ndarray
+    mass: str
+    lumped: np.ndarray
+    M_IB: object = None
+    solve_II: object = None
+
+
+def _operators(grid: Grid, mass: str) -> _Operators:
+    a, b = grid.mesh.t
+    x = grid.mesh.p[0]
+    boundary = grid.boundary_nodes
+    interior = np.setdiff1d(np.arange(grid.n_nodes), boundary)
+    ops = dict(
+        a=a, b=b, h=x[b] - x[a], n_nodes=grid.n_nodes, interior=interior, boundary=boundary,
+        mass=mass, lumped=grid.lumped_mass,
+    )
+    if mass == "consistent":
+        M = grid.consistent_mass.tocsr()
+        ops.update(
+            M_IB=M[interior][:, boundary],
+            solve_II=splu(M[interior][:, interior].tocsc()).solve,
+        )
+    return _Operators(**ops)
+
+
+def residual(v: np.ndarray, ops: _Operators, eps: float) -> np.ndarray:
+    """``R_i(v)`` of the module docstring at every node (n_nodes,), assembled with bincount."""
+    va, vb = v[ops.a], v[ops.b]
+    jump = vb - va
+    diffusive = eps * jump / ops.h
+    n = ops.n_nodes
+    return np.bincount(ops.a, -jump * (2.0 * va + vb) / 6.0 + diffusive, n) + np.bincount(
+        ops.b, -jump * (va + 2.0 * vb) / 6.0 - diffusive, n
+    )
+
+
+def time_derivative(v: np.ndarray, g_t: np.ndarray, ops: _Operators, eps: float) -> np.ndarray:
+    """``dv/dt`` at every node: interior rows of ``M dv/dt = R``, ``g_t`` at the boundary nodes."""
+    R = residual(v, ops, eps)
+    out = np.empty_like(v)
+    out[ops.boundary] = g_t
+    if ops.mass == "lumped":
+        out[ops.interior] = R[ops.interior] / ops.lumped[ops.interior]
+    else:
+        out[ops.interior] = ops.solve_II(R[ops.interior] - ops.M_IB @ g_t)
+    return out
+
+
+def _validate(h, T, mass, cfl, cfl_visc) -> None:
+    if mass not in MASS_KINDS:
+        raise ValueError(f"unknown mass {mass!r}: expected one of {MASS_KINDS}")
+    for name, value in (("cfl", cfl), ("cfl_visc", cfl_visc)):
+        if not (np.isfinite(value) and 0.0 < value <= 1.0):
+            raise ValueError(f"{name} must lie in (0, 1], got {name}={value}")
+    if not (np.isfinite(T) and T > 0):
+        raise ValueError(f"final time T must be positive and finite, got T={T}")
+
+
+def solve(
+    solution,
+    h: float,
+    T: float = 0.5,
+    mass: str = "consistent",
+    cfl: float = 0.5,
+    cfl_visc: float = 0.3,
+    progress: bool = False,
+) -> BurgersFEMResult:
+    """Galerkin P1 solution of Burgers' equation with the data of ``solution`` (an exact solution
+    from :mod:`baselines.exact.burgers`: ``.eps``, ``.domain``, ``.v(x, t)``, ``.v_t(x, t)``) on a
+    uniform mesh of size ``h``, up to time ``T`` (module docstring for the equations).
+
+    Raises ValueError for bad input (``h`` not dividing the domain, ``cfl`` or ``cfl_visc``
+    outside (0, 1], unknown ``mass``) and ArithmeticError if the solution becomes non-finite.
+    """
+    _validate(h, T, mass, cfl, cfl_visc)
+    eps = float(solution.eps)
+    lo, hi = solution.domain
+    try:
+        grid = uniform_grid(lo, hi, h)
+    except GridError as err:
+        raise ValueError(str(err)) from err
+    ops = _operators(grid, mass)
+    x = grid.nodes
+    x_b = x[ops.boundary]
+
+    v = np.asarray(solution.v(x, 0.0), dtype=float)
+    speed = float(np.max(np.abs(v)))
+    h_min = float(grid.h.min())
+    dt_limit = cfl_visc * h_min**2 / (2.0 * eps)
+    if speed > 0:
+        dt_limit = min(dt_limit, cfl * h_min / speed)
+    steps = int(np.ceil(T / dt_limit * (1 - 1e-12)))
+    dt = T / steps
+
+    # Boundary data at every half step k dt / 2 (the stage times), one vectorised call each.
+    half_times = 0.5 * dt * np.arange(2 * steps + 1)[:, None]
+    g = np.asarray(solution.v(x_b[None, :], half_times), dtype=float)
+    g_t = np.asarray(solution.v_t(x_b[None, :], half_times), dtype=float)
+
+    def L(w, k):
+        return time_derivative(w, g_t[k], ops, eps)
+
+    def with_boundary(w, k):
+        w[ops.boundary] = g[k]
+        return w
+
+    for n in range(steps):
+        k = 2 * n  # t = k dt / 2
+        v1 = with_boundary(v + dt * L(v, k), k + 2)
+        v2 = with_boundary(0.75 * v + 0.25 * (v1 + dt * L(v1, k + 2)), k + 1)
+        v = with_boundary(v / 3.0 + 2.0 / 3.0 * (v2 + dt * L(v2, k + 1)), k + 2)
+        if not np.all(np.isfinite(v)):
+            bad = int(np.flatnonzero(~np.isfinite(v))[0])
+            raise ArithmeticError(
+                f"v became non-finite at step {n + 1}, node {bad} (x = {x[bad]:.6g})"
+            )
+        if progress and (n + 1) % 1000 == 0:
+            print(f"fem_burgers h={h} {mass}: step {n + 1}/{steps}", flush=True)
+
+    settings = dict(
+        problem="burgers",
+        solution=type(solution).__name__,
+        solution_name=getattr(solution, "name", None),
+        eps=eps,
+        domain=(float(lo), float(hi)),
+        h=h,
+        T=T,
+        mass=mass,
+        cfl=cfl,
+        cfl_visc=cfl_visc,
+        dt_rule="min(cfl h / max|v(x,0)|, cfl_visc h^2 / (2 eps)), then T / ceil(T / dt)",
+        time_integrator="SSPRK3",
+        elements="P1",
+        nonlinear_term="int S_i v_h (v_h)_x dx, exact",
+        boundary="Dirichlet from the exact solution at both ends",
+    )
+    return BurgersFEMResult(
+        nodes=x.copy(), v=v, t=steps * dt, steps=steps, dt=dt, settings=settings
+    )
+
+
+def errors(result: BurgersFEMResult, solution) -> dict[str, float]:
+    """Nodal errors ``e_i = v_i - v_exact(x_i, t)``: ``L1 = sum_i w_i |e_i|``, ``L2 = sqrt(sum_i
+    w_i e_i^2)``, ``max = max_i |e_i|``, with ``w_i = int S_i dx`` (the lumped-mass weights)."""
+    x = result.nodes
+    w = np.zeros_like(x)
+    half = 0.5 * np.diff(x)
+    w[:-1] += half
+    w[1:] += half
+    e = result.v - solution.v(x, result.t)
+    return {
+        "L1": float(np.sum(w * np.abs(e))),
+        "L2": float(np.sqrt(np.sum(w * e * e))),
+        "max": float(np.max(np.abs(e))),
+    }

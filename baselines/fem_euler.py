@@ -1,0 +1,256 @@
+"""Fixed-mesh Galerkin FEM for the 1D Euler equations (Sod's shock tube), on scikit-fem.
+
+The baseline that MPM is compared with on the same mesh (STUDY.md, C15 and E3). Conservative
+variables at the nodes, ``U = (rho, rho u, E)``, ideal gas ``p = (gamma - 1)(E - rho u^2 / 2)``,
+flux ``F(U) = (rho u, rho u^2 + p, (E + p) u)``. The equations solved are
+
+    U_t + F(U)_x = (nu U_x)_x            on [0, 1],  u = 0 at both ends (reflecting walls),
+
+discretised with P1 elements (hat functions ``S_i``) in the group (product-interpolation) form:
+the flux is interpolated like the unknowns, ``F_h = sum_j F(U_j) S_j``, and the artificial
+viscosity ``nu_e`` is constant on each cell ``e``. The semi-discrete equations are
+
+    sum_j M_ij dU_j/dt = R_i(U),
+    R_i(U) = - int S_i (F_h)_x dx - sum_e nu_e int_e (U_h)_x S_i' dx,
+
+which, cell by cell (``e = [x_a, x_b]``, ``h_e = x_b - x_a``), is
+
+    R_a += -(F_b - F_a)/2 + nu_e (U_b - U_a)/h_e,    R_b += -(F_b - F_a)/2 - nu_e (U_b - U_a)/h_e.
+
+``M`` is the consistent mass ``int S_i S_j dx`` (scikit-fem, factorised once) or its row sums
+(lumped). Wall conditions: the momentum equation at the two end nodes is replaced by
+``(rho u)_i = 0``; the mass and energy fluxes ``rho u`` and ``(E + p) u`` then vanish there, so
+``sum_i m_i rho_i`` (``m_i = int S_i dx``, equal to ``int rho_h dx``) and ``sum_i m_i E_i`` are
+conserved to round-off with either mass matrix (``sum_i M_ij = m_j``, ``sum_i S_i' = 0``).
+
+Artificial viscosity (a von Neumann-Richtmyer / Lapidus form, constants fixed for every mesh):
+
+    nu_e = h_e ( c_lin s_e + c_quad max(0, -(u_b - u_a)) ),     s_e = max_{a,b} (|u| + c),
+
+linear in the signal speed and quadratic (``h |du|`` ~ ``h^2 |u_x|``) in the compressive
+velocity jump across the cell. Defaults ``c_lin = 0.1``, ``c_quad = 1``, the same for every mesh
+and both mass matrices; the artificial viscosity acts on all three conserved variables, so it
+enters the energy equation too.
+
+Time: SSP-RK3 (Shu-Osher) with ``dt = cfl h / max_i (|u_i| + c_i)`` recomputed every step, the
+last step shortened to land on ``T``. Default ``cfl = 0.3``: with the consistent mass the first
+step across the diaphragm loses positivity for ``cfl >= 0.5`` (0.45 runs), the lumped mass runs
+up to ``cfl = 1``. Positivity of density and pressure is checked after every stage.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+from mpm_fem.grid import Grid, GridError, uniform_grid
+
+SOD_LEFT = (1.0, 0.0, 1.0)
+SOD_RIGHT = (0.125, 0.0, 0.1)
+SOD_DIAPHRAGM = 0.5
+MASS_KINDS = ("consistent", "lumped")
+
+
+class PositivityError(ArithmeticError):
+    """Density or pressure lost positivity (or became non-finite) during a run."""
+
+
+@dataclass(frozen=True)
+class Viscosity:
+    """Constants of ``nu_e = h_e (linear s_e + quadratic max(0, -du_e))`` (module docstring)."""
+
+    linear: float = 0.1
+    quadratic: float = 1.0
+
+    def __post_init__(self):
+        for name in ("linear", "quadratic"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0):
+                raise ValueError(f"viscosity constant {name} must be finite and >= 0, got {value}")
+
+
+@dataclass(frozen=True)
+class EulerFEMResult:
+    """Nodal fields at time ``t``: ``nodes``, ``rho``, ``u``, ``p``, ``e`` (specific internal
+    energy ``p / ((gamma - 1) rho)``), all (n_nodes,); ``steps`` taken; ``settings`` of the run."""
+
+    nodes: np.ndarray
+    rho: np.ndarray
+    u: np.ndarray
+    p: np.ndarray
+    e: np.ndarray
+    t: float
+    steps: int
+    settings: dict
+
+
+@dataclass(frozen=True, eq=False)
+class _Operators:
+    """Cell connectivity (``a``, ``b`` node of each cell), cell sizes, and the mass solves."""
+
+    a: np.ndarray
+    b: np.ndarray
+    h: np.ndarray
+    n_nodes: int
+    mass: str
+    lumped: np.ndarray
+    solve_free: object = None  # consistent M, for rho and E
+    solve_wall: object = None  # consistent M with wall rows replaced by identity, for rho u
+
+
+def _operators(grid: Grid, mass: str) -> _Operators:
+    t = grid.mesh.t
+    x = grid.mesh.p[0]
+    a, b = t[0], t[1]
+    ops = dict(a=a, b=b, h=x[b] - x[a], n_nodes=grid.n_nodes, mass=mass, lumped=grid.lumped_mass)
+    if mass == "consistent":
+        M = grid.consistent_mass.tocsc()
+        keep = np.ones(grid.n_nodes)
+        keep[grid.boundary_nodes] = 0.0
+        wall = (sp.diags(keep) @ M + sp.diags(1.0 - keep)).tocsc()
+        ops.update(solve_free=splu(M).solve, solve_wall=splu(wall).solve)
+    return _Operators(**ops)
+
+
+def primitives(U: np.ndarray, gamma: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(rho, u, p)`` from ``U = (rho, rho u, E)`` (3, n)."""
+    rho, mom, E = U
+    u = mom / rho
+    return rho, u, (gamma - 1.0) * (E - 0.5 * mom * u)
+
+
+def _check_positive(U: np.ndarray, gamma: float, step: int, stage: int) -> None:
+    """Raise :class:`PositivityError` naming the step, stage and first bad node."""
+    rho = U[0]
+    with np.errstate(all="ignore"):
+        p = (gamma - 1.0) * (U[2] - 0.5 * U[1] ** 2 / rho)
+    for name, q in (("density", rho), ("pressure", p)):
+        bad = np.flatnonzero(~(q > 0))  # also catches NaN
+        if bad.size:
+            i = int(bad[0])
+            raise PositivityError(
+                f"{name} lost positivity at step {step} (RK stage {stage}), node {i}: "
+                f"{name} = {float(q[i]):.6g} ({bad.size} node(s) affected)"
+            )
+
+
+def residual(U: np.ndarray, ops: _Operators, gamma: float, visc: Viscosity) -> np.ndarray:
+    """``R_i(U)`` of the module docstring (3, n_nodes), assembled cell-wise with bincount."""
+    rho, u, p = primitives(U, gamma)
+    F = np.stack((U[1], U[1] * u + p, (U[2] + p) * u))
+    c = np.sqrt(gamma * p / rho)
+    speed = np.abs(u) + c
+    a, b = ops.a, ops.b
+    s_e = np.maximum(speed[a], speed[b])
+    nu = ops.h * (visc.linear * s_e + visc.quadratic * np.maximum(0.0, u[a] - u[b]))
+    half_dF = 0.5 * (F[:, b] - F[:, a])
+    diffusive = nu / ops.h * (U[:, b] - U[:, a])
+    n = ops.n_nodes
+    offset = n * np.arange(3)[:, None]  # one bincount for the three components
+    R = np.bincount((a + offset).ravel(), (-half_dF + diffusive).ravel(), 3 * n)
+    R += np.bincount((b + offset).ravel(), (-half_dF - diffusive).ravel(), 3 * n)
+    return R.reshape(3, n)
+
+
+def time_derivative(U: np.ndarray, ops: _Operators, gamma: float, visc: Viscosity) -> np.ndarray:
+    """``dU/dt = M^{-1} R(U)`` with ``d(rho u)/dt = 0`` at the wall nodes (3, n)."""
+    R = residual(U, ops, gamma, visc)
+    R[1, [0, -1]] = 0.0
+    if ops.mass == "lumped":
+        return R / ops.lumped
+    out = np.empty_like(R)
+    out[[0, 2]] = ops.solve_free(np.ascontiguousarray(R[[0, 2]].T)).T
+    out[1] = ops.solve_wall(R[1])
+    return out
+
+
+def sod_initial_state(nodes: np.ndarray, gamma: float) -> np.ndarray:
+    """Sod's data at the nodes, ``U`` (3, n); a node on the diaphragm takes the left state."""
+    left = nodes <= SOD_DIAPHRAGM
+    rho = np.where(left, SOD_LEFT[0], SOD_RIGHT[0])
+    u = np.where(left, SOD_LEFT[1], SOD_RIGHT[1])
+    p = np.where(left, SOD_LEFT[2], SOD_RIGHT[2])
+    return np.stack((rho, rho * u, p / (gamma - 1.0) + 0.5 * rho * u * u))
+
+
+def _validate(h, T, mass, cfl, gamma) -> None:
+    if mass not in MASS_KINDS:
+        raise ValueError(f"unknown mass {mass!r}: expected one of {MASS_KINDS}")
+    if not (np.isfinite(cfl) and 0.0 < cfl <= 1.0):
+        raise ValueError(f"cfl must lie in (0, 1], got cfl={cfl}")
+    if not (np.isfinite(T) and T > 0):
+        raise ValueError(f"final time T must be positive and finite, got T={T}")
+    if not (np.isfinite(gamma) and gamma > 1):
+        raise ValueError(f"gamma must be > 1, got gamma={gamma}")
+
+
+def solve(
+    h: float,
+    T: float = 0.2,
+    mass: str = "lumped",
+    cfl: float = 0.3,
+    gamma: float = 1.4,
+    viscosity: Viscosity = Viscosity(),
+    progress: bool = False,
+) -> EulerFEMResult:
+    """Sod's shock tube on a uniform mesh of size ``h`` up to time ``T`` (module docstring).
+
+    Raises ValueError for bad input (``h`` not dividing [0, 1], ``cfl`` outside (0, 1], unknown
+    ``mass``) and :class:`PositivityError` naming the step and node if density or pressure
+    stops being positive.
+    """
+    _validate(h, T, mass, cfl, gamma)
+    try:
+        grid = uniform_grid(0.0, 1.0, h)
+    except GridError as err:
+        raise ValueError(str(err)) from err
+    ops = _operators(grid, mass)
+    U = sod_initial_state(grid.nodes, gamma)
+    h_min = float(grid.h.min())
+
+    def L(V):
+        return time_derivative(V, ops, gamma, viscosity)
+
+    t, steps = 0.0, 0
+    while t < T * (1 - 1e-14):
+        rho, u, p = primitives(U, gamma)
+        dt = min(cfl * h_min / float(np.max(np.abs(u) + np.sqrt(gamma * p / rho))), T - t)
+        U1 = U + dt * L(U)
+        _check_positive(U1, gamma, steps + 1, 1)
+        U2 = 0.75 * U + 0.25 * (U1 + dt * L(U1))
+        _check_positive(U2, gamma, steps + 1, 2)
+        U = U / 3.0 + 2.0 / 3.0 * (U2 + dt * L(U2))
+        _check_positive(U, gamma, steps + 1, 3)
+        t += dt
+        steps += 1
+        if progress and steps % 100 == 0:
+            print(f"fem_euler h={h} {mass}: step {steps}, t={t:.4f}/{T}", flush=True)
+
+    rho, u, p = primitives(U, gamma)
+    settings = dict(
+        problem="sod",
+        h=h,
+        T=T,
+        mass=mass,
+        cfl=cfl,
+        gamma=gamma,
+        viscosity=asdict(viscosity),
+        viscosity_form="nu_e = h_e (linear max(|u|+c) + quadratic max(0, u_a - u_b)) on all of U",
+        time_integrator="SSPRK3",
+        dt_rule="cfl * h / max(|u| + c)",
+        elements="P1",
+        boundary="walls: rho u = 0 at both end nodes",
+    )
+    return EulerFEMResult(
+        nodes=grid.nodes.copy(),
+        rho=rho,
+        u=u,
+        p=p,
+        e=p / ((gamma - 1.0) * rho),
+        t=t,
+        steps=steps,
+        settings=settings,
+    )

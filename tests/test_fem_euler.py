@@ -1,0 +1,143 @@
+"""Fixed-mesh Galerkin FEM for Sod's shock tube (baselines/fem_euler.py): conservation, accuracy
+against the exact Riemann solution, the kernel against scikit-fem, and error handling."""
+
+from functools import lru_cache
+
+import numpy as np
+import pytest
+from skfem import Basis, ElementLineP1, LinearForm, asm
+
+from baselines.exact.riemann import sample
+from baselines.fem_euler import (
+    SOD_LEFT,
+    SOD_RIGHT,
+    PositivityError,
+    Viscosity,
+    _operators,
+    residual,
+    sod_initial_state,
+    solve,
+)
+from mpm_fem.grid import grid_from_nodes, uniform_grid
+
+GAMMA = 1.4
+RHO_POST_SHOCK = 0.26557  # Toro, Table 4.2: rho*_R of Sod's problem
+
+
+@lru_cache(maxsize=None)
+def _run(h, mass):
+    return solve(h, mass=mass)
+
+
+def _density_l1(result):
+    """``sum_i w_i |rho_i - rho_exact(x_i)|`` with the lumped-mass weights ``w_i = int S_i dx``."""
+    x = result.nodes
+    w = np.zeros_like(x)
+    w[:-1] += 0.5 * np.diff(x)
+    w[1:] += 0.5 * np.diff(x)
+    rho_exact, _, _ = sample(x, result.t, SOD_LEFT, SOD_RIGHT, x0=0.5, gamma=GAMMA)
+    return float(np.sum(w * np.abs(result.rho - rho_exact)))
+
+
+@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+def test_mass_and_energy_are_conserved_to_round_off(mass):
+    h = 0.01
+    result = _run(h, mass)
+    grid = uniform_grid(0.0, 1.0, h)
+    m = grid.lumped_mass
+    U0 = sod_initial_state(grid.nodes, GAMMA)
+    mass0, mass_t = np.sum(m * U0[0]), np.sum(m * result.rho)
+    E_t = result.rho * result.e + 0.5 * result.rho * result.u**2
+    energy0, energy_t = np.sum(m * U0[2]), np.sum(m * E_t)
+    drift = mass_t - mass0
+    assert abs(drift) <= 1e-13 * mass0, f"mass drift {drift:.3e} after {result.steps} steps"
+    assert abs(energy_t - energy0) <= 1e-13 * energy0, f"energy drift {energy_t - energy0:.3e}"
+
+
+@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+def test_post_shock_density_is_within_one_percent_at_h_0_0025(mass):
+    result = _run(0.0025, mass)
+    plateau = (result.nodes >= 0.72) & (result.nodes <= 0.82)
+    rho = float(result.rho[plateau].mean())
+    assert abs(rho / RHO_POST_SHOCK - 1) < 0.01, f"post-shock density {rho:.5f} vs {RHO_POST_SHOCK}"
+
+
+@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+def test_density_l1_error_decreases_with_h(mass):
+    errors = [_density_l1(_run(h, mass)) for h in (0.01, 0.005, 0.0025)]
+    assert errors[1] < 0.8 * errors[0] and errors[2] < 0.8 * errors[1], f"L1 errors {errors}"
+    # A first-order-viscosity Galerkin scheme on Sod: L1 ~ h^(0.5..1) (measured ~0.7).
+    order = np.log2(errors[0] / errors[2]) / 2
+    assert 0.5 < order < 1.1, f"observed L1 order {order:.3f} from {errors}"
+
+
+@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+def test_solution_is_finite_positive_and_reaches_T(mass):
+    result = _run(0.005, mass)
+    assert result.t == pytest.approx(0.2, abs=1e-14)
+    for name in ("rho", "u", "p", "e"):
+        assert np.all(np.isfinite(getattr(result, name))), name
+    assert result.rho.min() > 0 and result.p.min() > 0
+    assert result.u[0] == 0.0 and result.u[-1] == 0.0, "walls: u = 0 at the end nodes"
+    assert np.allclose(result.e, result.p / (0.4 * result.rho))
+    assert result.settings["mass"] == mass
+    assert result.settings["viscosity"] == {"linear": 0.1, "quadratic": 1.0}
+
+
+def test_residual_kernel_matches_scikit_fem_linear_form():
+    """The bincount kernel equals the weak form assembled by scikit-fem on a non-uniform mesh."""
+    rng = np.random.default_rng(7)
+    grid = grid_from_nodes(np.sort(np.r_[0.0, rng.uniform(0, 1, 30), 1.0]))
+    n = grid.n_nodes
+    rho = 1 + 0.5 * rng.uniform(size=n)
+    u = rng.normal(size=n)
+    p = 1 + rng.uniform(size=n)
+    U = np.stack((rho, rho * u, p / (GAMMA - 1) + 0.5 * rho * u**2))
+    visc = Viscosity(linear=0.3, quadratic=1.5)
+    R = residual(U, _operators(grid, "lumped"), GAMMA, visc)
+
+    F = np.stack((U[1], U[1] * u + p, (U[2] + p) * u))
+    a, b = grid.mesh.t
+    c = np.sqrt(GAMMA * p / rho)
+    s_e = np.maximum(np.abs(u[a]) + c[a], np.abs(u[b]) + c[b])
+    nu = grid.h * (visc.linear * s_e + visc.quadratic * np.maximum(0.0, u[a] - u[b]))
+    basis = Basis(grid.mesh, ElementLineP1(), intorder=2)
+    nu_qp = np.repeat(nu[:, None], basis.X.shape[1], axis=1)
+
+    @LinearForm
+    def weak(v, w):
+        return -w["F"].grad[0] * v - w["nu"] * w["U"].grad[0] * v.grad[0]
+
+    for k in range(3):
+        ref = asm(weak, basis, F=basis.interpolate(F[k]), U=basis.interpolate(U[k]), nu=nu_qp)
+        gap = np.abs(R[k] - ref).max()
+        assert np.allclose(R[k], ref, rtol=1e-12, atol=1e-12), f"component {k}: {gap:.2e}"
+
+
+def test_lost_positivity_raises_with_step_and_node():
+    # The consistent mass with cfl = 1 overshoots at the diaphragm in the first step.
+    with pytest.raises(PositivityError, match=r"step 1 .*node \d+"):
+        solve(0.01, mass="consistent", cfl=1.0)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(h=0.03), "does not divide"),
+        (dict(h=-0.01), "positive"),
+        (dict(h=0.01, cfl=0.0), "cfl"),
+        (dict(h=0.01, cfl=1.5), "cfl"),
+        (dict(h=0.01, cfl=np.nan), "cfl"),
+        (dict(h=0.01, mass="diagonal"), "unknown mass"),
+        (dict(h=0.01, T=-1.0), "T"),
+        (dict(h=0.01, gamma=1.0), "gamma"),
+    ],
+)
+def test_bad_input_raises_value_error(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        solve(**kwargs)
+
+
+def test_negative_viscosity_constant_is_rejected():
+    with pytest.raises(ValueError, match="quadratic"):
+        Viscosity(linear=0.1, quadratic=-1.0)
