@@ -98,16 +98,17 @@ def build_parser() -> argparse.ArgumentParser:
     size.add_argument("--quick", dest="quick", action="store_true", default=True,
                       help="a subset of meshes, a few minutes on 2 cores (default)")
     size.add_argument("--full", dest="quick", action="store_false", help="every mesh of every study")
-    _add_study_options(reproduce, quick_flag=False)
+    _add_study_options(reproduce, quick_flag=False,
+                       out_help="figures folder (default: figures/quick with --quick, figures with --full)")
     return parser
 
 
-def _add_study_options(parser: argparse.ArgumentParser, quick_flag: bool = True) -> None:
+def _add_study_options(parser: argparse.ArgumentParser, quick_flag: bool = True, out_help: str | None = None) -> None:
     if quick_flag:
         parser.add_argument("--quick", action="store_true", help="the subset of meshes of the quick reproduction")
     parser.add_argument("--jobs", type=int, default=None, help="worker processes (default: the number of cores)")
     parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler, tcp://HOST:PORT")
-    parser.add_argument("--out", default="figures", help="figures folder (default: figures)")
+    parser.add_argument("--out", default=None, help=out_help or "figures folder (default: figures, or figures/quick with --quick)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
 
 
@@ -194,8 +195,9 @@ def _study_options(args):
 
     if args.jobs is not None and args.jobs < 1:
         raise UsageError(f"--jobs must be >= 1, got {args.jobs}")
+    out = args.out or ("figures/quick" if args.quick else "figures")
     try:
-        out = output.ensure_writable_dir(args.out)
+        out = output.ensure_writable_dir(out)
     except PermissionError as err:
         raise UsageError(str(err)) from None
     return StudyOptions(quick=args.quick, jobs=args.jobs, scheduler=args.scheduler, out=out,
