@@ -25,7 +25,7 @@ import scipy.sparse as sp
 
 from .grid import Grid
 
-BASES = ("mpm", "gimp")
+BASES = ("mpm", "gimp", "bspline")
 
 
 class OutsideGridError(ValueError):
@@ -156,10 +156,42 @@ def gimp_shape(grid: Grid, x: np.ndarray, volume: np.ndarray) -> Shape:
     return Shape(nodes, S, G, grid.n_nodes, cell)
 
 
+def _quadratic_bspline(r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``N(r)`` and ``N'(r)`` of the uniform quadratic B-spline centred at 0, support |r| < 3/2."""
+    a = np.abs(r)
+    inner = a <= 0.5
+    outer = (a > 0.5) & (a < 1.5)
+    value = np.where(inner, 0.75 - r * r, np.where(outer, 0.5 * (1.5 - a) ** 2, 0.0))
+    slope = np.where(inner, -2.0 * r, np.where(outer, -(1.5 - a) * np.sign(r), 0.0))
+    return value, slope
+
+
+def bspline_shape(grid: Grid, x: np.ndarray) -> Shape:
+    """A C1 basis: nodal quadratic B-splines on a uniform grid (Steffen, Kirby & Berzins 2008).
+
+    ``S_ip = N((x_p - x_i)/h)``, ``G_ip = N'((x_p - x_i)/h)/h`` with ``N`` the quadratic B-spline,
+    ``N(r) = 3/4 - r^2`` for ``|r| <= 1/2``, ``(3/2 - |r|)^2 / 2`` for ``1/2 <= |r| <= 3/2``. The
+    spline of the ghost node outside each end is folded into the end node, which keeps the
+    partition of unity on the whole grid. ``S_ip`` and ``G_ip`` are continuous in ``x_p``: a particle
+    crossing a node sees no jump in ``dS/dx`` (slides: the jump in the third derivative of ``x_p``).
+    """
+    h = grid.h
+    if np.ptp(h) > 1e-9 * h.max():
+        raise ValueError("the quadratic B-spline basis needs a uniform grid")
+    cell, xi = locate(grid, x)
+    offsets = np.arange(-1, 3)
+    r = xi[:, None] - offsets  # (x_p - x_{c+k}) / h for k = -1, 0, 1, 2
+    S, dS = _quadratic_bspline(r)
+    nodes = np.clip(cell[:, None] + offsets, 0, grid.n_nodes - 1)
+    return Shape(nodes, S, dS / h[0], grid.n_nodes, cell)
+
+
 def make_shape(grid: Grid, x: np.ndarray, volume: np.ndarray | None = None, basis: str = "mpm") -> Shape:
-    """``S_ip``, ``G_ip`` for the named basis: ``"mpm"`` (point mass) or ``"gimp"``."""
+    """``S_ip``, ``G_ip`` for the named basis: ``"mpm"`` (point mass), ``"gimp"`` or ``"bspline"``."""
     if basis == "mpm":
         return point_shape(grid, x)
+    if basis == "bspline":
+        return bspline_shape(grid, x)
     if basis == "gimp":
         if volume is None:
             raise ValueError("the GIMP basis needs the particle volumes")

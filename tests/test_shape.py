@@ -39,9 +39,11 @@ def test_point_shape_values_and_derivatives_match_scikit_fem(mesh):
     assert err_G < 1e-12 * (1 / grid.h.min()), f"G_ip differs from gbasis by {err_G:.2e}"
 
 
-@pytest.mark.parametrize("basis", ["mpm", "gimp"])
+@pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline"])
 @pytest.mark.parametrize("mesh", MESHES)
 def test_partition_of_unity_and_zero_gradient_sum(mesh, basis):
+    if basis == "bspline" and mesh != "uniform":
+        pytest.skip("the B-spline basis is defined on uniform grids")
     grid = grid_from_nodes(MESHES[mesh])
     rng = np.random.default_rng(2)
     x = rng.uniform(0, 1, 2000)
@@ -105,3 +107,30 @@ def test_lumped_mass_is_row_sum_of_scikit_fem_consistent_mass():
     expected = np.concatenate(([h[0] / 2], (h[:-1] + h[1:]) / 2, [h[-1] / 2]))
     np.testing.assert_allclose(grid.lumped_mass, expected, rtol=1e-13)
     assert abs(grid.consistent_mass.sum() - 1.0) < 1e-14
+
+
+def test_bspline_basis_is_c1_across_nodes_and_p1_is_not():
+    """Values and derivatives of S_ip are continuous as a particle crosses a node for the C1 basis."""
+    grid = uniform_grid(0.0, 1.0, 0.1)
+    node = 0.5
+    x = np.array([node - 1e-9, node + 1e-9])
+    b = make_shape(grid, x, basis="bspline")
+    jump_S = np.abs(np.diff(b.matrix().toarray(), axis=0)).max()
+    jump_G = np.abs(np.diff(b.matrix(derivative=True).toarray(), axis=0)).max()
+    assert jump_S < 1e-7 and jump_G < 1e-6, (jump_S, jump_G)
+    p1 = make_shape(grid, x, basis="mpm")
+    assert np.abs(np.diff(p1.matrix(derivative=True).toarray(), axis=0)).max() > 9.0  # 1/h jumps
+
+
+def test_bspline_reproduces_linear_fields_in_the_interior():
+    grid = uniform_grid(0.0, 1.0, 0.1)
+    x = np.random.default_rng(8).uniform(0.15, 0.85, 300)
+    b = make_shape(grid, x, basis="bspline")
+    f = 3.0 * grid.nodes - 1.0
+    np.testing.assert_allclose(b.gather(f), 3.0 * x - 1.0, atol=1e-13)
+    np.testing.assert_allclose(b.gather_gradient(f), 3.0, atol=1e-12)
+
+
+def test_bspline_refuses_non_uniform_grids():
+    with pytest.raises(ValueError, match="uniform"):
+        make_shape(grid_from_nodes(MESHES["graded"]), np.array([0.5]), basis="bspline")
