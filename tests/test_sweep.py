@@ -45,3 +45,45 @@ def test_a_corrupt_cache_entry_is_recomputed(tmp_path):
 def test_bad_job_count_is_refused():
     with pytest.raises(ValueError, match="jobs"):
         run_cases(square, [], jobs=0)
+
+
+def slow_square(case):
+    """``square`` taking a while, so that a sweep can be killed midway."""
+    import time
+
+    time.sleep(case["sleep"])
+    return square(case)
+
+
+def test_a_killed_sweep_resumes_without_recomputing_finished_cases(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    trace, cache = tmp_path / "trace", tmp_path / "cache"
+    cases = [{"n": n, "trace": str(trace), "sleep": 0.3} for n in range(12)]
+    script = (
+        "import sys, json; sys.path.insert(0, sys.argv[1]); import test_sweep; from mpm_fem.sweep import run_cases; "
+        "run_cases(test_sweep.slow_square, json.loads(sys.argv[2]), jobs=1, cache_dir=sys.argv[3], progress=False)"
+    )
+    import json
+
+    proc = subprocess.Popen([sys.executable, "-c", script, str(Path(__file__).parent), json.dumps(cases), str(cache)])
+    deadline = time.time() + 60
+    while time.time() < deadline and len(list(cache.glob("*.json"))) < 4:
+        time.sleep(0.05)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    finished = len(list(cache.glob("*.json")))
+    assert 4 <= finished < len(cases), f"{finished} cases finished before the kill"
+    ran_before = trace.read_text().split()
+
+    results = run_cases(slow_square, cases, jobs=2, cache_dir=cache, progress=False)
+    assert [r["square"] for r in results] == [n * n for n in range(12)]
+    ran_after = trace.read_text().split()[len(ran_before):]
+    # every case cached before the kill is reused; only the others (and at most the one killed mid-run) run
+    assert len(ran_after) == len(cases) - finished, (finished, ran_after)
+    assert not set(ran_after) & set(ran_before[:finished])
