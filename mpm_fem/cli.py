@@ -64,6 +64,9 @@ def _add_settings_options(parser: argparse.ArgumentParser, settings_cls, extra_c
             help=f"{HELP.get(f.name, f.name)} (default: %(default)s)",
         )
     parser.add_argument("--out", default=None, help="output directory (default: runs/<problem>-<settings hash>/)")
+    parser.add_argument("--save-fields", type=int, nargs="?", const=20, default=None, metavar="EVERY",
+                        help="write particle and grid fields every EVERY steps (default 20) as VTU files with a "
+                             ".pvd time series for ParaView, into DIR/fields/")
     parser.add_argument("--quiet", action="store_true", help="no progress bar and no summary line")
 
 
@@ -128,6 +131,16 @@ def _out_dir(args, problem: str, settings) -> Path:
         raise UsageError(str(err)) from None
 
 
+def _field_writer(args, out: Path, grid):
+    if args.save_fields is None:
+        return None
+    if args.save_fields < 1:
+        raise UsageError(f"--save-fields takes a step interval >= 1, got {args.save_fields}")
+    from .fields import FieldWriter
+
+    return FieldWriter(out / "fields", grid, args.save_fields)
+
+
 def _record(out: Path, problem: str, settings, result, errors: dict, extra_csv=None) -> dict:
     summary = {
         "problem": problem,
@@ -152,7 +165,10 @@ def cmd_sod(args) -> dict:
 
     settings = _settings(sod.SodSettings, args)
     out = _out_dir(args, "sod", settings)
-    result = sod.simulate(settings, progress=False if args.quiet else None)
+    writer = _field_writer(args, out, sod.uniform_grid(*sod.DOMAIN, settings.h))
+    result = sod.simulate(settings, progress=False if args.quiet else None, observer=writer)
+    if writer is not None:
+        writer.close(result.t, result.particles)
     errors = sod.errors(settings, result)
     rho, u, p = sod.exact(settings, result.particles.x, result.t)
     summary = _record(out, "sod", settings, result, errors, {"density_exact": rho})
@@ -176,7 +192,10 @@ def cmd_burgers(args) -> dict:
 
     settings = _settings(burgers.BurgersSettings, args)
     out = _out_dir(args, "burgers", settings)
-    result = burgers.simulate(settings, progress=False if args.quiet else None)
+    writer = _field_writer(args, out, burgers.uniform_grid(*settings.exact.domain, settings.h))
+    result = burgers.simulate(settings, progress=False if args.quiet else None, observer=writer)
+    if writer is not None:
+        writer.close(result.t, result.particles)
     errors = burgers.errors(settings, result)
     solution = settings.exact
     summary = _record(out, "burgers", settings, result, errors, {"velocity_exact": solution.v(result.particles.x, result.t)})

@@ -85,3 +85,25 @@ def test_help_of_every_command_exits_0():
         proc = subprocess.run([sys.executable, "-m", "mpm_fem.cli", *argv], capture_output=True, text=True,
                               env={**os.environ, "PYTHONPATH": os.getcwd()})
         assert proc.returncode == 0 and "usage: mpm-fem" in proc.stdout
+
+
+def test_saved_fields_read_back_with_meshio_match_the_run(tmp_path):
+    import meshio
+    import numpy as np
+
+    out = tmp_path / "f"
+    assert main(["sod", "--h", "0.05", "--T", "0.05", "--save-fields", "5", "--out", str(out), "--quiet"]) == 0
+    fields = out / "fields"
+    pvd = (fields / "particles.pvd").read_text()
+    assert pvd.count("<DataSet") == len(list(fields.glob("particles_*.vtu"))) >= 3
+    names = sorted(fields.glob("particles_*.vtu"))
+    first, last = meshio.read(names[0]), meshio.read(names[-1])
+    np.testing.assert_allclose(first.point_data["density"], np.where(first.points[:, 0] < 0.5, 1.0, 0.125))
+    table = np.loadtxt(out / "particles.csv", delimiter=",", skiprows=1)
+    order = np.argsort(last.points[:, 0], kind="stable")
+    np.testing.assert_allclose(last.points[order, 0], table[:, 0], rtol=1e-15)
+    np.testing.assert_allclose(last.point_data["density"][order], table[:, 4], rtol=1e-15)
+    grid = meshio.read(sorted(fields.glob("grid_*.vtu"))[0])
+    assert grid.points.shape[0] == 21 and grid.cells_dict["line"].shape == (20, 2)
+    assert abs(grid.point_data["mass"].sum() - 0.5625) < 1e-12
+    assert main(["sod", "--h", "0.05", "--save-fields", "0", "--out", str(out)]) == 2
