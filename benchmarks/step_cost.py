@@ -26,13 +26,13 @@ from mpm_fem.step import Stages, Walls, explicit_step
 
 def bare_transfers(nodes, S, G, q, f, n_nodes):
     """What any MPM step must do: 3 scatters and 3 gathers of the compact (n_p, 2) kernel."""
-    flat = nodes.ravel()
+    flat, n0, n1 = nodes.ravel(), nodes[:, 0], nodes[:, 1]
     m = np.bincount(flat, (S * q[:, None]).ravel(), n_nodes)
-    P = np.bincount(flat, (S * (q * f[nodes[:, 0]])[:, None]).ravel(), n_nodes)
+    P = np.bincount(flat, (S * (q * f[n0])[:, None]).ravel(), n_nodes)
     F = np.bincount(flat, (G * q[:, None]).ravel(), n_nodes)
-    a = (S * F[nodes]).sum(axis=1)
-    v = (S * P[nodes]).sum(axis=1)
-    L = (G * m[nodes]).sum(axis=1)
+    a = S[:, 0] * F[n0] + S[:, 1] * F[n1]
+    v = S[:, 0] * P[n0] + S[:, 1] * P[n1]
+    L = G[:, 0] * m[n0] + G[:, 1] * m[n1]
     return a, v, L
 
 

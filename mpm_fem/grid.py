@@ -55,6 +55,12 @@ class Grid:
         return float(self.nodes[0]), float(self.nodes[-1])
 
     @cached_property
+    def uniform_spacing(self) -> float | None:
+        """The mean cell size if all cells agree to 1e-6 relative (round-off of linspace), else None."""
+        h = self.h
+        return float(h.mean()) if np.ptp(h) <= 1e-6 * h.max() else None
+
+    @cached_property
     def boundary_nodes(self) -> np.ndarray:
         """Indices of the two end nodes, as scikit-fem reports them."""
         return np.sort(self.mesh.boundary_nodes())

@@ -57,11 +57,11 @@ class Shape:
 
     def gather(self, f: np.ndarray) -> np.ndarray:
         """Grid -> particles: ``sum_i S_ip f_i`` (n_p,)."""
-        return np.einsum("pk,pk->p", self.S, f[self.nodes])
+        return _row_dot(self.S, self.nodes, f)
 
     def gather_gradient(self, f: np.ndarray) -> np.ndarray:
         """Grid -> particles: ``sum_i G_ip f_i`` (n_p,)."""
-        return np.einsum("pk,pk->p", self.G, f[self.nodes])
+        return _row_dot(self.G, self.nodes, f)
 
     def matrix(self, derivative: bool = False) -> sp.csr_matrix:
         """The (n_p x n_nodes) sparse matrix of ``S_ip`` (or ``G_ip``); duplicates summed."""
@@ -69,6 +69,14 @@ class Shape:
         data = (self.G if derivative else self.S).ravel()
         rows = np.repeat(np.arange(n_p), k)
         return sp.csr_matrix((data, (rows, self.nodes.ravel())), shape=(n_p, self.n_nodes))
+
+
+def _row_dot(W: np.ndarray, nodes: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """``sum_k W[p, k] f[nodes[p, k]]``, column by column (k is 2 to 4): faster than einsum."""
+    out = W[:, 0] * f[nodes[:, 0]]
+    for k in range(1, W.shape[1]):
+        out += W[:, k] * f[nodes[:, k]]
+    return out
 
 
 def locate(grid: Grid, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -86,9 +94,21 @@ def locate(grid: Grid, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             f"particle {p} at x={float(x[p])!r} lies outside the grid [{float(a)}, {float(b)}] "
             f"({int(bad.sum())} such particles)"
         )
-    cell = np.searchsorted(grid.nodes, x, side="right") - 1
-    np.minimum(cell, grid.n_cells - 1, out=cell)
-    x0 = grid.nodes[cell]
+    last = grid.n_cells - 1
+    if grid.uniform_spacing is not None:
+        # O(n_p): floor of the scaled coordinate; the few points that round into a neighbouring
+        # cell are found again by bisection among the mesh's own nodes
+        cell = ((x - a) * (1.0 / grid.uniform_spacing)).astype(np.intp)
+        np.clip(cell, 0, last, out=cell)
+        x0 = grid.nodes[cell]
+        off = (x < x0) | ((x >= grid.nodes[cell + 1]) & (cell < last))
+        if off.any():
+            cell[off] = np.minimum(np.searchsorted(grid.nodes, x[off], side="right") - 1, last)
+            x0 = grid.nodes[cell]
+    else:
+        cell = np.searchsorted(grid.nodes, x, side="right") - 1
+        np.minimum(cell, last, out=cell)
+        x0 = grid.nodes[cell]
     xi = (x - x0) / (grid.nodes[cell + 1] - x0)
     return cell, xi
 
@@ -97,9 +117,11 @@ def point_shape(grid: Grid, x: np.ndarray) -> Shape:
     """Standard MPM: P1 hats at the particle points, ``S = (1 - xi, xi)``, ``G = (-1, 1)/h_c``."""
     cell, xi = locate(grid, x)
     inv_h = 1.0 / grid.h[cell]
-    nodes = np.stack((cell, cell + 1), axis=1)
-    S = np.stack((1.0 - xi, xi), axis=1)
-    G = np.stack((-inv_h, inv_h), axis=1)
+    n = cell.size
+    nodes, S, G = np.empty((n, 2), np.intp), np.empty((n, 2)), np.empty((n, 2))
+    nodes[:, 0], nodes[:, 1] = cell, cell + 1
+    S[:, 0], S[:, 1] = 1.0 - xi, xi
+    G[:, 0], G[:, 1] = -inv_h, inv_h
     return Shape(nodes, S, G, grid.n_nodes, cell)
 
 

@@ -134,3 +134,15 @@ def test_bspline_reproduces_linear_fields_in_the_interior():
 def test_bspline_refuses_non_uniform_grids():
     with pytest.raises(ValueError, match="uniform"):
         make_shape(grid_from_nodes(MESHES["graded"]), np.array([0.5]), basis="bspline")
+
+
+@pytest.mark.parametrize("n_cells", [3, 10, 3200, 125000])
+def test_fast_uniform_cell_search_agrees_with_bisection_on_nodes_and_neighbours(n_cells):
+    grid = uniform_grid(0.0, 1.0, 1.0 / n_cells)
+    nodes = grid.nodes
+    x = np.concatenate((np.random.default_rng(9).random(20000), nodes,
+                        np.nextafter(nodes[1:], -1.0), np.nextafter(nodes[:-1], 2.0)))
+    cell, xi = locate(grid, x)
+    expected = np.minimum(np.searchsorted(nodes, x, side="right") - 1, n_cells - 1)
+    assert np.array_equal(cell, expected)
+    assert xi.min() >= 0.0 and xi.max() <= 1.0
