@@ -29,6 +29,10 @@ run) when ``E_VG`` interpolates. Norms (:func:`mpm_fem.errors.norms`) weigh node
 Weights: ``"cell"`` is the slides' ``w_p = h/N_p^i`` (``m_ip = h rho_p / N_p^i``, the equal-weight
 rule of Hickernell's bound); ``"volume"`` is the particle volume ``V_p`` that a run carries. The two
 coincide for seeded layouts (``V_p = h/N_p``) and differ once particles have moved.
+
+Basis: ``"mpm"`` (point mass, ``S_ip = S_i(x_p)``, the slides' analysis) or ``"gimp"`` (``S_ip``,
+``G_ip`` averaged over the particle domain ``[x_p - w_p/2, x_p + w_p/2]``); both stand in for the
+same integrals of the P1 hats.
 """
 
 from __future__ import annotations
@@ -43,13 +47,14 @@ from .errors import norms
 from .grid import Grid
 from .particles import seed_positions
 from .quadrature import cell_points, discrepancy_d2, hickernell_bound, integrate_cells
-from .shape import point_shape
+from .shape import make_shape, point_shape
 from .transfer import divide_by_lumped, nodal_internal_force, nodal_mass, nodal_momentum
 
 Field = Callable[[np.ndarray], np.ndarray]
 QUANTITIES = ("E_m", "E_P", "E_F", "E_a", "E_a_pred", "E_v", "E_v1", "E_VG", "E_VG_proj")
 LAYOUTS = ("regular", "jittered", "random", "advected")
 WEIGHTS = ("cell", "volume")
+BASES = ("mpm", "gimp")
 
 
 @dataclass(frozen=True)
@@ -111,9 +116,16 @@ def exact_nodal(grid: Grid, fields: Fields) -> Nodal:
     )
 
 
-def particle_nodal(grid: Grid, x: np.ndarray, w: np.ndarray, fields: Fields) -> Nodal:
+def _shape(grid: Grid, x: np.ndarray, w: np.ndarray, basis: str):
+    if basis not in BASES:
+        raise ValueError(f"the projection errors compare with integrals of the P1 hats: basis must be one of "
+                         f"{', '.join(BASES)}, got {basis!r}")
+    return make_shape(grid, x, w, basis)
+
+
+def particle_nodal(grid: Grid, x: np.ndarray, w: np.ndarray, fields: Fields, basis: str = "mpm") -> Nodal:
     """The MPM sums with ``m_p = rho(x_p) w_p``: ``m_i``, ``P_i``, ``F_i = sum_p w_p p_p G_ip``."""
-    shape = point_shape(grid, x)
+    shape = _shape(grid, x, w, basis)
     m_p = fields.rho(x) * w
     return Nodal(
         m=nodal_mass(shape, m_p),
@@ -155,10 +167,11 @@ class ProjectionErrors:
         return {q: norms(getattr(self, q), weights.get(q, self.nodal_weights)) for q in QUANTITIES}
 
 
-def projection_errors(grid: Grid, x: np.ndarray, w: np.ndarray, fields: Fields) -> ProjectionErrors:
-    """Every projection error of the slides for particles ``x`` with weights ``w`` (see module doc)."""
+def projection_errors(grid: Grid, x: np.ndarray, w: np.ndarray, fields: Fields, basis: str = "mpm") -> ProjectionErrors:
+    """Every projection error of the slides for particles ``x`` with weights ``w`` (see module doc);
+    ``basis="gimp"`` projects with the hats averaged over the particle domains ``x_p +- w_p/2``."""
     x, w = np.asarray(x, dtype=float), np.asarray(w, dtype=float)
-    ex, mpm = exact_nodal(grid, fields), particle_nodal(grid, x, w, fields)
+    ex, mpm = exact_nodal(grid, fields), particle_nodal(grid, x, w, fields, basis)
     inner = slice(1, -1)
     a, v = ex.F / ex.m, ex.P / ex.m
     a_mpm, v_mpm = divide_by_lumped(mpm.F, mpm.m), divide_by_lumped(mpm.P, mpm.m)
@@ -167,7 +180,7 @@ def projection_errors(grid: Grid, x: np.ndarray, w: np.ndarray, fields: Fields) 
     E_v[[0, -1]] = 0.0
     v_nodes = v_mpm.copy()
     v_nodes[[0, -1]] = fields.v(grid.nodes[[0, -1]])
-    shape = point_shape(grid, x)
+    shape = _shape(grid, x, w, basis)
     return ProjectionErrors(
         E_m=E_m[inner],
         E_P=(ex.P - mpm.P)[inner],

@@ -118,13 +118,13 @@ def discrepancy_d2_slides(grid: Grid, x: np.ndarray) -> np.ndarray:
 
 
 def estimate_c(h, n, d2_slides) -> float:
-    """Least-squares ``C`` of (4): minimises ``sum (D2^2 - 1/(12 N^2) - C h^2)^2`` over the samples.
+    """Least-squares ``C`` of (4), relative to ``h^2``: minimises ``sum ((D2^2 - 1/(12 N^2))/h^2 - C)^2``
+    over the samples (every mesh weighs the same), i.e. the mean of ``(D2^2 - 1/(12 N^2))/h^2``.
 
     ``h``, ``n`` (particles per cell) and ``d2_slides`` (the literal (3)) are arrays of samples.
     """
     h, n, d = (np.asarray(a, dtype=float) for a in (h, n, d2_slides))
-    y = d**2 - 1.0 / (12.0 * n**2)
-    return float(np.sum(y * h**2) / np.sum(h**4))
+    return float(np.mean((d**2 - 1.0 / (12.0 * n**2)) / h**2))
 
 
 def integrate_cells(grid: Grid, integrand: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
