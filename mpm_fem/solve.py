@@ -1,7 +1,8 @@
 """The time loop: ``run(problem, grid, particles, stages) -> Result``.
 
-Steps :func:`mpm_fem.step.explicit_step` from ``t = 0`` to ``T`` with ``dt = model.stable_dt``
-(the last step shortened to land on ``T``). Every step is checked: lost positivity raises
+Steps :func:`mpm_fem.step.explicit_step` from ``t = 0`` to ``T`` with ``dt = model.stable_dt``,
+or the problem's fixed ``dt``, divided by ``stages.refine`` (the last step shortened to land on
+``T``). Every step is checked: lost positivity raises
 :class:`~mpm_fem.particles.PositivityError` naming the step, and a non-finite particle state raises
 :class:`FloatingPointError` naming the step and the particle: a run never returns NaN.
 """
@@ -15,11 +16,12 @@ from typing import Callable
 import numpy as np
 from tqdm.auto import tqdm
 
+from .exact_stages import ExactFields
 from .grid import Grid
 from .particles import Particles, PositivityError
 from .shape import make_shape
 from .step import Boundary, GridState, Model, Stages, explicit_step
-from .transfer import grid_values, nodal_mass, nodal_momentum
+from .transfer import MASS_KINDS, grid_values, nodal_mass, nodal_momentum
 
 Observer = Callable[[int, float, Particles, Particles, GridState], None]
 
@@ -29,7 +31,9 @@ class Problem:
     """What the time loop needs besides the particles.
 
     ``particle_boundary(particles, grid, t) -> particles`` removes particles that left the grid
-    and adds inflow particles (Burgers); ``exact_acceleration(x_i, t)`` serves the exact stage.
+    and adds inflow particles (Burgers); ``exact_acceleration(x_i, t)`` serves the exact stage;
+    ``exact`` (:class:`~mpm_fem.exact_stages.ExactFields`) serves the exact projection, mass and
+    interpolation stages; ``dt``, if given, is a fixed time step instead of the CFL step.
     """
 
     model: Model
@@ -38,12 +42,16 @@ class Problem:
     cfl: float
     exact_acceleration: Callable[[np.ndarray, float], np.ndarray] | None = None
     particle_boundary: Callable[[Particles, Grid, float], Particles] | None = None
+    exact: ExactFields | None = None
+    dt: float | None = None
 
     def __post_init__(self):
         if not (np.isfinite(self.T) and self.T >= 0):
             raise ValueError(f"the final time T must be >= 0, got {self.T}")
         if not (0 < self.cfl <= 1):
             raise ValueError(f"the CFL number must lie in (0, 1], got {self.cfl}")
+        if self.dt is not None and not (np.isfinite(self.dt) and self.dt > 0):
+            raise ValueError(f"a fixed time step must be positive, got {self.dt}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,7 +79,8 @@ def project(grid: Grid, particles: Particles, stages: Stages) -> tuple[np.ndarra
     shape = make_shape(grid, particles.x, particles.volume, stages.basis)
     m_i = nodal_mass(shape, particles.mass)
     P_i = nodal_momentum(shape, particles.mass, particles.velocity)
-    return m_i, grid_values(shape, particles.mass, m_i, P_i, stages.mass)
+    kind = stages.mass if stages.mass in MASS_KINDS else "lumped"  # "exact" is a stage switch
+    return m_i, grid_values(shape, particles.mass, m_i, P_i, kind)
 
 
 def _check_finite(particles: Particles, step: int, t: float) -> None:
@@ -101,13 +110,15 @@ def run(
                bar_format="{l_bar}{bar}| t={n:.4g}/{total:.4g} [{elapsed}<{remaining}]")
     try:
         while t < problem.T * (1 - 1e-12):
-            dt = min(problem.model.stable_dt(particles, grid, problem.cfl), problem.T - t)
+            base = problem.model.stable_dt(particles, grid, problem.cfl) if problem.dt is None else problem.dt
+            dt = min(base / stages.refine, problem.T - t)
             if not (dt > 0 and np.isfinite(dt)):
                 raise FloatingPointError(f"time step {dt!r} at step {steps} (t={t:.6g}) is not positive and finite")
             if steps >= max_steps:
                 raise RuntimeError(f"{max_steps} steps did not reach T={problem.T} (t={t:.6g})")
             try:
-                new, state = explicit_step(grid, particles, problem.model, problem.boundary, t, dt, stages, problem.exact_acceleration)
+                new, state = explicit_step(grid, particles, problem.model, problem.boundary, t, dt, stages,
+                                           problem.exact_acceleration, problem.exact)
             except PositivityError as err:
                 raise err.at(steps, t) from None
             if problem.particle_boundary is not None:

@@ -12,7 +12,9 @@ The particle state (density, energy, pressure) is updated from the velocity grad
     MUSL (modified USL): as USL, with v_i^{n+1} re-projected from the updated particle velocities.
 
 Each stage of the step has a switch (:class:`Stages`); the exact forms used by the error budget
-are supplied by the problem (``exact_acceleration``).
+are supplied by the problem (``exact_acceleration``, and :class:`~mpm_fem.exact_stages.
+ExactFields` for the projection, mass and interpolation switches; their equations are in
+:mod:`mpm_fem.exact_stages`). The default stages run the plain MPM step below, untouched.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import Callable, Protocol
 
 import numpy as np
 
+from .exact_stages import ExactFields, GridData, exact_projection
 from .grid import Grid
 from .particles import Particles
 from .shape import BASES, make_shape
@@ -29,27 +32,46 @@ from .transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass,
 
 SCHEMES = ("usl", "usf", "musl")
 ACCELERATIONS = ("calculated", "exact")
+PROJECTIONS = ("mpm", "exact")
+INTERPOLATIONS = ("mpm", "exact")
+STAGE_MASS = MASS_KINDS + ("exact",)
 
 
 @dataclass(frozen=True)
 class Stages:
     """Which form each stage of the step takes.
 
-    ``basis``: ``"mpm"`` (point mass) or ``"gimp"``; ``mass``: ``"lumped"`` or ``"consistent"``
-    (particle mass matrix); ``acceleration``: ``"calculated"`` (``F_i/m_i``) or ``"exact"`` (the
-    problem's exact nodal acceleration); ``scheme``: ``"usl"``, ``"usf"`` or ``"musl"``.
+    ``basis``: ``"mpm"`` (point mass), ``"gimp"`` or ``"bspline"``; ``mass``: ``"lumped"``,
+    ``"consistent"`` (particle mass matrix) or ``"exact"`` (FE + lumping error removed);
+    ``acceleration``: ``"calculated"`` (``F_i/m_i``) or ``"exact"`` (the problem's exact nodal
+    acceleration); ``scheme``: ``"usl"``, ``"usf"`` or ``"musl"``; ``projection`` and
+    ``interpolation``: ``"mpm"`` or ``"exact"``; ``refine``: the time step is ``dt / refine``.
+    The exact forms are those of :mod:`mpm_fem.exact_stages`.
     """
 
     basis: str = "mpm"
     mass: str = "lumped"
     acceleration: str = "calculated"
     scheme: str = "usl"
+    projection: str = "mpm"
+    interpolation: str = "mpm"
+    refine: int = 1
 
     def __post_init__(self):
-        for name, allowed in (("basis", BASES), ("mass", MASS_KINDS), ("acceleration", ACCELERATIONS), ("scheme", SCHEMES)):
+        for name, allowed in (("basis", BASES), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
+                              ("scheme", SCHEMES), ("projection", PROJECTIONS), ("interpolation", INTERPOLATIONS)):
             value = getattr(self, name)
             if value not in allowed:
                 raise ValueError(f"unknown {name} {value!r}; choose one of {', '.join(allowed)}")
+        if isinstance(self.refine, bool) or not isinstance(self.refine, (int, np.integer)) or self.refine < 1:
+            raise ValueError(f"the time refinement must be an integer >= 1, got {self.refine!r}")
+        if self.uses_exact_fields and self.scheme == "musl":
+            raise ValueError("the exact projection, mass and interpolation stages are defined for USL and USF only")
+
+    @property
+    def uses_exact_fields(self) -> bool:
+        """Whether a stage needs the problem's :class:`~mpm_fem.exact_stages.ExactFields`."""
+        return self.projection == "exact" or self.interpolation == "exact" or self.mass == "exact"
 
 
 class Model(Protocol):
@@ -123,8 +145,11 @@ def explicit_step(
     dt: float,
     stages: Stages = Stages(),
     exact_acceleration: Callable[[np.ndarray, float], np.ndarray] | None = None,
+    exact: ExactFields | None = None,
 ) -> tuple[Particles, GridState]:
     """Advance the particles from ``t`` to ``t + dt``; returns the new particles and the grid state."""
+    if stages.uses_exact_fields:
+        return _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exact_acceleration, exact)
     shape = make_shape(grid, particles.x, particles.volume, stages.basis)
     h_p = grid.h[shape.cell]
     m, V = particles.mass, particles.volume
@@ -156,3 +181,74 @@ def explicit_step(
     if stages.scheme in ("usl", "musl"):
         particles = model.update(particles, shape.gather_gradient(v_new), dt, h_p)
     return particles, GridState(m_i, v_i, a_i, v_new)
+
+
+def _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exact_acceleration, exact):
+    """:func:`explicit_step` with some stages in their exact form (:mod:`mpm_fem.exact_stages`).
+
+    The same pipeline as the plain step; at each stage the MPM value is replaced as follows.
+    projection: ``m_i, P_i, F_i`` are the exact integrals. mass ``"exact"``: a nodal value is the
+    exact nodal value plus the projection error carried through the lumped solve. interpolation:
+    ``f_p = f*(x_p) + sum_i S_ip (f_i - f*_i)`` for the particle acceleration, the velocity that
+    moves the particle and the velocity gradient.
+    """
+    if exact is None:
+        raise ValueError("the exact projection, mass and interpolation stages need the problem's exact fields")
+    shape = make_shape(grid, particles.x, particles.volume, stages.basis)
+    h_p = grid.h[shape.cell]
+    m = particles.mass
+    mpm = GridData(shape, m, nodal_mass(shape, m), nodal_momentum(shape, m, particles.velocity))
+    quad = exact_projection(grid, stages.basis, exact, t) if stages.projection == "exact" or stages.mass == "exact" else None
+    source = quad if stages.projection == "exact" else mpm
+    kind = "lumped" if stages.mass == "exact" else stages.mass
+    ref_v, _, ref_a = exact.reference(grid.nodes, t)
+
+    def solve(rhs: np.ndarray, exact_rhs: np.ndarray | None, reference: np.ndarray) -> np.ndarray:
+        if stages.mass != "exact":
+            return grid_values(source.shape, source.mass, source.m_i, rhs, kind)
+        if stages.projection == "exact":
+            return reference.copy()
+        own = grid_values(mpm.shape, mpm.mass, mpm.m_i, rhs, kind)
+        return reference + own - grid_values(quad.shape, quad.mass, quad.m_i, exact_rhs, kind)
+
+    P_exact = quad.P_i if quad is not None else None
+    v_i = boundary.velocity(grid, solve(source.P_i, P_exact, ref_v), t)
+
+    # the exact nodal values, with the grid's boundary rule: what the interpolation is exact for
+    star_v = boundary.velocity(grid, ref_v, t)
+    star_a = boundary.acceleration(grid, ref_a, star_v, t, dt)
+    exact_at_particles = stages.interpolation == "exact"
+    if exact_at_particles:
+        p_v, p_vx, p_a = exact.reference(particles.x, t)
+
+    def gradient(nodal, star, time):
+        if not exact_at_particles:
+            return shape.gather_gradient(nodal)
+        field = p_vx if time == t else exact.velocity_gradient(particles.x, time)
+        return field + shape.gather_gradient(nodal - star)
+
+    if stages.scheme == "usf":
+        particles = model.update(particles, gradient(v_i, star_v, t), dt, h_p)
+
+    if stages.acceleration == "exact":
+        if exact_acceleration is None:
+            raise ValueError("this problem has no exact acceleration to use")
+        a_i = exact_acceleration(grid.nodes, t)
+    else:
+        stress = model.stress(particles, gradient(v_i, star_v, t))
+        F_i = nodal_internal_force(shape, particles.volume, stress) if stages.projection == "mpm" else quad.F_i
+        a_i = solve(F_i, quad.F_i if quad is not None else None, ref_a)
+    a_i = boundary.acceleration(grid, a_i, v_i, t, dt)
+    v_new = v_i + dt * a_i
+
+    if exact_at_particles:
+        star_new = star_v + dt * star_a
+        acceleration = p_a + shape.gather(a_i - star_a)
+        moving = p_v + dt * p_a + shape.gather(v_new - star_new)
+    else:
+        star_new = None
+        acceleration, moving = shape.gather(a_i), shape.gather(v_new)
+    particles = particles.replace(x=particles.x + dt * moving, velocity=particles.velocity + dt * acceleration)
+    if stages.scheme == "usl":
+        particles = model.update(particles, gradient(v_new, star_new, t + dt), dt, h_p)
+    return particles, GridState(mpm.m_i, v_i, a_i, v_new)

@@ -1,0 +1,262 @@
+"""The exact forms of the stages of the MPM step (ARCHITECTURE.md, "The stage switches").
+
+The slides ("Explicit MPM Algorithm Errors") name four sources of error: projection,
+interpolation, time, and finite element + mass lumping. Each stage of :func:`mpm_fem.step.
+explicit_step` can be replaced by an exact form that removes the error *that stage adds*, while
+the errors carried in from the stages before it pass through unchanged. That is what makes the
+error budget (E1) additive. With ``f*`` the exact field a stage should deliver:
+
+    projection (particles -> grid)      m_i = int rho S_i dx,  P_i = int rho v S_i dx,
+                                        F_i = - int sigma S_i' dx
+                                        (composite Gauss-Legendre, split at the cell nodes, the
+                                        half cells and the problem's breakpoints: exact to
+                                        round-off for piecewise-polynomial fields)
+    mass (FE + lumping, grid solve)     u_i = u*(x_i) + [solve(MPM data) - solve(exact data)]:
+                                        the solve makes no error of its own on exact data
+    interpolation (grid -> particles)   f_p = f*(x_p) + sum_i S_ip (f_i - f*_i): the interpolant is
+                                        exact for the exact field; the nodal error still reaches
+                                        the particle
+    time                                dt -> dt / k (``Stages.refine``)
+
+``solve`` is the lumped division ``rhs_i / m_i`` (the MPM default) and ``f*_i`` are the exact
+nodal values with the boundary conditions applied (the grid's boundary rule is part of the
+scheme). Every stage exact leaves semi-implicit Euler on the exact fields:
+
+    v_p^{n+1} = v_p^n + dt a*(x_p^n, t^n),    x_p^{n+1} = x_p^n + dt (v* + dt a*)(x_p^n, t^n),
+    (dv/dx)_p = v*_x(x_p^n, t^{n+1})  (USL; USF: t^n),
+
+so the remainder is the time error of the (refined) step alone.
+
+A problem supplies its exact fields through :class:`ExactFields`: point values for the
+projection integrals, and the *reference* fields ``v*``, ``v*_x``, ``a* = Dv*/Dt`` that grid and
+particle values approximate. A smooth problem (Burgers, :class:`SmoothBurgersFields`) uses the
+point values. Across a shock ``v*_x`` and ``a*`` are Dirac masses, so Sod
+(:class:`RiemannFields`) uses the exact fields averaged over a particle domain of width ``2 l``
+(the GIMP ``chi_p``):
+
+    v*(x) = 1/(2l) int_{x-l}^{x+l} u dy,   v*_x = (u(x+l) - u(x-l)) / (2l),   a* = dv*/dt + v* v*_x,
+
+which is ``u + O(l^2)`` where ``u`` is smooth, finite at a shock, and consistent: a point moving
+with ``v*`` crosses a shock with the Rankine-Hugoniot density ratio, since
+``int v*_x dt = int_{u_1}^{u_2} du/(s - u) = log((s - u_1)/(s - u_2))``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Protocol
+
+import numpy as np
+
+from .grid import Grid
+from .shape import Shape, make_shape
+from .transfer import nodal_internal_force, nodal_mass, nodal_momentum
+
+GAUSS_POINTS = 5  # exact for polynomials of degree 9 (Sod's fan: rho u S_i has degree 7)
+_XI, _W = np.polynomial.legendre.leggauss(GAUSS_POINTS)
+
+
+class ExactFields(Protocol):
+    """The exact solution as the exact stages need it (all arrays have the shape of ``x``)."""
+
+    def integrand(self, x: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Point values ``(rho, v, sigma)`` integrated by the exact projection."""
+        ...
+
+    def breakpoints(self, t: float) -> np.ndarray:
+        """Where the integrand may jump or kink at time ``t`` (quadrature splits there)."""
+        ...
+
+    def reference(self, x: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Reference fields ``(v*, v*_x, a*)`` at ``x``: what nodal and particle values approximate."""
+        ...
+
+    def velocity_gradient(self, x: np.ndarray, t: float) -> np.ndarray:
+        """``v*_x`` alone (the second entry of :meth:`reference`)."""
+        ...
+
+
+@dataclass(frozen=True, eq=False)
+class GridData:
+    """What the projection hands the grid: the kernel and weights that define the mass matrix
+    ``M_ij = sum_q w_q S_iq S_jq`` (particles, or quadrature points), and ``m_i``, ``P_i``, ``F_i``."""
+
+    shape: Shape
+    mass: np.ndarray
+    m_i: np.ndarray
+    P_i: np.ndarray
+    F_i: np.ndarray | None = field(default=None)
+
+
+def quadrature(grid: Grid, breakpoints=()) -> tuple[np.ndarray, np.ndarray]:
+    """Points and weights of the composite Gauss-Legendre rule on the grid's domain.
+
+    The domain is split at every node, every cell midpoint (the knots of the quadratic
+    B-splines) and every breakpoint inside it; each piece gets ``GAUSS_POINTS`` points.
+    """
+    a, b = grid.domain
+    cuts = [grid.nodes, 0.5 * (grid.nodes[:-1] + grid.nodes[1:])]
+    inner = np.asarray(breakpoints, dtype=float)
+    cuts.append(inner[(inner > a) & (inner < b)])
+    edges = np.unique(np.concatenate(cuts))
+    left, width = edges[:-1], np.diff(edges)
+    x = (left + 0.5 * width)[:, None] + 0.5 * width[:, None] * _XI
+    w = 0.5 * width[:, None] * _W
+    return x.ravel(), w.ravel()
+
+
+def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float) -> GridData:
+    """``m_i = int rho S_i``, ``P_i = int rho v S_i``, ``F_i = -int sigma S_i'`` of the exact fields.
+
+    The grid functions are the P1 hats for the point-mass and GIMP bases (GIMP averages the same
+    hats over the particle domain) and the quadratic B-splines for ``"bspline"``. The quadrature
+    points act as particles of mass ``w_q rho_q`` and volume ``w_q``, so the consistent mass of the
+    exact projection is ``int rho S_i S_j`` by the same code as the particle mass matrix.
+    """
+    x, w = quadrature(grid, fields.breakpoints(t))
+    rho, v, sigma = fields.integrand(x, t)
+    shape = make_shape(grid, x, w, "bspline" if basis == "bspline" else "mpm")
+    mass = w * rho
+    m_i = nodal_mass(shape, mass)
+    return GridData(shape, mass, m_i, nodal_momentum(shape, mass, v), nodal_internal_force(shape, w, sigma))
+
+
+@dataclass(frozen=True)
+class SmoothBurgersFields:
+    """Viscous Burgers ``Dv/Dt = eps v_xx`` from a smooth exact solution (point values).
+
+    Unit density; stress ``sigma = eps v_x``; reference ``(v, v_x, eps v_xx)``.
+    """
+
+    solution: object  # baselines.exact.burgers solution: .fields(x, t) -> (v, v_x, v_xx, v_t)
+    eps: float
+
+    def integrand(self, x, t):
+        v, v_x, _, _ = self.solution.fields(x, t)
+        return np.ones_like(v), v, self.eps * v_x
+
+    def breakpoints(self, t):
+        return np.empty(0)
+
+    def reference(self, x, t):
+        v, v_x, v_xx, _ = self.solution.fields(x, t)
+        return v, v_x, self.eps * v_xx
+
+    def velocity_gradient(self, x, t):
+        return self.solution.fields(x, t)[1]
+
+
+@dataclass(frozen=True)
+class RiemannFields:
+    """Sod's tube (any Riemann problem without vacuum): exact ``(rho, u, -p)`` for the projection;
+    reference fields averaged over ``[x - l, x + l]`` (module docstring), in closed form.
+
+    The solution is self-similar, ``u(x, t) = U(xi)`` with ``xi = (x - x0)/t``, and ``U`` is
+    piecewise linear between the wave speeds (constant states, linear fans). With
+    ``F(xi) = int U``, ``alpha = (x - l - x0)/t`` and ``beta = (x + l - x0)/t``:
+
+        v*   = t (F(beta) - F(alpha)) / (2l),      v*_x = (U(beta) - U(alpha)) / (2l),
+        dv*/dt = (G(beta) - G(alpha)) / (2l),      G = F - xi U,
+
+    the last from differentiating ``t (F(beta) - F(alpha))`` in ``t``. At ``t = 0`` the limits.
+    """
+
+    left: tuple
+    right: tuple
+    x0: float
+    gamma: float
+    half_width: float
+
+    def __post_init__(self):
+        if not self.half_width > 0:
+            raise ValueError(f"the averaging half-width must be positive, got {self.half_width}")
+
+    @cached_property
+    def _speeds(self) -> np.ndarray:
+        """Sorted speeds of the wave fronts (fan heads and tails, contact, shocks)."""
+        from baselines.exact import riemann
+
+        waves = riemann.wave_positions(1.0, self.left, self.right, self.x0, self.gamma)
+        fronts = [v for k, v in waves.items() if k.startswith(("left_", "right_")) or k == "contact"]
+        return np.sort(np.array(fronts) - self.x0)
+
+    @cached_property
+    def _pieces(self) -> tuple[np.ndarray, ...]:
+        """Per piece ``k`` of ``U`` (0: left of the first speed, ...): anchor ``xi_k``, ``F(xi_k)``,
+        ``U(xi_k^+)`` and slope ``m_k``, so that ``U = U_k + m_k (xi - xi_k)`` on the piece."""
+        knots = self._speeds
+        anchor = np.concatenate(([knots[0]], knots))
+        end = np.concatenate((knots, [knots[-1] + 1.0]))
+        width = end - anchor
+        probe = np.where(width > 0, width, 1.0)
+        a, b = anchor + 0.25 * probe, anchor + 0.75 * probe
+        a[0], b[0] = knots[0] - 1.0, knots[0] - 0.5  # the outer states: constant
+        _, ua, _ = self._sample(self.x0 + a, 1.0)
+        _, ub, _ = self._sample(self.x0 + b, 1.0)
+        slope = np.where(width > 0, (ub - ua) / (b - a), 0.0)
+        slope[0] = slope[-1] = 0.0
+        value = ua - slope * (a - anchor)
+        value[0] = ua[0]
+        F = np.zeros_like(anchor)
+        inner = np.diff(knots)
+        for k in range(2, anchor.size):  # a handful of wave fronts, not particles
+            w = inner[k - 2]
+            F[k] = F[k - 1] + value[k - 1] * w + 0.5 * slope[k - 1] * w * w
+        return anchor, F, value, slope
+
+    def _profile(self, xi):
+        """``U(xi)``, ``F(xi)`` and ``G(xi) = F - xi U`` for finite ``xi``."""
+        anchor, F0, U0, m = self._pieces
+        k = np.searchsorted(self._speeds, xi, side="right")
+        d = xi - anchor[k]
+        U = U0[k] + m[k] * d
+        F = F0[k] + U0[k] * d + 0.5 * m[k] * d * d
+        G = F0[k] - U0[k] * anchor[k] + 0.5 * m[k] * d * d - xi * m[k] * d
+        return U, F, G
+
+    def _sample(self, x, t):
+        from baselines.exact import riemann
+
+        return riemann.sample(x, t, self.left, self.right, x0=self.x0, gamma=self.gamma)
+
+    def breakpoints(self, t):
+        return self.x0 + self._speeds * t
+
+    def integrand(self, x, t):
+        rho, u, p = self._sample(x, t)
+        return rho, u, -p
+
+    def _initial(self, x):
+        """``(v*, v*_x, dv*/dt)`` at ``t = 0``: averages of the step data and their limits."""
+        l = self.half_width
+        u_l, u_r = self.left[1], self.right[1]
+        lo, hi = x - l, x + l
+        left_part = np.clip(self.x0 - lo, 0.0, 2 * l)
+        v = (u_l * left_part + u_r * (2 * l - left_part)) / (2 * l)
+        inside = (lo < self.x0) & (self.x0 <= hi)
+        anchor, F0, U0, _ = self._pieces
+        g_left, g_right = F0[0] - U0[0] * anchor[0], F0[-1] - U0[-1] * anchor[-1]
+        return v, np.where(inside, (u_r - u_l) / (2 * l), 0.0), np.where(inside, (g_right - g_left) / (2 * l), 0.0)
+
+    def velocity_gradient(self, x, t):
+        x = np.asarray(x, dtype=float)
+        if t == 0:
+            return self._initial(x)[1]
+        l = self.half_width
+        U_hi = self._profile((x + l - self.x0) / t)[0]
+        U_lo = self._profile((x - l - self.x0) / t)[0]
+        return (U_hi - U_lo) / (2 * l)
+
+    def reference(self, x, t):
+        x = np.asarray(x, dtype=float)
+        if t == 0:
+            v, v_x, v_t = self._initial(x)
+        else:
+            l = self.half_width
+            U_hi, F_hi, G_hi = self._profile((x + l - self.x0) / t)
+            U_lo, F_lo, G_lo = self._profile((x - l - self.x0) / t)
+            v = t * (F_hi - F_lo) / (2 * l)
+            v_x = (U_hi - U_lo) / (2 * l)
+            v_t = (G_hi - G_lo) / (2 * l)
+        return v, v_x, v_t + v * v_x
