@@ -18,6 +18,7 @@ import numpy as np
 from baselines.exact import burgers as exact_burgers
 
 from ..errors import norms
+from ..exact_stages import SmoothBurgersFields
 from ..grid import Grid, uniform_grid
 from ..models.burgers import ViscousBurgers
 from ..particles import LAYOUTS, Particles, make_particles, seed_positions
@@ -41,6 +42,9 @@ class BurgersSettings:
     scheme: str = "usl"
     layout: str = "regular"
     seed: int = 0
+    projection: str = "mpm"
+    interpolation: str = "mpm"
+    refine: int = 1
 
     def __post_init__(self):
         if not (np.isfinite(self.eps) and self.eps > 0):
@@ -65,7 +69,8 @@ class BurgersSettings:
 
     @property
     def stages(self) -> Stages:
-        return Stages(basis=self.basis, mass=self.mass, acceleration=self.acceleration, scheme=self.scheme)
+        return Stages(basis=self.basis, mass=self.mass, acceleration=self.acceleration, scheme=self.scheme,
+                      projection=self.projection, interpolation=self.interpolation, refine=self.refine)
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -110,6 +115,11 @@ def initial_particles(settings: BurgersSettings, grid: Grid) -> Particles:
     return make_particles(x, volume, 1.0, settings.exact.v(x, 0.0))
 
 
+def exact_fields(settings: BurgersSettings) -> SmoothBurgersFields:
+    """The exact fields of the exact stages (:mod:`mpm_fem.exact_stages`): point values."""
+    return SmoothBurgersFields(settings.exact, settings.eps)
+
+
 def simulate(settings: BurgersSettings = BurgersSettings(), progress: bool | None = None, observer=None) -> Result:
     """Run MPM on viscous Burgers with ``settings``."""
     solution = settings.exact
@@ -121,6 +131,7 @@ def simulate(settings: BurgersSettings = BurgersSettings(), progress: bool | Non
         cfl=settings.cfl,
         exact_acceleration=lambda x, t: settings.eps * solution.v_xx(x, t),
         particle_boundary=Reservoir(settings.h / settings.ppc, solution.v),
+        exact=exact_fields(settings),
     )
     return run(problem, grid, initial_particles(settings, grid), settings.stages, progress, observer)
 

@@ -16,6 +16,7 @@ import numpy as np
 from baselines.exact import riemann
 
 from ..errors import norms
+from ..exact_stages import RiemannFields
 from ..grid import uniform_grid
 from ..models.euler import IdealGas
 from ..particles import LAYOUTS, make_particles, seed_positions
@@ -44,6 +45,9 @@ class SodSettings:
     left: tuple = (1.0, 0.0, 1.0)
     right: tuple = (0.125, 0.0, 0.1)
     x0: float = 0.5
+    projection: str = "mpm"
+    interpolation: str = "mpm"
+    refine: int = 1
 
     def __post_init__(self):
         uniform_grid(*DOMAIN, self.h)  # raises unless h divides [0, 1]
@@ -59,7 +63,8 @@ class SodSettings:
 
     @property
     def stages(self) -> Stages:
-        return Stages(basis=self.basis, mass=self.mass, scheme=self.scheme)
+        return Stages(basis=self.basis, mass=self.mass, scheme=self.scheme, projection=self.projection,
+                      interpolation=self.interpolation, refine=self.refine)
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -80,11 +85,19 @@ def exact(settings: SodSettings, x: np.ndarray, t: float):
     return riemann.sample(x, t, settings.left, settings.right, x0=settings.x0, gamma=settings.gamma)
 
 
+def exact_fields(settings: SodSettings) -> RiemannFields:
+    """The exact fields of the exact stages (:mod:`mpm_fem.exact_stages`): the Riemann solution,
+    averaged over one cell (half-width ``h / 2``) where a stage needs ``v_x`` or ``Dv/Dt``, which
+    are Dirac masses at the shock. One cell, not one particle: the artificial viscosity's length
+    is the cell size, and a gradient spread over ``h / N_p`` makes it overheat the shock."""
+    return RiemannFields(settings.left, settings.right, settings.x0, settings.gamma, settings.h / 2)
+
+
 def simulate(settings: SodSettings = SodSettings(), progress: bool | None = None, observer=None) -> Result:
     """Run MPM on Sod's tube with ``settings``."""
     grid = uniform_grid(*DOMAIN, settings.h)
     model = IdealGas(settings.gamma, settings.av_linear, settings.av_quadratic)
-    problem = Problem(model=model, boundary=Walls(), T=settings.T, cfl=settings.cfl)
+    problem = Problem(model=model, boundary=Walls(), T=settings.T, cfl=settings.cfl, exact=exact_fields(settings))
     return run(problem, grid, initial_particles(settings, grid), settings.stages, progress, observer)
 
 
