@@ -53,25 +53,37 @@ def divide_by_lumped(rhs: np.ndarray, m: np.ndarray) -> np.ndarray:
     return out
 
 
+def _tridiagonal_mass(shape: Shape, mass: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Diagonal ``M_ii`` (n_nodes,) and super-diagonal ``M_{i,i+1}`` (n_nodes - 1,) of the particle
+    mass matrix when every particle touches two neighbouring nodes ``(c, c + 1)`` (P1 point mass):
+    the same sums as :func:`particle_mass_matrix`, by bincount instead of sparse products."""
+    c, n = shape.nodes[:, 0], shape.n_nodes
+    S0, S1 = shape.S[:, 0], shape.S[:, 1]
+    diag = np.bincount(c, mass * S0 * S0, n) + np.bincount(c + 1, mass * S1 * S1, n)
+    return diag, np.bincount(c, mass * S0 * S1, n)[: n - 1]
+
+
 def solve_consistent(shape: Shape, mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """Solve ``M u = rhs`` with the particle mass matrix; nodes with no mass get 0.
 
     For P1 the matrix is tridiagonal and is solved banded; otherwise by sparse LU.
     """
-    M = particle_mass_matrix(shape, mass)
-    active = np.asarray(M.diagonal()) > 0
     out = np.zeros_like(rhs)
-    Ma = M[active][:, active]
-    n = Ma.shape[0]
+    tridiagonal = shape.nodes.shape[1] == 2 and np.array_equal(shape.nodes[:, 1], shape.nodes[:, 0] + 1)
     try:
-        if shape.nodes.shape[1] == 2 and Ma.nnz <= 3 * n:
-            ab = np.zeros((3, n))
-            ab[0, 1:] = Ma.diagonal(1)
-            ab[1] = Ma.diagonal()
-            ab[2, :-1] = Ma.diagonal(-1)
+        if tridiagonal:
+            diag, upper = _tridiagonal_mass(shape, mass)
+            active = np.flatnonzero(diag > 0)
+            ab = np.zeros((3, active.size))
+            ab[1] = diag[active]
+            # neighbours across a node without mass are not coupled
+            ab[0, 1:] = np.where(np.diff(active) == 1, upper[active[:-1]], 0.0)
+            ab[2, :-1] = ab[0, 1:]
             out[active] = solve_banded((1, 1), ab, rhs[active])
         else:
-            out[active] = spsolve(Ma.tocsc(), rhs[active])
+            M = particle_mass_matrix(shape, mass)
+            active = np.asarray(M.diagonal()) > 0
+            out[active] = spsolve(M[active][:, active].tocsc(), rhs[active])
         singular = not np.all(np.isfinite(out))
     except np.linalg.LinAlgError:
         singular = True

@@ -1,0 +1,182 @@
+"""Error by region of the exact solution (C12) and new extrema created by cell crossings (C14).
+
+Regions (slides, "Final Error Combination"). At time ``t`` the exact Sod solution has, from left
+to right, the rarefaction head ``x_H``, its tail ``x_T``, the contact ``x_C`` and the shock
+``x_S``. With one half-width ``w`` (the same for every wave and every mesh) the domain is cut into
+
+    0  undisturbed         [a, x_H - w)  and  [x_S + w, b]
+    1  rarefaction head    [x_H - w, x_H + w)
+    2  smooth              [x_H + w, x_T - w)  (the fan)  and  [x_T + w, x_C - w)  (the plateau)
+    3  rarefaction tail    [x_T - w, x_T + w)
+    4  contact             [x_C - w, x_C + w)
+    5  behind the shock    [x_C + w, x_S - w)  (carries the error the shock leaves behind)
+    6  shock front         [x_S - w, x_S + w)
+
+a partition of the domain, so the regional L1 errors ``sum_{k in region} w_k |e_k|`` (weights
+``V_p`` over particles, ``int S_i dx`` over nodes) add up to the total L1 error.
+
+New extrema (slides, "Particle Methods applied to Euler Equations": "differing particle velocity
+gradients in different cells may lead to new extrema when particles cross over cells"). With the
+particles in position order, particle ``p`` is a strict local extremum of a field ``q`` if
+
+    q_p > max(q_{p-1}, q_{p+1}) + tol   or   q_p < min(q_{p-1}, q_{p+1}) - tol,
+    tol = rtol * max(|q_{p-1}|, |q_p|, |q_{p+1}|)
+
+(the first and last particle are never extrema). A *new* extremum in a step is a particle that
+is an extremum after the step and was not before it. :class:`ExtremaCounter` counts them each
+step, separately for the particles that crossed a cell boundary in that step (cell of ``x_p^n``
+differs from the cell of ``x_p^{n+1}``) and for those that did not.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .grid import Grid
+from .particles import Particles
+
+REGION_NAMES = (
+    "undisturbed",
+    "rarefaction head",
+    "smooth",
+    "rarefaction tail",
+    "contact",
+    "behind shock",
+    "shock front",
+)
+
+
+@dataclass(frozen=True)
+class Regions:
+    """Breakpoints ``edges`` (increasing, n+1 for n pieces) and the region number of each piece."""
+
+    edges: np.ndarray
+    region: np.ndarray
+
+    def index(self, x: np.ndarray) -> np.ndarray:
+        """Region number (0..6) of every point of ``x``."""
+        piece = np.searchsorted(self.edges, np.asarray(x, dtype=float), side="right") - 1
+        return self.region[np.clip(piece, 0, self.region.size - 1)]
+
+
+def sod_regions(waves: dict, half_width: float, domain: tuple[float, float] = (0.0, 1.0)) -> Regions:
+    """The partition of the module docstring from the exact wave positions (``wave_positions``
+    of :mod:`baselines.exact.riemann`: keys ``rarefaction_head``, ``rarefaction_tail``,
+    ``contact``, ``shock``)."""
+    if not half_width > 0:
+        raise ValueError(f"the region half-width must be positive, got {half_width}")
+    H, T, C, S = (waves[k] for k in ("rarefaction_head", "rarefaction_tail", "contact", "shock"))
+    w = half_width
+    a, b = domain
+    if not (a < H - w and H + w <= T - w and T + w <= C - w and C + w <= S - w and S + w < b):
+        raise ValueError(f"half-width {w} makes the regions of waves at {H:.4g}, {T:.4g}, {C:.4g}, {S:.4g} overlap")
+    edges = np.array([a, H - w, H + w, T - w, T + w, C - w, C + w, S - w, S + w, b])
+    edges[-1] = np.nextafter(b, np.inf)  # the right end belongs to the last piece
+    region = np.array([0, 1, 2, 3, 2, 4, 5, 6, 0])
+    return Regions(edges=edges, region=region)
+
+
+def l1_by_region(x: np.ndarray, error: np.ndarray, weights: np.ndarray, regions: Regions) -> np.ndarray:
+    """``E_r = sum_{k: x_k in region r} w_k |e_k|`` for r = 0..6; ``sum_r E_r`` is the L1 norm."""
+    return np.bincount(regions.index(x), np.asarray(weights) * np.abs(error), len(REGION_NAMES))
+
+
+def mean_by_region(x: np.ndarray, error: np.ndarray, weights: np.ndarray, regions: Regions) -> np.ndarray:
+    """Signed weighted mean ``sum w_k e_k / sum w_k`` of the error in each region (0 where empty):
+    a bias (e.g. a density too low on a whole plateau) shows here, noise averages out."""
+    index = regions.index(x)
+    n = len(REGION_NAMES)
+    total = np.bincount(index, np.asarray(weights, dtype=float), n)
+    signed = np.bincount(index, np.asarray(weights) * np.asarray(error), n)
+    return np.divide(signed, total, out=np.zeros(n), where=total > 0)
+
+
+def strict_extrema(q: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
+    """Boolean mask of strict local extrema of ``q`` (ordered) beyond ``tol`` (module docstring)."""
+    q = np.asarray(q, dtype=float)
+    out = np.zeros(q.shape, dtype=bool)
+    if q.size < 3:
+        return out
+    left, mid, right = q[:-2], q[1:-1], q[2:]
+    tol = rtol * np.maximum(np.maximum(np.abs(left), np.abs(mid)), np.abs(right))
+    out[1:-1] = (mid > np.maximum(left, right) + tol) | (mid < np.minimum(left, right) - tol)
+    return out
+
+
+def _cell(grid: Grid, x: np.ndarray) -> np.ndarray:
+    return np.clip(np.searchsorted(grid.nodes, x, side="right") - 1, 0, grid.n_cells - 1)
+
+
+def _in_order(q: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """``q`` in position order (``x`` is usually sorted already: no sort then)."""
+    if np.all(x[1:] >= x[:-1]):
+        return q, None
+    order = np.argsort(x, kind="stable")
+    return q[order], order
+
+
+def _extrema_in_particle_order(q: np.ndarray, x: np.ndarray, rtol: float) -> np.ndarray:
+    ordered, order = _in_order(q, x)
+    mask = strict_extrema(ordered, rtol)
+    if order is None:
+        return mask
+    out = np.empty_like(mask)
+    out[order] = mask
+    return out
+
+
+@dataclass(eq=False)
+class ExtremaCounter:
+    """An observer for :func:`mpm_fem.solve.run` that counts new extrema of density and energy
+    per step (module docstring). After the run, :meth:`summary` gives the totals."""
+
+    grid: Grid
+    rtol: float = 1e-9
+    fields: tuple = ("density", "energy")
+    steps: int = 0
+    crossings: int = 0
+    particle_steps: int = 0
+    new_crossing: dict = field(default_factory=dict)
+    new_staying: dict = field(default_factory=dict)
+    per_step_max: dict = field(default_factory=dict)
+    _last: tuple | None = field(default=None, repr=False)
+
+    def __call__(self, step: int, t: float, old: Particles, new: Particles, state=None) -> None:
+        # the state after one step is the state before the next: reuse what was computed for it
+        if self._last is not None and self._last[0] is old:
+            old_cell, before = self._last[1], self._last[2]
+        else:
+            old_cell = _cell(self.grid, old.x)
+            before = {n: _extrema_in_particle_order(getattr(old, n), old.x, self.rtol) for n in self.fields}
+        new_cell = _cell(self.grid, new.x)
+        after = {n: _extrema_in_particle_order(getattr(new, n), new.x, self.rtol) for n in self.fields}
+        self._last = (new, new_cell, after)
+        crossed = old_cell != new_cell
+        self.steps += 1
+        self.crossings += int(np.count_nonzero(crossed))
+        self.particle_steps += new.n
+        for name in self.fields:
+            fresh = after[name] & ~before[name]
+            total = int(np.count_nonzero(fresh))
+            at_crossing = int(np.count_nonzero(fresh & crossed)) if total else 0
+            self.new_crossing[name] = self.new_crossing.get(name, 0) + at_crossing
+            self.new_staying[name] = self.new_staying.get(name, 0) + total - at_crossing
+            self.per_step_max[name] = max(self.per_step_max.get(name, 0), total)
+
+    def summary(self) -> dict:
+        """Totals over the run and rates: new extrema per crossing and per non-crossing particle-step."""
+        staying = self.particle_steps - self.crossings
+        out = {"steps": self.steps, "crossings": self.crossings, "particle_steps": self.particle_steps}
+        for name in self.fields:
+            c, s = self.new_crossing.get(name, 0), self.new_staying.get(name, 0)
+            out[name] = {
+                "new_at_crossing": c,
+                "new_elsewhere": s,
+                "new_per_step": (c + s) / max(self.steps, 1),
+                "max_per_step": self.per_step_max.get(name, 0),
+                "rate_crossing": c / max(self.crossings, 1),
+                "rate_elsewhere": s / max(staying, 1),
+            }
+        return out

@@ -1,0 +1,119 @@
+"""Sod's shock tube study (studies/sod.py, issue 5): FEM baseline conservation and accuracy, MPM
+against the source's table (C11), the region split (C12), new-extrema counting (C14), and lost
+positivity reported cleanly."""
+
+from functools import lru_cache
+
+import numpy as np
+import pytest
+
+from baselines import fem_euler
+from baselines.exact import riemann
+from mpm_fem.grid import uniform_grid
+from mpm_fem.particles import make_particles
+from mpm_fem.problems.sod import SodSettings
+from mpm_fem.regions import REGION_NAMES, ExtremaCounter, l1_by_region, mean_by_region, sod_regions, strict_extrema
+from studies import sod as study
+
+RHO_POST_SHOCK = 0.26557  # Toro, Table 4.2
+WAVES = riemann.wave_positions(0.2, (1.0, 0.0, 1.0), (0.125, 0.0, 0.1))
+
+
+@lru_cache(maxsize=None)
+def _case(kind: str, h: float, mass: str = "lumped", **changes):
+    case = study.fem_case(h, mass) if kind == "fem" else study.mpm_case(h, **changes)
+    return study.run_case(case)
+
+
+@pytest.mark.parametrize("mass", ["consistent", "lumped"])
+def test_fem_conserves_mass_to_round_off_and_post_shock_density_is_within_1_percent(mass):
+    r = _case("fem", 0.0025, mass)
+    assert r["ok"], r.get("error")
+    grid = uniform_grid(0, 1, 0.0025)
+    initial = float(np.sum(grid.lumped_mass * fem_euler.sod_initial_state(grid.nodes, 1.4)[0]))
+    assert abs(r["mass"] - initial) < 1e-13 * initial, f"FEM {mass}: mass {r['mass']!r} at T, {initial!r} at t = 0"
+    profile = r["profile"]  # h = 0.0025 is a profile mesh
+    x, rho = np.array(profile["x"]), np.array(profile["density"])
+    plateau = (x > WAVES["contact"] + 0.03) & (x < WAVES["shock"] - 0.03)
+    mean = rho[plateau].mean()
+    assert abs(mean / RHO_POST_SHOCK - 1) < 0.01, f"FEM {mass}: post-shock density {mean:.5f} vs {RHO_POST_SHOCK}"
+
+
+def test_mpm_density_error_falls_from_h_001_to_0005_and_both_are_within_factor_two_of_the_source():
+    """C11 at the start of the table: the nodal density L1 (the norm that matches the source)."""
+    e = {h: _case("mpm", h)["density"]["nodes"]["L1"] for h in (0.01, 0.005)}
+    assert e[0.005] < e[0.01], f"L1 {e}: no convergence from h = 0.01 to 0.005"
+    for h, value in e.items():
+        source = study.SOURCE[h][0]
+        assert source / 2 < value < 2 * source, f"h={h}: nodal L1 {value:.4g} vs the source's {source:.4g}"
+
+
+@pytest.mark.parametrize("where", ["nodes", "particles"])
+def test_region_split_sums_to_the_total_l1_error(where):
+    r = _case("mpm", 0.01)
+    parts = np.array(r["regions"][where])
+    total = r["density"][where]["L1"]
+    assert parts.shape == (len(REGION_NAMES),) and np.all(parts >= 0)
+    assert abs(parts.sum() - total) < 1e-12 * total, f"{where}: regions sum {parts.sum()!r}, L1 {total!r}"
+
+
+def test_regions_follow_the_exact_waves_and_cover_the_domain():
+    w = 0.02
+    regions = sod_regions(WAVES, w)
+    probes = {0.1: 0, WAVES["rarefaction_head"]: 1, 0.37: 2, WAVES["rarefaction_tail"]: 3, 0.6: 2,
+              WAVES["contact"]: 4, 0.77: 5, WAVES["shock"]: 6, 0.95: 0, 0.0: 0, 1.0: 0}
+    got = regions.index(np.array(list(probes)))
+    assert got.tolist() == list(probes.values())
+    x = np.linspace(0, 1, 1001)
+    e = np.sin(7 * x)
+    weights = np.full_like(x, 1e-3)
+    assert l1_by_region(x, e, weights, regions).sum() == pytest.approx(np.sum(weights * np.abs(e)), rel=1e-13)
+    assert mean_by_region(x, np.ones_like(x), weights, regions) == pytest.approx(np.ones(len(REGION_NAMES)))
+    with pytest.raises(ValueError, match="overlap"):
+        sod_regions(WAVES, 0.2)
+
+
+def test_strict_extrema_ignore_round_off_and_plateaus():
+    q = np.array([1.0, 1.0, 1.0 + 1e-14, 1.0, 0.5, 0.7, 0.3, 0.3])
+    assert strict_extrema(q).tolist() == [False, False, False, False, True, True, False, False]
+
+
+def test_extrema_counter_attributes_a_new_extremum_to_the_particle_that_crossed_a_node():
+    grid = uniform_grid(0, 1, 0.25)
+    x = np.array([0.05, 0.15, 0.24, 0.3, 0.4])
+    old = make_particles(x, 0.05, np.array([1.0, 0.9, 0.8, 0.7, 0.6]), energy=np.array([1.0, 1.0, 1.0, 1.0, 1.0]))
+    x_new = x.copy()
+    x_new[2] = 0.26  # crosses the node 0.25
+    rho = old.density.copy()
+    rho[2] = 0.95  # leaves the range (0.7, 0.9) of its neighbours
+    rho[3] = 0.65  # stays between its neighbours 0.95 and 0.6
+    new = old.replace(x=x_new, density=rho)
+    counter = ExtremaCounter(grid)
+    counter(0, 0.0, old, new)
+    s = counter.summary()
+    assert s["crossings"] == 1
+    # in a monotone sequence a new maximum makes its left neighbour (0.9 < 1, 0.95) a new minimum
+    assert s["density"]["new_at_crossing"] == 1 and s["density"]["new_elsewhere"] == 1, s
+    assert s["density"]["rate_crossing"] == 1.0 and s["density"]["rate_elsewhere"] == 0.25, s
+    assert s["energy"]["new_at_crossing"] == 0 and s["energy"]["new_elsewhere"] == 0, s
+
+
+def test_a_run_that_loses_positivity_reports_it_and_returns_no_nan():
+    """CFL 1 with 16 particles per cell breaks 1 - (dv/dx) dt > 0 at the diaphragm."""
+    r = study.run_case(study.mpm_case(0.01, cfl=1.0))
+    assert r["ok"] is False
+    assert "positivity lost at step" in r["error"] and "1 - (dv/dx) dt" in r["error"], r["error"]
+    assert "nan" not in r["error"].lower().replace("reduce", "")
+
+
+def test_cfl_above_one_is_refused_with_a_message():
+    with pytest.raises(ValueError, match="CFL number must lie in"):
+        SodSettings(cfl=1.5)
+
+
+def test_one_set_of_settings_for_every_mesh():
+    plan = study._plan(quick=False)
+    keys = set(study.MPM)
+    for h, case in plan["mpm"].items():
+        assert {k: case[k] for k in keys} == study.MPM, f"h={h} uses other settings"
+    assert set(plan["mpm"]) == set(study.H) == set(study.SOURCE)
