@@ -22,8 +22,9 @@ velocity gradient at a particle in cell ``[x_i, x_{i+1}]`` is ``(v_{i+1}^MPM - v
     E_VG^i = (E_v^{i+1} - E_v^i)/h                         (its projection part, per cell)
 
 Nodal errors are taken at the interior nodes, whose hat ``S_i`` is whole (the slides' two-cell
-form); the end nodes take the exact boundary value of ``v`` (a wall or Dirichlet condition in a
-run) when ``E_VG`` interpolates. Norms (:func:`mpm_fem.errors.norms`) weigh nodes by ``int S_i dx
+form), and the velocity gradient errors on the cells between interior nodes (at the particles whose
+``S_ip``, ``G_ip`` touch interior nodes only): a cut hat at a wall is a boundary error the slides do
+not analyse (``E_v1`` is O(h) there, O(h^2) inside). Norms (:func:`mpm_fem.errors.norms`) weigh nodes by ``int S_i dx
 = h``, particles by ``w_p`` and cells by ``h``.
 
 Weights: ``"cell"`` is the slides' ``w_p = h/N_p^i`` (``m_ip = h rho_p / N_p^i``, the equal-weight
@@ -145,8 +146,9 @@ def cell_weights(grid: Grid, x: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True, eq=False)
 class ProjectionErrors:
     """Signed errors (exact minus MPM). Nodal ones at the interior nodes (n_nodes - 2,); ``E_VG``
-    at the particles (n_p,); ``E_VG_proj`` per cell (n_cells,). ``nodal_weights`` (n_nodes - 2,),
-    ``particle_weights`` (n_p,) and ``cell_weights`` (n_cells,) are the norms' weights."""
+    at the particles that touch interior nodes only; ``E_VG_proj`` on the cells between interior
+    nodes (n_cells - 2,). ``nodal_weights``, ``particle_weights`` and ``cell_weights`` (same
+    shapes) are the norms' weights."""
 
     E_m: np.ndarray
     E_P: np.ndarray
@@ -177,10 +179,9 @@ def projection_errors(grid: Grid, x: np.ndarray, w: np.ndarray, fields: Fields, 
     a_mpm, v_mpm = divide_by_lumped(mpm.F, mpm.m), divide_by_lumped(mpm.P, mpm.m)
     E_m, E_F = ex.m - mpm.m, ex.F - mpm.F
     E_v = v - v_mpm
-    E_v[[0, -1]] = 0.0
-    v_nodes = v_mpm.copy()
-    v_nodes[[0, -1]] = fields.v(grid.nodes[[0, -1]])
     shape = _shape(grid, x, w, basis)
+    end = (shape.nodes == 0) | (shape.nodes == grid.n_nodes - 1)
+    inside = ~np.any(end & ((shape.S != 0) | (shape.G != 0)), axis=1)
     return ProjectionErrors(
         E_m=E_m[inner],
         E_P=(ex.P - mpm.P)[inner],
@@ -189,11 +190,11 @@ def projection_errors(grid: Grid, x: np.ndarray, w: np.ndarray, fields: Fields, 
         E_a_pred=(E_F / ex.m - a * E_m / ex.m)[inner],
         E_v=E_v[inner],
         E_v1=(fields.v(grid.nodes) - v)[inner],
-        E_VG=fields.dv(x) - shape.gather_gradient(v_nodes),
-        E_VG_proj=np.diff(E_v) / grid.h,
+        E_VG=(fields.dv(x) - shape.gather_gradient(v_mpm))[inside],
+        E_VG_proj=np.diff(E_v[inner]) / grid.h[inner],
         nodal_weights=grid.lumped_mass[inner],
-        particle_weights=w,
-        cell_weights=grid.h.copy(),
+        particle_weights=w[inside],
+        cell_weights=grid.h[inner].copy(),
     )
 
 

@@ -149,3 +149,27 @@ def test_advected_layout_follows_the_exact_flow():
         errs.append(np.abs(x - adv.flow(x0)).max())
         assert abs(V.sum() - 1) < 0.05, f"total volume {V.sum():.4f}"
     assert errs[1] < errs[0] / 2 and errs[1] < 5e-3, f"distance to the exact flow {errs}"
+
+
+def test_e_v1_is_second_order_inside_and_first_order_at_the_end_nodes():
+    """``v(x_i) - int S_i rho v / int S_i rho``: the whole hat is symmetric about x_i, the cut one is not."""
+    inner, end = [], []
+    for h in (1 / 20, 1 / 40, 1 / 80):
+        grid = uniform_grid(0, 1, h)
+        ex = exact_nodal(grid, FIELDS)
+        e = np.abs(FIELDS.v(grid.nodes) - ex.P / ex.m)
+        inner.append(e[1:-1].max())
+        end.append(e[0])
+    p_inner, p_end = fitted_order([1 / 20, 1 / 40, 1 / 80], inner), fitted_order([1 / 20, 1 / 40, 1 / 80], end)
+    assert 1.8 <= p_inner <= 2.2 and 0.9 <= p_end <= 1.1, f"E_v1 order inside {p_inner:.3f}, at x=0 {p_end:.3f}"
+
+
+def test_study_case_and_tables_on_a_tiny_sweep():
+    from studies.projection import case, tables
+
+    cs = [{"layout": lay, "ppc": 2, "cells": k, "seed": 0} for lay in ("random", "advected") for k in (10, 20, 40)]
+    t = tables([(c, case(c)) for c in cs])
+    orders = {(r["quantity"], r["layout"], r["weights"], r["basis"], r["norm"]): r for r in t["orders"]}
+    assert orders[("E_m", "random", "cell", "mpm", "L1")]["band"] == "[1, 2]"
+    assert ("E_F", "advected", "volume", "mpm", "L1") in orders and ("E_F", "random", "volume", "mpm", "L1") not in orders
+    assert all(r["holds"] == "yes" for r in t["bounds"]), [r for r in t["bounds"] if r["holds"] != "yes"]
