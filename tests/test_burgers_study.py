@@ -22,11 +22,12 @@ def _by_position(result):
     {"acceleration": "exact"},
     {"mass": "consistent", "cfl": 0.3},
     {"solution": "cole_hopf", "eps": 0.02},
+    {"acceleration": "exact", "dt_rule": "advective", "refine": 2},
 ])
 def test_fast_loop_is_the_general_step_to_round_off(changes):
     """The fused loop and ``run(explicit_step)`` take the same steps: same particles to 1e-12."""
     settings = burgers.BurgersSettings(h=0.02, **changes)
-    general = burgers.simulate(settings, progress=False)
+    general = burgers.simulate_general(settings, progress=False)
     fast = burgers_fast.simulate(settings, progress=False)
     assert fast.steps == general.steps and fast.particles.n == general.particles.n
     for a, b, name in zip(_by_position(general), _by_position(fast), ("x", "v", "V")):
@@ -36,10 +37,12 @@ def test_fast_loop_is_the_general_step_to_round_off(changes):
     assert gap < 1e-12, f"nodal velocity differs by {gap:.3g}"
 
 
-def test_fast_loop_refuses_what_it_does_not_implement():
+def test_settings_and_loops_refuse_what_they_do_not_implement():
     with pytest.raises(ValueError, match="only the exact acceleration"):
-        burgers_fast.simulate(burgers.BurgersSettings(h=0.02), dt_rule="advective")
-    with pytest.raises(ValueError, match="basis='mpm'"):
-        burgers_fast.simulate(burgers.BurgersSettings(h=0.02, basis="gimp"))
+        burgers.BurgersSettings(h=0.02, dt_rule="advective")
     with pytest.raises(ValueError, match="unknown weights"):
-        burgers_fast.simulate(burgers.BurgersSettings(h=0.02), weights="mass")
+        burgers.BurgersSettings(h=0.02, weights="mass")
+    with pytest.raises(ValueError, match="point mass"):
+        burgers_fast.simulate(burgers.BurgersSettings(h=0.02, basis="gimp"))
+    with pytest.raises(ValueError, match="USL only"):
+        burgers.simulate(burgers.BurgersSettings(h=0.02, basis="gimp", force="slides"))

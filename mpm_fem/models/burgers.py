@@ -25,9 +25,12 @@ from ..particles import Particles, check_positive
 
 @dataclass(frozen=True)
 class ViscousBurgers:
-    """Burgers' viscous stress with coefficient ``eps`` > 0."""
+    """Burgers' viscous stress with coefficient ``eps`` > 0; ``viscous_limit=False`` drops the
+    explicit-diffusion limit from the time step (for the exact acceleration, which computes no
+    viscous force)."""
 
     eps: float
+    viscous_limit: bool = True
 
     def __post_init__(self):
         if not (np.isfinite(self.eps) and self.eps > 0):
@@ -45,8 +48,11 @@ class ViscousBurgers:
         return particles.replace(volume=volume, mass=volume.copy())
 
     def stable_dt(self, particles: Particles, grid, cfl: float) -> float:
-        """``dt = CFL min(h / max|v|, h^2 / (2 eps))``: advective and explicit-diffusion limits."""
+        """``dt = CFL min(h / max|v|, h^2 / (2 eps))``: advective and explicit-diffusion limits
+        (the advective one alone without ``viscous_limit``)."""
         h = float(grid.h.min())
         vmax = float(np.max(np.abs(particles.velocity), initial=0.0))
         advective = h / vmax if vmax > 0 else np.inf
+        if not self.viscous_limit:
+            return cfl * advective
         return cfl * min(advective, h * h / (2.0 * self.eps))

@@ -3,10 +3,20 @@
 Initial data, Dirichlet data at both ends and the exact acceleration ``Dv/Dt = eps v_xx`` come
 from an exact solution (``baselines.exact.burgers``), so the error at T is exact:
 
-    e_p = v_p - v(x_p, T)  over particles (weights V_p);   e_i = v_i - v(x_i, T)  over nodes.
+    e_p = v_p - v(x_p, T)  over particles (weights V_p);   e_i = v_i - v(x_i, T)  over nodes,
 
-Particles leave through the ends; a reservoir outside each end feeds new particles in, spaced
-``h / N_p`` like the initial layout, so that the domain never empties (the pitfall of STUDY.md).
+with the grid velocity ``v_i = P_i / m_i`` taking the Dirichlet data at the two end nodes, as it
+does in every step. Particles leave through the ends; a reservoir outside each end feeds new
+particles in, spaced ``h / N_p`` like the initial layout, so that the domain never empties (the
+pitfall of STUDY.md).
+
+Besides the stage switches, three settings reach the slides' own forms (:mod:`.burgers_fast`,
+which runs point mass with USL; the general loop the rest): ``weights`` ``"volume"`` (the
+volumes ``V_p`` carried by the flow, standard MPM) or ``"cell"`` (the slides' ``m_ip = h/N_p^i``);
+``force`` ``"weak"`` (``a_i = F_i/m_i`` with ``F_i = -sum_p V_p eps (dv/dx)_p G_ip``) or
+``"slides"`` (their count-normalised second difference ``eps (v_{i+1} - 2 v_i + v_{i-1})/h^2``);
+``dt_rule`` ``"stable"`` (``dt = CFL min(h/max|v|, h^2/(2 eps))``) or ``"advective"`` (``CFL
+h/max|v|``: no viscous limit, for the exact acceleration, which computes no viscous force).
 """
 
 from __future__ import annotations
@@ -24,6 +34,12 @@ from ..models.burgers import ViscousBurgers
 from ..particles import LAYOUTS, Particles, make_particles, seed_positions
 from ..solve import Problem, Result, run
 from ..step import ACCELERATIONS, Dirichlet, Stages
+from . import burgers_fast
+
+
+WEIGHTS = ("volume", "cell")
+FORCES = ("weak", "slides")
+DT_RULES = ("stable", "advective")
 
 
 @dataclass(frozen=True)
@@ -45,6 +61,9 @@ class BurgersSettings:
     projection: str = "mpm"
     interpolation: str = "mpm"
     refine: int = 1
+    weights: str = "volume"
+    force: str = "weak"
+    dt_rule: str = "stable"
 
     def __post_init__(self):
         if not (np.isfinite(self.eps) and self.eps > 0):
@@ -61,6 +80,11 @@ class BurgersSettings:
         if self.acceleration not in ACCELERATIONS:
             raise ValueError(f"unknown acceleration {self.acceleration!r}; choose one of {', '.join(ACCELERATIONS)}")
         self.stages  # validates mass, basis, scheme
+        for name, allowed in (("weights", WEIGHTS), ("force", FORCES), ("dt_rule", DT_RULES)):
+            if getattr(self, name) not in allowed:
+                raise ValueError(f"unknown {name} {getattr(self, name)!r}; choose one of {', '.join(allowed)}")
+        if self.dt_rule == "advective" and self.acceleration != "exact":
+            raise ValueError("dt_rule 'advective' drops the viscous limit: only the exact acceleration may use it")
 
     @property
     def exact(self):
@@ -121,11 +145,24 @@ def exact_fields(settings: BurgersSettings) -> SmoothBurgersFields:
 
 
 def simulate(settings: BurgersSettings = BurgersSettings(), progress: bool | None = None, observer=None) -> Result:
-    """Run MPM on viscous Burgers with ``settings``."""
+    """Run MPM on viscous Burgers with ``settings``: the fused loop of :mod:`.burgers_fast` where it
+    applies (point mass, USL, MPM projection and interpolation; the same steps to round-off), the
+    general :func:`simulate_general` otherwise."""
+    if burgers_fast.supports(settings):
+        return burgers_fast.simulate(settings, progress, observer)
+    return simulate_general(settings, progress, observer)
+
+
+def simulate_general(settings: BurgersSettings = BurgersSettings(), progress: bool | None = None, observer=None) -> Result:
+    """Run MPM on viscous Burgers with ``settings`` through :func:`mpm_fem.solve.run` (any stages;
+    the standard ``weights`` and ``force`` only)."""
+    if settings.weights != "volume" or settings.force != "weak":
+        raise ValueError("weights 'cell' and force 'slides' are implemented for point mass with USL only "
+                         "(mpm_fem.problems.burgers_fast)")
     solution = settings.exact
     grid = uniform_grid(*solution.domain, settings.h)
     problem = Problem(
-        model=ViscousBurgers(settings.eps),
+        model=ViscousBurgers(settings.eps, viscous_limit=settings.dt_rule == "stable"),
         boundary=Dirichlet(solution.v),
         T=settings.T,
         cfl=settings.cfl,
@@ -137,12 +174,15 @@ def simulate(settings: BurgersSettings = BurgersSettings(), progress: bool | Non
 
 
 def errors(settings: BurgersSettings, result: Result) -> dict:
-    """Velocity errors at T over particles and over grid nodes."""
+    """Velocity errors at T over particles (weights ``V_p``) and over grid nodes (weights ``int
+    S_i dx``; the end nodes carry the Dirichlet data, as in every step, so their error is zero)."""
     P, g = result.particles, result.grid
     v = settings.exact.v
+    nodal = result.nodal_velocity.copy()
+    nodal[g.boundary_nodes] = v(g.nodes[g.boundary_nodes], result.t)
     return {
         "velocity": {
             "particles": norms(P.velocity - v(P.x, result.t), P.volume),
-            "nodes": norms(result.nodal_velocity - v(g.nodes, result.t), g.lumped_mass),
+            "nodes": norms(nodal - v(g.nodes, result.t), g.lumped_mass),
         }
     }

@@ -36,30 +36,17 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..grid import uniform_grid
-from ..particles import PositivityError, Particles, make_particles
+from ..particles import Particles, PositivityError, make_particles
 from ..shape import point_shape
 from ..solve import Result
 from ..step import GridState
 from ..transfer import solve_consistent
 
-WEIGHTS = ("volume", "cell")
-FORCES = ("weak", "slides")
-DT_RULES = ("stable", "advective")
-
-
-def check_variant(settings, weights: str, force: str, dt_rule: str) -> None:
-    """Raise ``ValueError`` unless the fast loop can run ``settings`` with these options."""
-    for name, value, allowed in (("weights", weights, WEIGHTS), ("force", force, FORCES), ("dt rule", dt_rule, DT_RULES)):
-        if value not in allowed:
-            raise ValueError(f"unknown {name} {value!r}; choose one of {', '.join(allowed)}")
-    if dt_rule == "advective" and settings.acceleration != "exact":
-        raise ValueError("the advective time step drops the viscous limit: only the exact acceleration may use it")
-    unsupported = {"basis": "mpm", "scheme": "usl", "projection": "mpm", "interpolation": "mpm"}
-    for name, value in unsupported.items():
-        if getattr(settings, name, value) != value:
-            raise ValueError(f"the fast Burgers loop runs {name}={value!r} only, got {getattr(settings, name)!r}")
-    if settings.mass not in ("lumped", "consistent"):
-        raise ValueError(f"the fast Burgers loop needs a lumped or consistent mass, got {settings.mass!r}")
+def supports(settings) -> bool:
+    """Whether this loop implements ``settings``: point mass, USL, MPM projection and interpolation,
+    lumped or consistent mass (the general :func:`mpm_fem.solve.run` does the rest)."""
+    return (settings.basis == "mpm" and settings.scheme == "usl" and settings.projection == "mpm"
+            and settings.interpolation == "mpm" and settings.mass in ("lumped", "consistent"))
 
 
 def cells(x: np.ndarray, a: float, h: float, n_cells: int) -> tuple[np.ndarray, np.ndarray]:
@@ -91,15 +78,18 @@ def cell_weights(cell: np.ndarray, h: float, n_cells: int) -> np.ndarray:
     return h / count[cell]
 
 
-def simulate(settings, weights: str = "volume", force: str = "weak", dt_rule: str = "stable",
-             progress: bool | None = None, observer=None) -> Result:
-    """Run MPM on viscous Burgers with ``settings`` (a ``BurgersSettings``); the module docstring
-    gives the equations. ``observer(step, t, old, new, grid_state)`` as for :func:`mpm_fem.solve.run`."""
+def simulate(settings, progress: bool | None = None, observer=None) -> Result:
+    """Run MPM on viscous Burgers with ``settings`` (a ``BurgersSettings``, with its ``weights``,
+    ``force`` and ``dt_rule``); the module docstring gives the equations. ``observer(step, t, old,
+    new, grid_state)`` as for :func:`mpm_fem.solve.run`."""
     from .burgers import initial_particles
 
-    check_variant(settings, weights, force, dt_rule)
+    if not supports(settings):
+        raise ValueError("the fast Burgers loop runs point mass, USL, MPM projection and interpolation with a "
+                         f"lumped or consistent mass only; got {settings.stages}")
+    weights, force, dt_rule = settings.weights, settings.force, settings.dt_rule
     eps, T, cfl = float(settings.eps), float(settings.T), float(settings.cfl)
-    refine = int(getattr(settings, "refine", 1))
+    refine = int(settings.refine)
     solution = settings.exact
     grid = uniform_grid(*solution.domain, settings.h)
     h = float(grid.h.mean())
