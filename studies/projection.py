@@ -12,7 +12,7 @@ also with the volumes ``V_p`` the run carries. Hickernell's ``D2`` and bound
 
 Tables (``figures/projection/``): ``errors.csv`` (quantity, layout, weights, N_p, h, norm, value,
 spread), ``orders.csv`` (least-squares order over all h, the orders between the two coarsest and
-the two finest meshes, the source's band, inside), ``d2.csv``, ``d2_constant.csv`` (the C of
+the two finest meshes and between every pair of successive meshes, the source's band, inside), ``d2.csv``, ``d2_constant.csv`` (the C of
 ``D2 ~ [1/(12 N^2) + C h^2]^{1/2}``), ``bounds.csv`` (smallest bound/error ratio). Figures:
 ``errors_vs_h.png``, ``errors_vs_h_random.png``, ``d2.png``, ``hickernell.png``.
 """
@@ -137,6 +137,7 @@ def tables(results: list[tuple[dict, dict]]) -> dict[str, list[dict]]:
             steps = observed_orders(h, val)
             order_rows.append({"quantity": q, "layout": lay, "weights": weights, "basis": basis, "N_p": n, "norm": norm,
                                "order": fitted[q], "order_coarse": float(steps[0]), "order_fine": float(steps[-1]),
+                               "successive": " ".join(f"{p:.2f}" for p in steps),
                                "band": _band_text(q), "inside": "yes" if _inside(q, fitted[q], fitted) else "no"})
 
     d2_rows = []
