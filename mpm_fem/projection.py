@@ -24,8 +24,8 @@ velocity gradient at a particle in cell ``[x_i, x_{i+1}]`` is ``(v_{i+1}^MPM - v
 Nodal errors are taken at the interior nodes, whose hat ``S_i`` is whole (the slides' two-cell
 form), and the velocity gradient errors on the cells between interior nodes (at the particles whose
 ``S_ip``, ``G_ip`` touch interior nodes only): a cut hat at a wall is a boundary error the slides do
-not analyse (``E_v1`` is O(h) there, O(h^2) inside). Norms (:func:`mpm_fem.errors.norms`) weigh nodes by ``int S_i dx
-= h``, particles by ``w_p`` and cells by ``h``.
+not analyse (``E_v1`` is O(h) there, O(h^2) inside). Norms (:func:`mpm_fem.errors.norms`) weigh
+nodes by ``int S_i dx = h``, particles by ``w_p`` and cells by ``h``.
 
 Weights: ``"cell"`` is the slides' ``w_p = h/N_p^i`` (``m_ip = h rho_p / N_p^i``, the equal-weight
 rule of Hickernell's bound); ``"volume"`` is the particle volume ``V_p`` that a run carries. The two
@@ -47,7 +47,7 @@ import numpy as np
 from .errors import norms
 from .grid import Grid
 from .particles import seed_positions
-from .quadrature import cell_points, discrepancy_d2, hickernell_bound, integrate_cells
+from .quadrature import cell_mean_error, cell_points, derivative_l2, discrepancy_d2, hickernell_bound, integrate_cells
 from .shape import make_shape, point_shape
 from .transfer import divide_by_lumped, nodal_internal_force, nodal_mass, nodal_momentum
 
@@ -221,8 +221,6 @@ def quadrature_checks(grid: Grid, x: np.ndarray, fields: Fields) -> dict[str, Bo
     ``node_F``: ``|E_F^i|``, bound ``sum_{c = i, i+1} D2_c h^{1/2} ||p'||_{2,h}`` (slides, force).
     Cells without a particle have no bound (NaN) and are left out.
     """
-    from .quadrature import cell_mean_error, derivative_l2
-
     d2, h = discrepancy_d2(grid, x), grid.h
     w = cell_weights(grid, x)
     errors = projection_errors(grid, x, w, fields)
