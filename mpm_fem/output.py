@@ -19,6 +19,9 @@ import numpy as np
 
 from .particles import Particles
 
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+
 PACKAGES = ("mpm-fem", "numpy", "scipy", "scikit-fem", "meshio", "matplotlib")
 
 
@@ -67,6 +70,7 @@ def write_atomic(path: str | os.PathLike, text: str) -> None:
     try:
         with os.fdopen(fd, "w") as f:
             f.write(text)
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; a record is a normal file
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
