@@ -1,0 +1,160 @@
+"""The exact stages of the error budget (E1) and the bases' conservation (E2)."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from baselines.exact import riemann
+from mpm_fem.exact_stages import RiemannFields, exact_projection, quadrature
+from mpm_fem.grid import uniform_grid
+from mpm_fem.models.euler import IdealGas
+from mpm_fem.problems import burgers, sod
+from mpm_fem.shape import make_shape
+from mpm_fem.step import Stages, Walls, explicit_step
+from mpm_fem.timing import field_difference
+from mpm_fem.transfer import nodal_internal_force
+
+SOD = ((1.0, 0.0, 1.0), (0.125, 0.0, 0.1))
+
+
+class Polynomial:
+    """rho = 1 + x + x^2, v = x, sigma = x^3, with a kink-free breakpoint list (tests the splits)."""
+
+    def integrand(self, x, t):
+        return 1 + x + x**2, x, x**3
+
+    def breakpoints(self, t):
+        return np.array([0.3141, 0.777])
+
+
+@pytest.mark.parametrize("basis", ["mpm", "bspline"])
+def test_exact_projection_integrates_polynomial_fields_to_round_off(basis):
+    """m_i = int rho S_i, P_i = int rho v S_i, F_i = -int sigma S_i' against a 200 000-point
+    midpoint rule (error ~1e-11) of the same integrands."""
+    grid = uniform_grid(0.0, 1.0, 0.1)
+    got = exact_projection(grid, basis, Polynomial(), 0.0)
+    n = 200_000
+    x = (np.arange(n) + 0.5) / n
+    w = np.full(n, 1.0 / n)
+    shape = make_shape(grid, x, w, basis)
+    rho, v, sigma = Polynomial().integrand(x, 0.0)
+    want = (shape.scatter(w * rho), shape.scatter(w * rho * v), nodal_internal_force(shape, w, sigma))
+    for name, a, b in zip(("m_i", "P_i", "F_i"), (got.m_i, got.P_i, got.F_i), want):
+        err = np.abs(a - b).max()
+        assert err < 1e-9, f"{name} differs from the fine midpoint rule by {err:.2e}"
+
+
+def test_quadrature_splits_at_nodes_midpoints_and_breakpoints():
+    grid = uniform_grid(0.0, 1.0, 0.25)
+    x, w = quadrature(grid, [0.3, 1.5, -1.0])
+    assert w.sum() == pytest.approx(1.0, rel=1e-14)
+    assert x.size == 5 * 9  # 8 half cells, one split at 0.3; points outside the domain are ignored
+
+
+def test_riemann_reference_fields_are_the_exact_cell_averages():
+    """v* = average of u over [x - l, x + l] (pieces cut at the waves), v*_x its difference
+    quotient, a* = dv*/dt + v* v*_x with dv*/dt checked by a central difference in t."""
+    l = 0.01
+    fields = RiemannFields(*SOD, 0.5, 1.4, l)
+    x = np.random.default_rng(0).uniform(0, 1, 500)
+
+    def average(t):
+        lo, hi = (x - l)[:, None], (x + l)[:, None]
+        cuts = np.clip(fields.breakpoints(t)[None, :], lo, hi)
+        edges = np.concatenate((lo, cuts, hi), axis=1)
+        mids, widths = 0.5 * (edges[:, 1:] + edges[:, :-1]), np.diff(edges, axis=1)
+        return (riemann.sample(mids, t, *SOD)[1] * widths).sum(axis=1) / (2 * l)
+
+    t, dt = 0.13, 1e-6
+    v, v_x, a = fields.reference(x, t)
+    u_hi, u_lo = riemann.sample(x + l, t, *SOD)[1], riemann.sample(x - l, t, *SOD)[1]
+    assert np.abs(v - average(t)).max() < 1e-13
+    assert np.abs(v_x - (u_hi - u_lo) / (2 * l)).max() < 1e-12
+    v_t = (average(t + dt) - average(t - dt)) / (2 * dt)
+    assert np.abs(a - (v_t + v * v_x)).max() < 1e-6 * np.abs(a).max()
+
+
+def test_exact_projection_and_mass_give_the_exact_nodal_values():
+    """With the projection and the FE + mass stage exact, the grid holds v(x_i, t) and a(x_i, t)
+    (Dirichlet data at the ends) whatever the particles carry."""
+    settings = burgers.BurgersSettings(h=0.05, projection="exact", mass="exact")
+    grid = uniform_grid(0.0, 2.0, settings.h)
+    particles = burgers.initial_particles(settings, grid)
+    noisy = particles.replace(velocity=particles.velocity + 0.1 * np.sin(37 * particles.x))
+    exact = burgers.exact_fields(settings)
+    model = burgers.ViscousBurgers(settings.eps)
+    _, state = explicit_step(grid, noisy, model, burgers.Dirichlet(settings.exact.v), 0.1, 1e-3, settings.stages,
+                             exact=exact)
+    v, _, a = exact.reference(grid.nodes, 0.1)
+    inner = slice(1, -1)
+    assert np.abs(state.velocity - v).max() < 1e-14
+    assert np.abs(state.acceleration[inner] - a[inner]).max() < 1e-12
+
+
+def test_exact_stages_without_exact_fields_stop_with_a_message():
+    grid = uniform_grid(0.0, 1.0, 0.1)
+    settings = sod.SodSettings(h=0.1)
+    particles = sod.initial_particles(settings, grid)
+    with pytest.raises(ValueError, match="exact fields"):
+        explicit_step(grid, particles, IdealGas(), Walls(), 0.0, 1e-3, Stages(projection="exact"))
+    with pytest.raises(ValueError, match="USL and USF"):
+        Stages(interpolation="exact", scheme="musl")
+
+
+def test_every_stage_exact_leaves_the_time_error_of_the_step():
+    """Burgers (h = 0.02): with every stage exact the remainder is first order in dt (halves when
+    dt halves) and its dt -> 0 extrapolation is below 2% of it: no other error is left."""
+    base = burgers.BurgersSettings(h=0.02, projection="exact", mass="exact", interpolation="exact")
+    runs = {k: burgers.simulate(replace(base, refine=k), progress=False) for k in (1, 2)}
+    points = np.linspace(0.1, 1.9, 4001)
+
+    def error_field(result):
+        P = result.particles
+        order = np.argsort(P.x)
+        return np.interp(points, P.x[order], P.velocity[order]) - base.exact.v(points, result.t)
+
+    e1, e2 = error_field(runs[1]), error_field(runs[2])
+    l1 = lambda e: float(np.trapezoid(np.abs(e), points))  # noqa: E731
+    ratio = l1(e1) / l1(e2)
+    assert 1.8 < ratio < 2.2, f"remainder at dt {l1(e1):.3g}, at dt/2 {l1(e2):.3g}: ratio {ratio:.3f}"
+    extrapolated = l1(2 * e2 - e1)
+    assert extrapolated < 0.02 * l1(e1), f"dt -> 0 remainder {extrapolated:.3g} vs {l1(e1):.3g} at dt"
+    mpm = burgers.simulate(burgers.BurgersSettings(h=0.02), progress=False)
+    assert field_difference(mpm.particles, runs[1].particles, (0.1, 1.9)) > 0.1 * l1(e1) / 1.8
+
+
+def test_every_stage_exact_sod_remainder_is_first_order_in_h():
+    """Sod (8 particles per cell, CFL 0.1): every stage exact at dt and dt/2; the dt -> 0
+    remainder comes from averaging the exact fields over one cell at the waves, O(h)."""
+    out = []
+    for h in (0.02, 0.01):
+        base = sod.SodSettings(h=h, ppc=8, cfl=0.1, projection="exact", mass="exact", interpolation="exact")
+        L1 = [sod.errors(base, sod.simulate(replace(base, refine=k), progress=False))["density"]["particles"]["L1"]
+              for k in (1, 2)]
+        out.append(2 * L1[1] - L1[0])
+    order = np.log2(out[0] / out[1])
+    assert 0.7 < order < 1.3, f"all-exact remainders {out}, order {order:.3f}"
+
+
+@pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline"])
+def test_bases_keep_partition_of_unity_and_conservation_in_a_step(basis):
+    """Sod, one step: total mass is the nodal mass (partition of unity), the nodal forces sum to
+    zero (sum_i G_ip = 0), and the particle momentum changes by dt sum_i m_i a_i: only the wall
+    nodes' forces, which the walls cancel, act on the gas."""
+    settings = sod.SodSettings(h=0.02, ppc=4, basis=basis)
+    grid = uniform_grid(0.0, 1.0, settings.h)
+    particles = sod.initial_particles(settings, grid)
+    moved = particles.replace(velocity=0.05 * np.sin(6 * particles.x))
+    dt = 1e-3
+    new, state = explicit_step(grid, moved, IdealGas(), Walls(), 0.0, dt, settings.stages)
+    shape = make_shape(grid, moved.x, moved.volume, basis)
+    F = nodal_internal_force(shape, moved.volume, -moved.pressure)
+    scale = np.abs(F).max()
+    assert abs(F.sum()) < 1e-12 * scale, f"sum of nodal forces {F.sum():.3e}"
+    assert state.mass.sum() == pytest.approx(moved.mass.sum(), rel=1e-14)
+    dP = (new.mass * new.velocity).sum() - (moved.mass * moved.velocity).sum()
+    assert dP == pytest.approx(dt * (state.mass * state.acceleration).sum(), rel=1e-12, abs=1e-15)
+    walls = grid.boundary_nodes
+    assert dP == pytest.approx(-dt * F[walls].sum(), rel=1e-10)
+    assert new.mass.sum() == moved.mass.sum()
