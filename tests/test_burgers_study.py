@@ -4,11 +4,15 @@ The numbers asserted here are measured by ``studies/burgers.py`` on the full set
 fast tests run the coarse meshes of the same settings.
 """
 
+from functools import lru_cache
+
 import numpy as np
 import pytest
 
-from mpm_fem.problems import burgers
-from mpm_fem.problems import burgers_fast
+from baselines import fem_burgers
+from baselines.exact.burgers import make_solution
+from mpm_fem.problems import burgers, burgers_fast
+from studies import burgers as study
 
 
 def _by_position(result):
@@ -46,3 +50,92 @@ def test_settings_and_loops_refuse_what_they_do_not_implement():
         burgers_fast.simulate(burgers.BurgersSettings(h=0.02, basis="gimp"))
     with pytest.raises(ValueError, match="USL only"):
         burgers.simulate(burgers.BurgersSettings(h=0.02, basis="gimp", force="slides"))
+
+
+# ---------------------------------------------------------------- C13: orders of the study's settings
+
+@lru_cache(maxsize=None)
+def _errors(h, **changes):
+    """Velocity errors at T (over particles and nodes) of the study's default problem (the viscous
+    rarefaction, eps = 0.045, 4 particles per cell, CFL 0.5, lumped mass, USL) with ``changes``."""
+    settings = burgers.BurgersSettings(h=h, solution=study.DEFAULT, eps=0.045, **changes)
+    return burgers.errors(settings, burgers.simulate(settings, progress=False))["velocity"]
+
+
+def _order(h1, h2, where, norm, **changes):
+    e1, e2 = _errors(h1, **changes)[where][norm], _errors(h2, **changes)[where][norm]
+    return float(np.log(e1 / e2) / np.log(h1 / h2)), (e1, e2)
+
+
+@pytest.mark.parametrize("norm", ["L1", "max"])
+def test_exact_acceleration_with_dt_proportional_to_h_is_first_order(norm):
+    """The source's first-order row: with dt = 0.5 h / max|v| (no viscous limit, which the exact
+    acceleration does not need) the O(dt) error of the semi-implicit Euler step is O(h)."""
+    for h1, h2 in ((0.01, 0.005), (0.005, 0.0025)):
+        order, errs = _order(h1, h2, "particles", norm, acceleration="exact", dt_rule="advective")
+        assert 0.8 <= order <= 1.3, f"h {h1} -> {h2}: {norm} errors {errs}, observed order {order:.2f}"
+
+
+def test_exact_acceleration_with_the_viscous_time_step_is_second_order():
+    """With the calculated variant's dt = 0.5 h^2 / (2 eps), the exact variant's error (time error
+    O(dt) plus space error O(h^2): see timestep.csv) is second order, not first as in the source."""
+    order, errs = _order(0.01, 0.005, "particles", "max", acceleration="exact")
+    assert 1.7 <= order <= 2.3, f"max errors {errs}, observed order {order:.2f}"
+
+
+@pytest.mark.parametrize("norm", ["L1", "max"])
+def test_calculated_acceleration_stalls_with_four_particles_per_cell(norm):
+    """Not the source's first order: with 4 particles per cell the calculated acceleration stops
+    converging by h = 0.01 (study: 0.01 -> 0.0025 gives orders -0.4 (L1) and 0.05 (max)). Cause
+    (diagnosis.csv): the force F_i = -sum_p V_p eps (dv/dx)_p G_ip is a particle quadrature whose
+    cell sums sum_{p in I} V_p jump by a particle volume h/4 whenever a particle crosses a node, an
+    O(eps v_x / (N_p h)) acceleration error; GIMP or 16 particles per cell remove the stall."""
+    order, errs = _order(0.01, 0.005, "particles", norm)
+    assert -0.5 <= order <= 0.4, f"{norm} errors {errs}, observed order {order:.2f}"
+
+
+def test_exact_acceleration_beats_calculated_at_every_h_with_the_same_time_step():
+    """As in the source, the exact acceleration is the more accurate, here by more than 10x."""
+    for h in (0.01, 0.005):
+        for norm in ("L1", "L2", "max"):
+            exact, calc = _errors(h, acceleration="exact")["particles"][norm], _errors(h)["particles"][norm]
+            assert 10 * exact < calc, f"h={h} {norm}: exact {exact:.3g}, calculated {calc:.3g}"
+
+
+def test_time_error_of_the_calculated_acceleration_is_below_its_space_error():
+    """dt / 4 at h = 0.01 changes the calculated variant's max error by less than 15 %."""
+    coarse, fine = _errors(0.01)["particles"]["max"], _errors(0.01, refine=4)["particles"]["max"]
+    assert abs(coarse - fine) < 0.15 * fine, f"max error {coarse:.4g} at dt, {fine:.4g} at dt/4"
+
+
+@pytest.mark.slow
+def test_sixteen_particles_per_cell_restore_first_order_for_the_calculated_acceleration():
+    """C3 for Burgers: at 16 particles per cell the node-crossing jumps are 4x smaller and the
+    calculated acceleration converges at first order over h = 0.01 ... 0.0025."""
+    for h1, h2 in ((0.01, 0.005), (0.005, 0.0025)):
+        order, errs = _order(h1, h2, "particles", "max", ppc=16)
+        assert 0.7 <= order <= 1.3, f"h {h1} -> {h2}: max errors {errs}, observed order {order:.2f}"
+
+
+@pytest.mark.slow
+def test_gimp_removes_the_stall_of_the_calculated_acceleration():
+    """GIMP's G_ip is continuous as a particle crosses a node: no jump in the force quadrature."""
+    order, errs = _order(0.01, 0.005, "particles", "L1", basis="gimp")
+    assert order >= 1.5, f"L1 errors {errs}, observed order {order:.2f}"
+
+
+def test_fem_p1_consistent_is_second_order_in_l2_and_lumped_is_larger():
+    solution = make_solution(study.DEFAULT, 0.045)
+    e = {(m, h): fem_burgers.errors(fem_burgers.solve(solution, h, mass=m), solution)["L2"]
+         for m in ("consistent", "lumped") for h in (0.02, 0.01)}
+    order = np.log2(e[("consistent", 0.02)] / e[("consistent", 0.01)])
+    assert 1.8 <= order <= 2.2, f"consistent L2 {e}, observed order {order:.2f}"
+    assert e[("lumped", 0.01)] > 2 * e[("consistent", 0.01)], e
+
+
+def test_source_table_with_corrections_falls_monotonically():
+    """STUDY.md's exponent corrections (*) put every row of the source's table in decreasing order."""
+    for row, table in study.SOURCE.items():
+        for eps, values in table.items():
+            assert all(a > b for a, b in zip(values, values[1:])), f"{row} eps={eps}: {values}"
+            assert all(0.8 < a / b < 4 for a, b in zip(values, values[1:])), f"{row} eps={eps}: {values}"
