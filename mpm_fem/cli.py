@@ -21,10 +21,10 @@ from . import output, plots
 from .grid import GridError
 from .particles import LAYOUTS, PositivityError
 from .shape import BASES
-from .step import ACCELERATIONS, SCHEMES
-from .transfer import MASS_KINDS
+from .step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, SCHEMES, STAGE_MASS
 
-CHOICES = {"mass": MASS_KINDS, "basis": BASES, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS}
+CHOICES = {"mass": STAGE_MASS, "basis": BASES, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
+           "projection": PROJECTIONS, "interpolation": INTERPOLATIONS}
 HELP = {
     "h": "cell size (must divide the domain)",
     "ppc": "particles per cell N_p",
@@ -33,8 +33,11 @@ HELP = {
     "gamma": "ratio of specific heats",
     "av_linear": "artificial viscosity, linear coefficient",
     "av_quadratic": "artificial viscosity, quadratic coefficient",
-    "mass": "grid mass matrix",
-    "basis": "particle basis: point mass (mpm) or particle domain (gimp)",
+    "mass": "grid mass matrix; exact: the FE + mass lumping stage made exact (error budget)",
+    "projection": "particle-to-grid projection: MPM sums or exact integrals of the exact fields",
+    "interpolation": "grid-to-particle interpolation: MPM sums or exact for the exact fields",
+    "refine": "time stage: the time step divided by this integer",
+    "basis": "particle basis: point mass (mpm), particle domain (gimp) or quadratic B-spline (bspline)",
     "scheme": "stress update order",
     "layout": "initial particle layout in each cell",
     "seed": "random seed of jittered/random layouts",
