@@ -117,3 +117,20 @@ def test_one_set_of_settings_for_every_mesh():
     for h, case in plan["mpm"].items():
         assert {k: case[k] for k in keys} == study.MPM, f"h={h} uses other settings"
     assert set(plan["mpm"]) == set(study.H) == set(study.SOURCE)
+
+
+@pytest.mark.slow
+def test_quick_study_writes_every_table_and_a_report_with_verdicts(tmp_path):
+    from mpm_fem.study import StudyOptions
+
+    study.run(StudyOptions(quick=True, jobs=1, out=tmp_path, progress=False))
+    folder = tmp_path / "sod"
+    for name in ("convergence", "regions", "extrema", "ppc", "mass"):
+        assert (folder / f"{name}.csv").exists() and (folder / f"{name}.json").exists(), name
+    for png in ("convergence", "regions", "extrema", "ppc", "profiles_h0.01", "profiles_h0.0025"):
+        assert (folder / f"{png}.png").exists(), png
+    text = study.report(folder)
+    assert "**C11**" in text and "**C12**" in text and "**C14**" in text and "**C3**" in text
+    verdicts = {c["id"]: c["verdict"] for c in study.claims(folder)}
+    assert set(verdicts) == {"C11", "C12", "C14", "C3", "C15"}
+    assert verdicts["C14"] == "confirmed", verdicts
