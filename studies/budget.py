@@ -16,9 +16,13 @@ domain:
     remainder (every stage exact, dt->0):  r   = (K e_{all, dt/K} - e_{all, dt}) / (K - 1)
     interaction:                           e_MPM - sum_s d_s - r
 
-``budget.csv`` (problem, h, basis, source, error, share = error / ||e_MPM||) and ``budget_<problem>
-.png`` (stacked shares per mesh, one panel per basis). Every study here runs the point-mass P1
-basis ("mpm"), GIMP and the C1 quadratic B-spline ("bspline").
+A second view, *alone*: the error of a run with only that stage in MPM form (the others exact),
+less the all-exact run at the same dt. Where the sources add up the two views agree.
+``budget.csv`` (problem, h, basis, source, view, error, share = error / ||e_MPM||, run_error),
+``runs.csv`` (every run's particle and nodal L1; Sod: plateau velocity scatter) and
+``budget_<problem>.png`` (stacked shares per mesh, one panel per basis and view). Every study
+here runs the point-mass P1 basis ("mpm"), GIMP and the C1 quadratic B-spline ("bspline"); E2,
+``bases.csv``: Sod with each basis down to h = 0.00125 (density L1, plateau velocity scatter).
 
 C1, ``time_order.csv``: at fixed h and particles, a fixed dt refined 1, 2, 4, 8, 16 times against
 dt / 256 (pulse) or dt / 64 (Burgers), for a smooth acoustic pulse in a gas without viscosity
@@ -98,13 +102,14 @@ def _error_field(problem: str, settings, result, points: np.ndarray) -> np.ndarr
     return field_on(points, P.x, P.velocity) - settings.exact.v(points, result.t)
 
 
-def _plateau_noise(settings, result) -> float:
-    """RMS of ``v_p - u*`` over the post-shock plateau (contact + 3h, shock - 3h): the velocity
-    noise of the force quadrature (STUDY.md, pitfalls)."""
+def _plateau(settings, result) -> dict:
+    """Particle velocities on the post-shock plateau (contact + 3h, shock - 3h): their scatter
+    (standard deviation, the velocity noise of the force quadrature, STUDY.md pitfalls) and the
+    offset of their mean from the exact ``u*``."""
     w = sod.riemann.wave_positions(result.t, settings.left, settings.right)
     P = result.particles
-    inside = (P.x > w["contact"] + 3 * settings.h) & (P.x < w["shock"] - 3 * settings.h)
-    return float(np.sqrt(np.mean((P.velocity[inside] - w["u_star"]) ** 2)))
+    v = P.velocity[(P.x > w["contact"] + 3 * settings.h) & (P.x < w["shock"] - 3 * settings.h)]
+    return {"plateau_noise": float(np.std(v)), "plateau_offset": float(np.mean(v) - w["u_star"])}
 
 
 def budget_case(case: dict) -> dict:
@@ -133,7 +138,7 @@ def budget_case(case: dict) -> dict:
                       "particles_L1": errors[key]["particles"]["L1"], "nodes_L1": errors[key]["nodes"]["L1"],
                       "particles_max": errors[key]["particles"]["max"]}
         if problem == "sod":
-            runs[name]["plateau_noise"] = _plateau_noise(settings, result)
+            runs[name].update(_plateau(settings, result))
     return {"runs": runs, "budget": _budget(fields, points)}
 
 
@@ -240,7 +245,7 @@ def bases_case(case: dict) -> dict:
         return {"ok": False, "error": str(err)}
     density = sod.errors(settings, result)["density"]
     return {"ok": True, "particles_L1": density["particles"]["L1"], "nodes_L1": density["nodes"]["L1"],
-            "plateau_noise": _plateau_noise(settings, result), "steps": result.steps, "wall_s": result.wall_s}
+            **_plateau(settings, result), "steps": result.steps, "wall_s": result.wall_s}
 
 
 def run_case(case: dict) -> dict:
@@ -334,7 +339,8 @@ def _budget_tables(folder: Path, got: dict, settings: dict) -> None:
         for name, run in R.items():
             runs.append({"problem": problem, "h": h, "basis": basis, "variant": name, **{
                 k: run.get(k, "") for k in ("ok", "field_L1", "particles_L1", "nodes_L1", "particles_max",
-                                            "plateau_noise", "steps", "wall_s")}, "error": run.get("error", "")})
+                                            "plateau_noise", "plateau_offset", "steps", "wall_s")},
+                         "error": run.get("error", "")})
     write_table(folder, "budget", rows, settings)
     write_table(folder, "runs", runs, settings)
     for problem in sorted({r["problem"] for r in rows}):
@@ -459,7 +465,7 @@ def _crossing_tables(folder: Path, got: dict, settings: dict) -> None:
 
 
 def _bases_table(folder: Path, got: dict, settings: dict) -> None:
-    rows = [{"h": h, "basis": basis, **{k: r.get(k, "") for k in ("ok", "particles_L1", "nodes_L1", "plateau_noise",
+    rows = [{"h": h, "basis": basis, **{k: r.get(k, "") for k in ("ok", "particles_L1", "nodes_L1", "plateau_noise", "plateau_offset",
                                                                   "steps", "wall_s", "error")}}
             for (h, basis), r in sorted(got.items(), key=lambda kv: (-kv[0][0], BASES.index(kv[0][1])))]
     write_table(folder, "bases", rows, settings)
@@ -478,7 +484,7 @@ def _bases_table(folder: Path, got: dict, settings: dict) -> None:
     axes[0].set_title("E2: Sod with each basis (16 ppc, CFL 0.05)", fontsize=9)
     axes[0].legend(fontsize=6)
     axes[1].set_xlabel("h")
-    axes[1].set_ylabel("RMS of v_p - u* on the post-shock plateau")
+    axes[1].set_ylabel("std of v_p on the post-shock plateau")
     axes[1].set_title("E2: force-quadrature velocity noise", fontsize=9)
     axes[1].legend(fontsize=7)
     fig.tight_layout()
@@ -500,9 +506,114 @@ def report(folder: Path) -> str:
     if not (folder / "budget.csv").exists():
         return "## Error budget (E1), time error (C1), grid crossing (C2), bases (E2)\n\nNot run.\n"
     out = ["## Error budget (E1), time error (C1), grid crossing (C2), bases (E2)", ""]
-    out += _budget_report(folder) + _time_report(folder) + _crossing_report(folder)
+    out += _findings(folder) + _runs_report(folder) + _budget_report(folder) + _bases_report(folder) + _time_report(folder)
+    out += _crossing_report(folder)
     out += ["", "Verdicts:", ""] + [f"- **{c['id']}** ({c['verdict']}): {c['evidence']}" for c in claims(folder)]
     return "\n".join(out) + "\n"
+
+
+def _findings(folder) -> list[str]:
+    """What the tables say, mesh by mesh, with their numbers."""
+    runs = _runs(folder)
+    e = lambda p, h, v, b="mpm", k="particles_L1": _run_error(runs, p, h, b, v, k)  # noqa: E731
+    out = ["### What the budget says", ""]
+    hb = [h for h in H["burgers"] if not np.isnan(e("burgers", h, "MPM"))]
+    hs = [h for h in H["sod"] if not np.isnan(e("sod", h, "MPM"))]
+    if len(hb) < 2 or len(hs) < 2:
+        out.append("- Quick run (one mesh per problem): the statements across meshes need `--full`; the tables "
+                   "below hold what was run.")
+    if len(hb) >= 2:
+        mpm = [e("burgers", h, "MPM") for h in hb]
+        proj = [e("burgers", h, "projection") for h in hb]
+        all_dt = [e("burgers", h, "all exact, dt") for h in hb]
+        all_k = [e("burgers", h, "all exact, dt/K") for h in hb]
+        change = [abs(e("burgers", hb[-1], v) / mpm[-1] - 1) for v in ("FE + mass lumping", "interpolation", "time")]
+        budget = read_table(folder / "budget.csv")
+        pick = lambda h, source, view, key="share": next(  # noqa: E731
+            (_f(r, key) for r in budget if r["problem"] == "burgers" and r["basis"] == "mpm" and float(r["h"]) == h
+             and r["source"] == source and r["view"] == view), float("nan"))
+        share_t, share_p = pick(hb[0], "time", "removed"), pick(hb[0], "projection", "removed")
+        rem = [pick(h, REMAINDER, "", "error") for h in hb]
+        out.append(
+            f"- **Burgers, P1**: the MPM error {', '.join(f'{x:.3g}' for x in mpm)} (h = {', '.join(f'{h:g}' for h in hb)}; "
+            f"orders {_orders_text(hb, mpm)}) stagnates; with the projection exact it is {', '.join(f'{x:.3g}' for x in proj)} "
+            f"(orders {_orders_text(hb, proj)}). The projection (the force quadrature with the volumes V_p the run "
+            "carries) is the source that dominates on the fine meshes and the cause of the stagnation; making the FE + "
+            f"mass, interpolation or time stage exact changes it by {min(change):.0%} to {max(change):.0%} on the finest mesh. "
+            f"On the coarsest mesh the time and projection contributions ({share_t:.0%} and {share_p:.0%} of the error) "
+            f"partly cancel. Every stage exact leaves {', '.join(f'{x:.3g}' for x in all_dt)} at dt and "
+            f"{', '.join(f'{x:.3g}' for x in all_k)} at dt/2: the remainder is the time error of the step, and its dt -> 0 "
+            f"extrapolation is {', '.join(f'{x:.2g}' for x in rem)}.")
+    if len(hs) >= 2:
+        only = [e("sod", h, "only projection MPM") for h in hs]
+        noise = [e("sod", h, "only projection MPM", k="plateau_noise") for h in hs]
+        mpm_noise = [e("sod", h, "MPM", k="plateau_noise") for h in hs]
+        single = {v: [e("sod", h, v) for h in hs] for v in ("MPM", "projection", "FE + mass lumping", "interpolation")}
+        allx = [e("sod", h, "all exact, dt/K") for h in hs]
+        worse = all(single[v][-1] > single["MPM"][-1] for v in ("projection", "FE + mass lumping", "interpolation"))
+        others_fall = all(np.all(np.diff([e("sod", h, v) for h in hs]) < 0)
+                          for v in ("only FE + mass MPM", "only interpolation MPM", "all exact, dt"))
+        out.append(
+            f"- **Sod, P1**: the stages do not add up. Making the projection, the FE + mass or the interpolation stage "
+            f"exact {'alone makes the particle error larger' if worse else 'alone changes the particle error'} "
+            f"(h = {hs[-1]:g}: MPM {single['MPM'][-1]:.3g}; projection exact {single['projection'][-1]:.3g}, FE + mass exact "
+            f"{single['FE + mass lumping'][-1]:.3g}, interpolation exact {single['interpolation'][-1]:.3g}); all of them "
+            f"exact give {', '.join(f'{x:.3g}' for x in allx)} (order {_orders_text(hs, allx)}): the MPM stages compensate each "
+            "other at the shock and the contact, where the exact fields of one stage meet the viscous, smeared profile "
+            "of the others. The interaction term of the budget is several times the error itself, so the shares are "
+            "not a decomposition on this problem. What does identify the stagnation is the one source whose error "
+            f"does not fall with h: the projection. With every other stage exact its error is {', '.join(f'{x:.3g}' for x in only)} "
+            f"and the scatter of the plateau velocities {', '.join(f'{x:.3g}' for x in noise)}; the other sources "
+            f"alone {'fall' if others_fall else 'do not all fall'} with h (table below). In the full MPM step the other stages damp this force-quadrature noise "
+            f"(plateau scatter {', '.join(f'{x:.3g}' for x in mpm_noise)}), which leaves a particle-norm floor: see E2.")
+    if (folder / "bases.csv").exists():
+        rows = [r for r in read_table(folder / "bases.csv") if r["ok"] == "True"]
+        last = {r["basis"]: r for r in rows if _f(r, "h") == min(_f(x, "h") for x in rows)}
+        if len(last) == len(BASES):
+            out.append(
+                "- **Bases (E2)**: on Sod at h = " + f"{_f(last['mpm'], 'h'):g}" + " the particle L1 is "
+                + ", ".join(f"{b} {_f(last[b], 'particles_L1'):.3g}" for b in BASES)
+                + "; plateau velocity scatter " + ", ".join(f"{b} {_f(last[b], 'plateau_noise'):.3g}" for b in BASES)
+                + ". Orders, the reach of the floor and the noise per mesh are in the E2 table: with 16 particles per "
+                "cell GIMP's particle domain is h/16 and it behaves like P1 on the coarse meshes. Burgers: orders in h "
+                "of the three bases in the second E2 table.")
+    out.append("")
+    return out
+
+
+def _runs(folder) -> list[dict]:
+    return [r for r in read_table(folder / "runs.csv") if r["ok"] == "True"]
+
+
+def _run_error(runs, problem, h, basis, variant, key="particles_L1") -> float:
+    for r in runs:
+        if (r["problem"], float(r["h"]), r["basis"], r["variant"]) == (problem, h, basis, variant):
+            return _f(r, key)
+    return float("nan")
+
+
+def _runs_report(folder) -> list[str]:
+    """The error of every run (the measured numbers the budget is made of), P1."""
+    runs = _runs(folder)
+    out = ["### E1: the error of every run (point-mass P1)", "",
+           "Particle L1 error at T (Sod: density, `(nodes L1)` beside it; Burgers: velocity) with the stages of each "
+           "row in their exact form. `runs.csv` holds every basis.", ""]
+    for problem in ("sod", "burgers"):
+        hs = sorted({float(r["h"]) for r in runs if r["problem"] == problem and r["basis"] == "mpm"}, reverse=True)
+        if not hs:
+            continue
+        out += [f"**{problem}**", "", "| stages exact | " + " | ".join(f"h = {h:g}" for h in hs) + " |",
+                "|---|" + "---:|" * len(hs)]
+        for variant in VARIANTS:
+            cells = []
+            for h in hs:
+                e = _run_error(runs, problem, h, "mpm", variant)
+                n = _run_error(runs, problem, h, "mpm", variant, "nodes_L1")
+                cells.append("failed" if np.isnan(e) else (f"{e:.3g} ({n:.3g})" if problem == "sod" else f"{e:.3g}"))
+            label = "none (MPM)" if variant == "MPM" else variant.replace("K", str(K))
+            out.append(f"| {label} | " + " | ".join(cells) + " |")
+        out.append("")
+    return out
 
 
 def _budget_report(folder) -> list[str]:
@@ -531,6 +642,39 @@ def _budget_report(folder) -> list[str]:
                 dom = max((s for s in SOURCES if s in at), key=lambda s: _f(at[s], "error"), default="-")
                 out.append(f"| {h:g} | {basis} | {view} | {_f(total, 'error'):.3g} | " + " | ".join(cells + tail) + f" | {dom} |")
         out += ["", f"![budget {problem}](budget/budget_{problem}.png)", ""]
+    return out
+
+
+def _orders_text(hs, values) -> str:
+    v = np.asarray(values, float)
+    if len(v) < 2 or not np.all(v > 0):
+        return ""
+    return ", ".join(f"{o:.2f}" for o in np.log(v[:-1] / v[1:]) / np.log(np.asarray(hs[:-1]) / np.asarray(hs[1:])))
+
+
+def _bases_report(folder) -> list[str]:
+    out = ["### E2: the bases", ""]
+    if (folder / "bases.csv").exists():
+        rows = [r for r in read_table(folder / "bases.csv") if r["ok"] == "True"]
+        out += ["Sod (MPM stages, the Sod study's settings): density L1 over particles and nodes, observed orders, "
+                "and the post-shock plateau velocity: scatter (std) and mean offset from u*.", "",
+                "| basis | h | particles L1 | nodes L1 | plateau std(v_p) | plateau mean - u* |", "|---|---:|---:|---:|---:|---:|"]
+        for basis in BASES:
+            sub = sorted((r for r in rows if r["basis"] == basis), key=lambda r: -_f(r, "h"))
+            for r in sub:
+                out.append(f"| {basis} | {_f(r, 'h'):g} | {_f(r, 'particles_L1'):.3g} | {_f(r, 'nodes_L1'):.3g} | "
+                           f"{_f(r, 'plateau_noise'):.3g} | {_f(r, 'plateau_offset'):.2g} |")
+            hs = [_f(r, "h") for r in sub]
+            out.append(f"| {basis} | orders | {_orders_text(hs, [_f(r, 'particles_L1') for r in sub])} | "
+                       f"{_orders_text(hs, [_f(r, 'nodes_L1') for r in sub])} | {_orders_text(hs, [_f(r, 'plateau_noise') for r in sub])} | |")
+        out += ["", "![bases](budget/bases.png)", ""]
+    runs = _runs(folder)
+    out += ["Burgers (rarefaction, eps = 0.045, MPM stages): velocity L1 over particles, observed orders.", "",
+            "| basis | " + " | ".join(f"h = {h:g}" for h in H["burgers"]) + " | orders |", "|---|" + "---:|" * (len(H["burgers"]) + 1)]
+    for basis in BASES:
+        e = [_run_error(runs, "burgers", h, basis, "MPM") for h in H["burgers"]]
+        out.append(f"| {basis} | " + " | ".join(f"{x:.3g}" for x in e) + f" | {_orders_text(H['burgers'], e)} |")
+    out.append("")
     return out
 
 
@@ -579,17 +723,80 @@ def claims(folder: Path) -> list[dict]:
     t = read_table(folder / "time_order.csv")
     loc = read_table(folder / "local_error.csv")
     fit = {(r["problem"], r["basis"], r["quantity"]): _f(r, "fitted_order") for r in t}
-    lfit = {(r["problem"], r["basis"], r["quantity"]): _f(r, "fitted_order") for r in loc}
-    out.append({"id": "C1", "verdict": "confirmed" if all(0.8 <= v <= 1.2 for k, v in fit.items() if k[1] != "mpm" or k[0] == "burgers") else "partly",
-                "evidence": "global order in dt: " + ", ".join(f"{p} {b} {q} {v:.2f}" for (p, b, q), v in fit.items())
-                            + "; local order (x): " + ", ".join(f"{p} {b} {v:.2f}" for (p, b, q), v in lfit.items() if q == "x")})
+    lfit = {(r["problem"], r["basis"]): _f(r, "fitted_order") for r in loc if r["quantity"] == "x"}
+    steps = {key: [_f(r, "order") for r in t if (r["problem"], r["basis"], r["quantity"]) == key and r["order"]]
+             for key in fit}
+    off = {k: v for k, v in fit.items() if not 0.8 <= v <= 1.2}
+    local_ok = all(1.8 <= v <= 2.2 for v in lfit.values())
+    text = ("global order in dt (least squares): " + ", ".join(f"{p} {b} {q} {v:.2f}" for (p, b, q), v in fit.items())
+            + "; local order of x_p: " + ", ".join(f"{p} {b} {v:.2f}" for (p, b), v in lfit.items()))
+    if off:
+        worst = max(off, key=lambda k: abs(fit[k] - 1))
+        text += (f". Outside 1 +- 0.2: {', '.join(f'{p} {b} {q}' for p, b, q in off)}; the P1 orders between "
+                 f"successive refinements scatter ({', '.join(f'{o:.2f}' for o in steps[worst])} for {' '.join(worst)}): "
+                 "node crossings make the P1 solution a rough function of dt (C2); GIMP and the B-spline give 1.0")
+    out.append({"id": "C1", "verdict": "confirmed" if not off and local_ok else "partly", "evidence": text})
     c = read_table(folder / "crossing.csv")
     ex = [_f(r, "ratio") for r in c if r["basis"] == "mpm" and r["acceleration"] == "exact"]
     smooth = [abs(_f(r, "ratio")) for r in c if r["basis"] != "mpm" and r["acceleration"] == "exact"]
+    noisy = {b: np.median([abs(_f(r, "measured")) for r in c if r["basis"] == b and r["acceleration"] == "calculated"])
+             for b in BASES if any(r["basis"] == b for r in c)}
     out.append({"id": "C2", "verdict": "confirmed" if ex and max(abs(np.array(ex) - 1)) < 0.1 else "partly",
-                "evidence": f"P1, exact acceleration: measured/predicted in [{min(ex):.3f}, {max(ex):.3f}] over {len(ex)} crossings; "
-                            f"GIMP and B-spline: |measured/predicted| <= {max(smooth, default=float('nan')):.3f}"})
+                "evidence": f"P1, exact nodal acceleration: measured/predicted jump in [{min(ex):.3f}, {max(ex):.3f}] over "
+                            f"{len(ex)} crossings; GIMP and B-spline: |measured|/|P1 formula| <= {max(smooth, default=float('nan')):.3f}. "
+                            "With the calculated acceleration the nodal a_i itself jumps whenever any particle crosses a node "
+                            "(force quadrature), and the median |jump of dA/dt| is "
+                            + ", ".join(f"{b} {v:.3g}" for b, v in noisy.items()) + " (P1 formula: ~0.04-0.8)"})
+    out += _e1_claims(folder) + _e2_claims(folder)
     return out
+
+
+def _e1_claims(folder) -> list[dict]:
+    rows = read_table(folder / "budget.csv")
+    runs = _runs(folder)
+    out = []
+    for problem in ("burgers", "sod"):
+        sub = [r for r in rows if r["problem"] == problem and r["basis"] == "mpm"]
+        if not sub:
+            continue
+        hs = sorted({float(r["h"]) for r in sub}, reverse=True)
+        parts = []
+        for h in (hs[0], hs[-1]) if len(hs) > 1 else hs:
+            at = {(r["source"], r["view"]): r for r in sub if float(r["h"]) == h}
+            total = _f(at[("total", "")], "error")
+            removed = {s: _f(at[(s, "removed")], "share") for s in SOURCES if (s, "removed") in at}
+            alone = {s: _f(at[(s, "alone")], "share") for s in SOURCES if (s, "alone") in at}
+            rem = _f(at.get((REMAINDER, ""), {}), "error")
+            inter = _f(at.get(("interaction", ""), {}), "share")
+            parts.append(f"h = {h:g}: MPM {total:.3g}; removed " + ", ".join(f"{s} {v:.0%}" for s, v in removed.items())
+                         + "; alone " + ", ".join(f"{s} {v:.0%}" for s, v in alone.items())
+                         + f"; remainder {rem:.2g}; interaction {inter:.0%}")
+        h = hs[-1]
+        single = {v: _run_error(runs, problem, h, "mpm", v) for v in ("MPM", "projection", "FE + mass lumping", "interpolation", "time", "all exact, dt/K")}
+        text = "; ".join(parts) + (f". Run errors at h = {h:g}: " + ", ".join(f"{k} {v:.3g}" for k, v in single.items()))
+        verdict = "measured"
+        out.append({"id": f"E1 ({problem})", "verdict": verdict, "evidence": text})
+    return out
+
+
+def _e2_claims(folder) -> list[dict]:
+    if not (folder / "bases.csv").exists():
+        return []
+    rows = [r for r in read_table(folder / "bases.csv") if r["ok"] == "True"]
+    parts = []
+    for basis in BASES:
+        sub = sorted((r for r in rows if r["basis"] == basis), key=lambda r: -_f(r, "h"))
+        if len(sub) < 2:
+            continue
+        hs = [_f(r, "h") for r in sub]
+        parts.append(f"{basis}: particle L1 {_f(sub[0], 'particles_L1'):.3g} -> {_f(sub[-1], 'particles_L1'):.3g} "
+                     f"(last order {_orders_text(hs[-2:], [_f(r, 'particles_L1') for r in sub[-2:]])}), nodes "
+                     f"{_f(sub[-1], 'nodes_L1'):.3g}, plateau std(v_p) {_f(sub[0], 'plateau_noise'):.3g} -> {_f(sub[-1], 'plateau_noise'):.3g}")
+    runs = _runs(folder)
+    b = [f"{basis} {_orders_text(H['burgers'], [_run_error(runs, 'burgers', h, basis, 'MPM') for h in H['burgers']])}" for basis in BASES]
+    return [{"id": "E2", "verdict": "measured",
+             "evidence": "Sod h = " + " ... ".join(f"{h:g}" for h in (BASES_H[0], BASES_H[-1])) + ": " + "; ".join(parts)
+                         + ". Burgers orders in h: " + "; ".join(b)}]
 
 
 if __name__ == "__main__":
