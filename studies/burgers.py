@@ -699,7 +699,7 @@ def claims(folder: Path) -> list[dict]:
         return f"{min(v):.2f}..{max(v):.2f}" if v else "not run"
 
     out.append({"id": "C13", "verdict": "partly", "evidence":
-                f"{DEFAULT} solution, {NORM} over {WHERE}, least-squares orders over the 5 eps: exact a with dt ~ h "
+                f"{DEFAULT} solution, {NORM} over {WHERE}, least-squares orders over eps: exact a with dt ~ h "
                 f"{rng(exact_dt_h)} (first order, as the source: the O(dt) time error), with the viscous dt "
                 f"{rng(exact)} (second order); calculated a at 4 particles per cell {rng(calc)} (stalls: "
                 f"node-crossing jumps of the force quadrature), at 16 per cell {rng(calc16)} (h <= 0.0025)"})
