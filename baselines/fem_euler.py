@@ -168,12 +168,16 @@ def time_derivative(U: np.ndarray, ops: _Operators, gamma: float, visc: Viscosit
 
 
 def sod_initial_state(nodes: np.ndarray, gamma: float) -> np.ndarray:
-    """Sod's data at the nodes, ``U`` (3, n); a node on the diaphragm takes the left state."""
-    left = nodes <= SOD_DIAPHRAGM
-    rho = np.where(left, SOD_LEFT[0], SOD_RIGHT[0])
-    u = np.where(left, SOD_LEFT[1], SOD_RIGHT[1])
-    p = np.where(left, SOD_LEFT[2], SOD_RIGHT[2])
-    return np.stack((rho, rho * u, p / (gamma - 1.0) + 0.5 * rho * u * u))
+    """Sod's data at the nodes, ``U`` (3, n); a node on the diaphragm takes the mean of the two
+    conserved states, which centres the discrete jump on the diaphragm and makes the lumped
+    integrals of mass and energy exact (0.5625 and 1.375 on [0, 1])."""
+    def conserved(state):
+        rho, u, p = state
+        return np.array([rho, rho * u, p / (gamma - 1.0) + 0.5 * rho * u * u])
+
+    UL, UR = conserved(SOD_LEFT), conserved(SOD_RIGHT)
+    weight = np.where(np.isclose(nodes, SOD_DIAPHRAGM, rtol=0, atol=1e-12), 0.5, (nodes < SOD_DIAPHRAGM).astype(float))
+    return UL[:, None] * weight + UR[:, None] * (1.0 - weight)
 
 
 def _validate(h, T, mass, cfl, gamma) -> None:

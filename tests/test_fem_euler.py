@@ -141,3 +141,10 @@ def test_bad_input_raises_value_error(kwargs, message):
 def test_negative_viscosity_constant_is_rejected():
     with pytest.raises(ValueError, match="quadratic"):
         Viscosity(linear=0.1, quadratic=-1.0)
+
+
+def test_initial_data_integrate_exactly_with_the_diaphragm_on_a_node():
+    grid = uniform_grid(0.0, 1.0, 0.01)
+    U0 = sod_initial_state(grid.nodes, GAMMA)
+    assert abs(np.sum(grid.lumped_mass * U0[0]) - 0.5625) < 1e-14
+    assert abs(np.sum(grid.lumped_mass * U0[2]) - 1.375) < 1e-14

@@ -72,13 +72,13 @@ def test_a_killed_sweep_resumes_without_recomputing_finished_cases(tmp_path):
     import json
 
     proc = subprocess.Popen([sys.executable, "-c", script, str(Path(__file__).parent), json.dumps(cases), str(cache)])
-    deadline = time.time() + 60
-    while time.time() < deadline and len(list(cache.glob("*.json"))) < 4:
+    deadline = time.time() + 300  # generous: the subprocess imports numpy, scipy and scikit-fem on a loaded machine
+    while time.time() < deadline and len(list(cache.glob("*.json"))) < 2:
         time.sleep(0.05)
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait()
     finished = len(list(cache.glob("*.json")))
-    assert 4 <= finished < len(cases), f"{finished} cases finished before the kill"
+    assert 2 <= finished < len(cases), f"{finished} cases finished before the kill"
     ran_before = trace.read_text().split()
 
     results = run_cases(slow_square, cases, jobs=2, cache_dir=cache, progress=False)
