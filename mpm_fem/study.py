@@ -38,6 +38,18 @@ class StudyOptions:
         return run_cases(fn, cases, jobs=self.jobs, cache_dir=self.folder(name) / ".cache", desc=desc or name,
                          scheduler=self.scheduler, progress=self.progress)
 
+    def sweep_plan(self, name: str, fn, plan: dict[str, dict], cost=None) -> dict[str, dict]:
+        """Run a plan, ``{group: {label: case}}``, in one sweep: a case shared by several groups runs
+        once, the most costly first (``cost(case)``); returns ``{group: {label: result}}``."""
+        key = lambda case: repr(sorted(case.items()))  # noqa: E731
+        unique = {}
+        for group in plan.values():
+            for case in group.values():
+                unique.setdefault(key(case), case)
+        cases = sorted(unique.values(), key=cost, reverse=True) if cost else list(unique.values())
+        results = dict(zip(map(key, cases), self.sweep(name, fn, cases)))
+        return {g: {label: results[key(c)] for label, c in group.items()} for g, group in plan.items()}
+
 
 def write_table(folder: Path, table: str, rows: list[dict], settings: dict) -> Path:
     """``<folder>/<table>.csv`` from ``rows`` (dicts with the same keys) and ``<table>.json``

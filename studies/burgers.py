@@ -197,22 +197,12 @@ def _plan(quick: bool) -> dict:
     return plan
 
 
-def _key(case: dict) -> str:
-    return repr(sorted(case.items()))
-
-
 # ---------------------------------------------------------------- the study
 
 def run(options: StudyOptions) -> None:
     """Every case in one sweep (shared cases run once, the longest first), then tables and figures."""
     plan = _plan(options.quick)
-    unique = {}
-    for group in plan.values():
-        for case in group.values():
-            unique.setdefault(_key(case), case)
-    cases = sorted(unique.values(), key=_cost, reverse=True)
-    results = dict(zip(map(_key, cases), options.sweep(NAME, run_case, cases)))
-    got = {name: {k: results[_key(c)] for k, c in group.items()} for name, group in plan.items()}
+    got = options.sweep_plan(NAME, run_case, plan, cost=_cost)
     folder = options.folder(NAME)
     settings = {"quick": options.quick, "mpm": MPM, "fem": FEM, "T": 0.5, "domain": [0, 2],
                 "default_solution": DEFAULT, "compared_norm": f"{NORM} over {WHERE}",
@@ -574,7 +564,7 @@ def _fitted(orders: list[dict], sol: str, method: str, eps: float, where: str = 
 
 def _main_table(errors: list[dict], orders: list[dict]) -> list[str]:
     col = f"{WHERE}_{NORM}"
-    lines = [f"| eps | row | " + " | ".join(f"h={h}" for h in H) + " | fitted order |", "|---|---|" + "---|" * (len(H) + 1)]
+    lines = ["| eps | row | " + " | ".join(f"h={h}" for h in H) + " | fitted order |", "|---|---|" + "---|" * (len(H) + 1)]
     for eps in [e for e in EPS if _table_of(errors, DEFAULT, "mpm_calculated", e)]:
         for row_name, methods in (("exact", ("mpm_exact_dt_h", "mpm_exact")), ("calculated", ("mpm_calculated", "mpm_calculated_16"))):
             src = SOURCE[row_name][eps]

@@ -200,13 +200,7 @@ def _plan(quick: bool) -> dict:
 def run(options: StudyOptions) -> None:
     """All cases in one sweep (shared ones run once), then tables and figures."""
     plan = _plan(options.quick)
-    unique = {}
-    for group in plan.values():
-        for case in group.values():
-            unique.setdefault(_key(case), case)
-    cases = sorted(unique.values(), key=_cost, reverse=True)
-    results = dict(zip(map(_key, cases), options.sweep(NAME, run_case, cases)))
-    got = {name: {k: results[_key(c)] for k, c in group.items()} for name, group in plan.items()}
+    got = options.sweep_plan(NAME, run_case, plan, cost=_cost)
     folder = options.folder(NAME)
     settings = {"mpm": MPM, "fem": FEM, "region_half_width": REGION_HALF_WIDTH, "T": 0.2,
                 "quick": options.quick, "problem": sod.SodSettings().as_dict()}
@@ -218,10 +212,6 @@ def run(options: StudyOptions) -> None:
     if got["plateau"]:
         _plateau(folder, got, settings)
     _profiles(folder, got)
-
-
-def _key(case: dict) -> str:
-    return repr(sorted(case.items()))
 
 
 def _orders(hs, values) -> list:

@@ -31,10 +31,10 @@ from ..errors import norms
 from ..exact_stages import SmoothBurgersFields
 from ..grid import Grid, uniform_grid
 from ..models.burgers import ViscousBurgers
-from ..particles import LAYOUTS, Particles, make_particles, seed_positions
+from ..particles import Particles, make_particles, seed_positions
 from ..solve import Problem, Result, run
 from ..step import ACCELERATIONS, Dirichlet, Stages
-from . import burgers_fast
+from . import burgers_fast, check_run_settings
 
 
 WEIGHTS = ("volume", "cell")
@@ -68,18 +68,9 @@ class BurgersSettings:
     def __post_init__(self):
         if not (np.isfinite(self.eps) and self.eps > 0):
             raise ValueError(f"the viscosity eps must be positive, got {self.eps}")
-        uniform_grid(*self.exact.domain, self.h)  # raises unless h divides the domain
-        if self.layout not in LAYOUTS:
-            raise ValueError(f"unknown particle layout {self.layout!r}; choose one of {', '.join(LAYOUTS)}")
-        if isinstance(self.ppc, bool) or not isinstance(self.ppc, int) or self.ppc < 1:
-            raise ValueError(f"particles per cell must be an integer >= 1, got {self.ppc!r}")
-        if not (np.isfinite(self.T) and self.T >= 0):
-            raise ValueError(f"the final time T must be >= 0, got {self.T}")
-        if not (0 < self.cfl <= 1):
-            raise ValueError(f"the CFL number must lie in (0, 1], got {self.cfl}")
         if self.acceleration not in ACCELERATIONS:
             raise ValueError(f"unknown acceleration {self.acceleration!r}; choose one of {', '.join(ACCELERATIONS)}")
-        self.stages  # validates mass, basis, scheme
+        check_run_settings(self, self.exact.domain)
         for name, allowed in (("weights", WEIGHTS), ("force", FORCES), ("dt_rule", DT_RULES)):
             if getattr(self, name) not in allowed:
                 raise ValueError(f"unknown {name} {getattr(self, name)!r}; choose one of {', '.join(allowed)}")

@@ -19,7 +19,8 @@ from ..errors import norms
 from ..exact_stages import RiemannFields
 from ..grid import uniform_grid
 from ..models.euler import IdealGas
-from ..particles import LAYOUTS, make_particles, seed_positions
+from ..particles import make_particles, seed_positions
+from . import check_run_settings
 from ..solve import Problem, Result, run
 from ..step import Stages, Walls
 
@@ -50,16 +51,7 @@ class SodSettings:
     refine: int = 1
 
     def __post_init__(self):
-        uniform_grid(*DOMAIN, self.h)  # raises unless h divides [0, 1]
-        if self.layout not in LAYOUTS:
-            raise ValueError(f"unknown particle layout {self.layout!r}; choose one of {', '.join(LAYOUTS)}")
-        if isinstance(self.ppc, bool) or not isinstance(self.ppc, int) or self.ppc < 1:
-            raise ValueError(f"particles per cell must be an integer >= 1, got {self.ppc!r}")
-        if not (np.isfinite(self.T) and self.T >= 0):
-            raise ValueError(f"the final time T must be >= 0, got {self.T}")
-        if not (0 < self.cfl <= 1):
-            raise ValueError(f"the CFL number must lie in (0, 1], got {self.cfl}")
-        self.stages  # validates mass, basis, scheme
+        check_run_settings(self, DOMAIN)
 
     @property
     def stages(self) -> Stages:
