@@ -89,7 +89,8 @@ def write_report(options: StudyOptions, studies=None, timings=()) -> Path:
         sections.append(f'<a id="{name}"></a>\n\n' + module.report(folder))
     found.setdefault("reproduce", []).append({
         "id": "E4", "verdict": "confirmed",
-        "evidence": "`mpm-fem reproduce --full` wrote this report and every table and figure beside it"
+        "evidence": f"`mpm-fem reproduce {'--quick' if options.quick else '--full'}` wrote this report and every "
+        "table and figure beside it"
         + (f" ({', '.join(f'{n} {t:.0f} s' for n, t in timings)})" if timings else ""),
     })
     v = versions()

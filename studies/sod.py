@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from baselines import fem_euler
+from baselines import fem_euler, fv_euler
 from baselines.exact import riemann
 from mpm_fem.errors import norms, observed_orders
 from mpm_fem.grid import uniform_grid
@@ -44,6 +44,7 @@ SOURCE = {
 # One set of MPM settings for every h (never tuned per mesh); why these: ppc.csv and plateau.csv
 MPM = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", scheme="usl", basis="mpm", layout="regular", seed=0)
 FEM = dict(cfl=0.3, viscosity_linear=0.1, viscosity_quadratic=1.0)  # baselines.fem_euler defaults
+FV_CFL = 0.8  # baselines.fv_euler default
 REGION_HALF_WIDTH = 0.02  # every wave, every mesh: two cells of the coarsest mesh on each side
 PROFILE_H = (0.01, 0.0025)
 PPC = (1, 2, 4, 8, 16, 32)
@@ -96,6 +97,8 @@ def run_case(case: dict) -> dict:
     h = case["h"]
     if case["solver"] == "fem":
         return _run_fem(case)
+    if case["solver"] == "fv":
+        return _run_fv(case)
     settings = sod.SodSettings(h=h, **{k: case[k] for k in MPM})
     counter = ExtremaCounter(uniform_grid(0.0, 1.0, h))
     try:
@@ -160,6 +163,15 @@ def _run_fem(case: dict) -> dict:
     return out
 
 
+def _run_fv(case: dict) -> dict:
+    """The finite-volume reference (MUSCL-Hancock + HLLC) on the cells of the same mesh: cell
+    averages against the exact density at the cell centres, weights h."""
+    r = fv_euler.solve(case["h"], cfl=case["cfl"])
+    e = r.rho - _exact_density(r.centres, r.t)
+    return {"ok": True, "steps": r.steps, "density": {"cells": norms(e, np.full(e.size, case["h"]))},
+            "mass": float(np.sum(r.rho) * case["h"])}
+
+
 # ---------------------------------------------------------------- the cases
 
 def mpm_case(h: float, **changes) -> dict:
@@ -173,9 +185,13 @@ def fem_case(h: float, mass: str) -> dict:
             "profiles": h in PROFILE_H}
 
 
+def fv_case(h: float) -> dict:
+    return {"solver": "fv", "h": h, "cfl": FV_CFL}
+
+
 def _cost(case: dict) -> float:
     """Particles x steps, to start the longest runs first."""
-    if case["solver"] == "fem":
+    if case["solver"] in ("fem", "fv"):
         return 1.0 / case["h"] ** 2
     return case["ppc"] / (case["h"] ** 2 * case["cfl"]) * (2.0 if case["mass"] == "consistent" else 1.0)
 
@@ -189,6 +205,7 @@ def _plan(quick: bool) -> dict:
         "mpm_consistent": {h: mpm_case(h, mass="consistent") for h in consistent_h},
         "fem_consistent": {h: fem_case(h, "consistent") for h in hs},
         "fem_lumped": {h: fem_case(h, "lumped") for h in hs},
+        "fv": {h: fv_case(h) for h in hs},
         "ppc": {(h, n): mpm_case(h, ppc=n) if n != MPM["ppc"] else mpm_case(h) for h in ppc_h for n in PPC},
         "plateau": {(h, name): mpm_case(h, **change) if change else mpm_case(h)
                     for h in plateau_h for name, change in PLATEAU_VARIANTS.items()},
@@ -202,7 +219,7 @@ def run(options: StudyOptions) -> None:
     plan = _plan(options.quick)
     got = options.sweep_plan(NAME, run_case, plan, cost=_cost)
     folder = options.folder(NAME)
-    settings = {"mpm": MPM, "fem": FEM, "region_half_width": REGION_HALF_WIDTH, "T": 0.2,
+    settings = {"mpm": MPM, "fem": FEM, "fv": {"cfl": FV_CFL, "scheme": "MUSCL-Hancock + HLLC"}, "region_half_width": REGION_HALF_WIDTH, "T": 0.2,
                 "quick": options.quick, "problem": sod.SodSettings().as_dict()}
     _convergence(folder, got, settings)
     _regions(folder, got, settings)
@@ -233,6 +250,7 @@ def _convergence(folder, got, settings) -> None:
         "particles_L2": [d(r, "particles", "L2") for r in mpm],
         "fem_consistent_L1": [d(got["fem_consistent"][h], "nodes", "L1") for h in hs],
         "fem_lumped_L1": [d(got["fem_lumped"][h], "nodes", "L1") for h in hs],
+        "fv_L1": [d(got["fv"][h], "cells", "L1") for h in hs],
     }
     orders = {k: _orders(hs, v) for k, v in cols.items()}
     src_orders = {n: _orders(hs, [SOURCE[h][i] for h in hs]) for i, n in enumerate(("L1", "L2"))}
@@ -251,6 +269,7 @@ def _convergence(folder, got, settings) -> None:
             "mpm_particles_L2": cols["particles_L2"][k], "ratio_particles_L2": cols["particles_L2"][k] / s2,
             "fem_consistent_L1": cols["fem_consistent_L1"][k], "order_fem_consistent_L1": orders["fem_consistent_L1"][k],
             "fem_lumped_L1": cols["fem_lumped_L1"][k], "order_fem_lumped_L1": orders["fem_lumped_L1"][k],
+            "fv_L1": cols["fv_L1"][k], "order_fv_L1": orders["fv_L1"][k],
             "mpm_particles_mean_error_smooth": mpm[k]["mean_error"]["particles"][2] if mpm[k]["ok"] else "",
             "mpm_nodes_mean_error_smooth": mpm[k]["mean_error"]["nodes"][2] if mpm[k]["ok"] else "",
             "mpm_volume_drift": mpm[k].get("volume_drift", ""), "mpm_head_shift": mpm[k].get("head_shift", ""),
@@ -267,6 +286,7 @@ def _convergence(folder, got, settings) -> None:
         "MPM, particles": (hs, cols["particles_L1"], "s-"),
         "FEM consistent": (hs, cols["fem_consistent_L1"], "^--"),
         "FEM lumped": (hs, cols["fem_lumped_L1"], "v--"),
+        "FV (MUSCL-Hancock + HLLC)": (hs, cols["fv_L1"], "x-."),
     }
     cons = sorted(got["mpm_consistent"], reverse=True)
     if cons:
@@ -529,6 +549,13 @@ def claims(folder: Path) -> list[dict]:
                             f"{_f(ext[0], 'density_new_per_step'):.2g} (h = {ext[0]['h']}) to "
                             f"{_f(ext[-1], 'density_new_per_step'):.2g} (h = {ext[-1]['h']})"})
     out.append(_c3_claim(read_table(folder / "ppc.csv")))
+    if "fv_L1" in conv[0]:
+        first, last = conv[0], conv[-1]
+        out.append({"id": "E3", "verdict": "measured", "evidence": (
+            "density L1 on the same meshes (convergence.csv, profiles_h*.png): "
+            + "; ".join(f"h = {r['h']}: MPM nodes {_f(r, 'mpm_nodes_L1'):.3g}, FEM lumped {_f(r, 'fem_lumped_L1'):.3g}, "
+                        f"FEM consistent {_f(r, 'fem_consistent_L1'):.3g}, FV {_f(r, 'fv_L1'):.3g}" for r in (first, last))
+            + ". The fixed-mesh methods keep converging where MPM's nodal error levels off")})
     mass = read_table(folder / "mass.csv")
     cm = [_f(r, "mpm_consistent_over_lumped_nodes") for r in mass]
     cf = [_f(r, "fem_consistent_over_lumped") for r in mass]
@@ -563,14 +590,15 @@ def _report_lines(folder: Path) -> list[str]:
            f"MPM with one set of settings for every mesh: {MPM}. FEM: P1, SSPRK3, {FEM}. "
            "Density error at T = 0.2 against the exact Riemann solution.", "",
            "### C11: density error vs h, beside the source", "",
-           "| h | source L1 | MPM nodes L1 | ratio | order | source order | source L2 | MPM nodes L2 | ratio | MPM particles L1 | order | FEM cons. L1 | FEM lumped L1 |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "| h | source L1 | MPM nodes L1 | ratio | order | source order | source L2 | MPM nodes L2 | ratio | MPM particles L1 | order | FEM cons. L1 | FEM lumped L1 | FV L1 |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in conv:
         out.append("| " + " | ".join([r["h"], r["source_L1"], f"{_f(r, 'mpm_nodes_L1'):.4g}", f"{_f(r, 'ratio_nodes_L1'):.3f}",
                                       _o(r, "order_nodes_L1"), _o(r, "source_order_L1"), r["source_L2"],
                                       f"{_f(r, 'mpm_nodes_L2'):.4g}", f"{_f(r, 'ratio_nodes_L2'):.3f}",
                                       f"{_f(r, 'mpm_particles_L1'):.4g}", _o(r, "order_particles_L1"),
-                                      f"{_f(r, 'fem_consistent_L1'):.4g}", f"{_f(r, 'fem_lumped_L1'):.4g}"]) + " |")
+                                      f"{_f(r, 'fem_consistent_L1'):.4g}", f"{_f(r, 'fem_lumped_L1'):.4g}",
+                                      f"{_f(r, 'fv_L1'):.4g}" if "fv_L1" in r else ""]) + " |")
     c = _c11(conv)
     out += ["", f"**C11** (the density error stops converging): {c['verdict']}; {c['evidence']}.", ""]
     out += _floor_report(conv) + _regions_report(folder) + _extrema_report(folder) + _ppc_report(folder) + _mass_report(folder)
