@@ -208,6 +208,23 @@ def bspline_shape(grid: Grid, x: np.ndarray) -> Shape:
     return Shape(nodes, S, dS / h[0], grid.n_nodes, cell)
 
 
+def basis_integrals(grid: Grid, basis: str = "mpm") -> np.ndarray:
+    """``int S_i dx`` over the grid (n_nodes,), the weight that turns a nodal mass into a density.
+
+    P1 (and GIMP, whose averaged hats integrate like P1): the lumped mass of scikit-fem. The
+    B-spline: two-point Gauss rules on each half cell, exact for its piecewise quadratics (an end
+    node with its folded ghost integrates to ``25h/48``, its neighbour to ``47h/48``).
+    """
+    if basis in ("mpm", "gimp"):
+        return grid.lumped_mass
+    left, h = grid.nodes[:-1], grid.h
+    g = 0.5 + np.array([-1.0, 1.0]) / (2.0 * np.sqrt(3.0))  # Gauss points on [0, 1]
+    local = np.concatenate((0.5 * g, 0.5 + 0.5 * g))
+    x = (left[:, None] + h[:, None] * local).ravel()
+    weights = np.repeat(h / 4.0, local.size)
+    return make_shape(grid, x, basis=basis).scatter(weights)
+
+
 def make_shape(grid: Grid, x: np.ndarray, volume: np.ndarray | None = None, basis: str = "mpm") -> Shape:
     """``S_ip``, ``G_ip`` for the named basis: ``"mpm"`` (point mass), ``"gimp"`` or ``"bspline"``."""
     if basis == "mpm":

@@ -19,7 +19,7 @@ from tqdm.auto import tqdm
 from .exact_stages import ExactFields
 from .grid import Grid
 from .particles import Particles, PositivityError
-from .shape import make_shape
+from .shape import basis_integrals, make_shape
 from .step import Boundary, GridState, Model, Stages, explicit_step
 from .transfer import MASS_KINDS, grid_values, nodal_mass, nodal_momentum
 
@@ -67,11 +67,12 @@ class Result:
     nodal_velocity: np.ndarray = field(repr=False)
     dt_min: float = 0.0
     dt_max: float = 0.0
+    basis: str = "mpm"
 
     @property
     def nodal_density(self) -> np.ndarray:
-        """``m_i / int S_i dx``: the grid density seen by the projection."""
-        return self.nodal_mass / self.grid.lumped_mass
+        """``m_i / int S_i dx``: the grid density seen by the projection (``S_i`` of the run's basis)."""
+        return self.nodal_mass / basis_integrals(self.grid, self.basis)
 
 
 def project(grid: Grid, particles: Particles, stages: Stages) -> tuple[np.ndarray, np.ndarray]:
@@ -144,4 +145,5 @@ def run(
         nodal_velocity=v_i,
         dt_min=min(dts, default=0.0),
         dt_max=max(dts, default=0.0),
+        basis=stages.basis,
     )

@@ -146,3 +146,15 @@ def test_fast_uniform_cell_search_agrees_with_bisection_on_nodes_and_neighbours(
     expected = np.minimum(np.searchsorted(nodes, x, side="right") - 1, n_cells - 1)
     assert np.array_equal(cell, expected)
     assert xi.min() >= 0.0 and xi.max() <= 1.0
+
+
+@pytest.mark.parametrize("basis", ["mpm", "bspline"])
+def test_basis_integrals_sum_to_the_domain_length_and_match_the_ends(basis):
+    from mpm_fem.shape import basis_integrals
+
+    grid = uniform_grid(0.0, 1.0, 0.1)
+    w = basis_integrals(grid, basis)
+    assert abs(w.sum() - 1.0) < 1e-14
+    expected = [0.05, 0.1] if basis == "mpm" else [25 * 0.1 / 48, 47 * 0.1 / 48]
+    np.testing.assert_allclose([w[0], w[1]], expected, rtol=1e-13)
+    np.testing.assert_allclose(w[3:-3], 0.1, rtol=1e-13)
