@@ -2,7 +2,7 @@
 
 ``run_cases(fn, cases)`` calls the module-level function ``fn(case) -> dict`` on every case (a
 JSON-able dict of settings). Results are cached under ``cache_dir`` by a key made of ``fn``'s
-qualified name, the case, and a hash of the source code of ``mpm_fem`` and ``baselines``: a
+qualified name, the case, and a hash of the source code of ``mpm_fem``, ``baselines`` and ``studies``: a
 finished case is never recomputed while the code is unchanged, and a change to the code
 recomputes everything. Each result is written atomically (temporary file + rename), so a sweep that
 is interrupted resumes where it stopped and never reads a half-written result.
@@ -33,10 +33,10 @@ CaseFn = Callable[[dict], dict]
 
 @lru_cache(maxsize=1)
 def code_version() -> str:
-    """A hash of every ``.py`` file of the packages ``mpm_fem`` and ``baselines``."""
+    """A hash of every ``.py`` file of the packages ``mpm_fem``, ``baselines`` and ``studies``."""
     root = Path(__file__).resolve().parent.parent
     digest = hashlib.sha256()
-    for package in ("mpm_fem", "baselines"):
+    for package in ("mpm_fem", "baselines", "studies"):
         for path in sorted((root / package).rglob("*.py")):
             digest.update(str(path.relative_to(root)).encode())
             digest.update(path.read_bytes())
