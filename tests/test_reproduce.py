@@ -1,0 +1,60 @@
+"""``mpm-fem reproduce --quick`` regenerates the committed numbers of its subset.
+
+The committed ``figures/`` hold the output of ``mpm-fem reproduce --full``. The quick run shares a
+subset of its cases; every row of a quick table that has a partner in the committed table (same
+key columns) must carry the same numbers to the 6 significant digits the CSV files store
+(relative tolerance 1e-5). The runs are deterministic, so anything else is a change of result that
+was not committed.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mpm_fem.report import CLAIMS, reproduce
+from mpm_fem.study import StudyOptions, read_table
+
+FIGURES = Path(__file__).resolve().parent.parent / "figures"
+TABLES = {
+    "sod/convergence.csv": (("h",), ("mpm_nodes_L1", "mpm_particles_L1", "fem_lumped_L1", "fem_consistent_L1", "fv_L1")),
+    "burgers/errors.csv": (("solution", "method", "eps", "h"), ("particles_L1", "particles_max", "nodes_L1")),
+    "projection/errors.csv": (("quantity", "layout", "weights", "basis", "N_p", "h", "norm", "seeds"), ("value",)),
+    "budget/runs.csv": (("problem", "h", "basis", "variant"), ("field_L1", "particles_L1", "nodes_L1")),
+}
+RTOL = 1e-5
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    out = tmp_path_factory.mktemp("quick")
+    reproduce(StudyOptions(quick=True, out=out, jobs=2, progress=False))
+    return out
+
+
+def test_quick_report_covers_every_claim_and_says_it_is_quick(quick):
+    text = (quick / "REPORT.md").read_text()
+    assert "QUICK" in text
+    for claim in CLAIMS:
+        assert f"| {claim} |" in text, claim
+
+
+@pytest.mark.parametrize("table", TABLES)
+def test_quick_run_reproduces_the_committed_numbers(quick, table):
+    keys, values = TABLES[table]
+    committed = read_table(FIGURES / table)
+    index = {tuple(r[k] for k in keys): r for r in committed}
+    matched, differ = 0, []
+    for row in read_table(quick / table):
+        partner = index.get(tuple(row[k] for k in keys))
+        if partner is None:
+            continue
+        matched += 1
+        for column in values:
+            a, b = row.get(column, ""), partner.get(column, "")
+            if a == b:
+                continue
+            if a == "" or b == "" or not np.isclose(float(a), float(b), rtol=RTOL, atol=0):
+                differ.append(f"{dict(zip(keys, (row[k] for k in keys)))} {column}: quick {a}, committed {b}")
+    assert matched > 0, f"no row of the quick {table} is in the committed one"
+    assert not differ, f"{len(differ)} of {matched} rows differ, e.g. " + "; ".join(differ[:3])
