@@ -59,12 +59,13 @@ def claims_index(found: dict[str, list[dict]]) -> list[str]:
     lines = ["## Claims of the source and their verdicts", "", "| claim | statement | verdict | evidence | study |",
              "|---|---|---|---|---|"]
     for cid, statement in CLAIMS.items():
-        rows = [(name, c) for name, cs in found.items() for c in cs if c["id"] == cid]
+        rows = [(name, c) for name, cs in found.items() for c in cs if c["id"].split()[0] == cid]  # "E1 (sod)"
         if not rows:
             lines.append(f"| {cid} | {statement} | not measured | no study reports it yet | |")
         for name, c in rows:
             evidence = str(c.get("evidence", "")).replace("|", "/")
-            lines.append(f"| {cid} | {statement} | {c['verdict']} | {evidence} | [{name}](#{name}) |")
+            label = c["id"] if c["id"] != cid else cid
+            lines.append(f"| {label} | {statement} | {c['verdict']} | {evidence} | [{name}](#{name}) |")
     return lines + [""]
 
 
