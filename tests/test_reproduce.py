@@ -35,8 +35,8 @@ def quick(tmp_path_factory):
 def test_quick_report_covers_every_claim_and_says_it_is_quick(quick):
     text = (quick / "REPORT.md").read_text()
     assert "QUICK" in text
-    for claim in CLAIMS:
-        assert f"| {claim} |" in text, claim
+    for claim in CLAIMS:  # a claim measured per problem is listed as "| E1 (sod) |"
+        assert f"| {claim} |" in text or f"| {claim} (" in text, claim
 
 
 @pytest.mark.parametrize("table", TABLES)
