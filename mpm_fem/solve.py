@@ -17,6 +17,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from .exact_stages import ExactFields
+from .fused import FusedStep, check_kernel, supported
 from .grid import Grid
 from .particles import Particles, PositivityError
 from .shape import basis_integrals, make_shape
@@ -101,8 +102,19 @@ def run(
     progress: bool | None = None,
     observer: Observer | None = None,
     max_steps: int = 10_000_000,
+    kernel: str = "fused",
+    threads: int = 1,
 ) -> Result:
-    """Integrate to ``problem.T``. ``progress=None`` shows a bar on a terminal for runs over 2 s."""
+    """Integrate to ``problem.T``. ``progress=None`` shows a bar on a terminal for runs over 2 s.
+
+    ``kernel="fused"`` steps with the compiled :class:`~mpm_fem.fused.FusedStep` (on ``threads``
+    threads) wherever it supports the model and stages, the numpy :func:`explicit_step` otherwise;
+    ``kernel="numpy"`` always steps with :func:`explicit_step`. Both take the same steps (bit for
+    bit on one thread)."""
+    check_kernel(kernel, threads)
+    fused = None
+    if kernel == "fused" and supported(problem.model, stages) is None:
+        fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads)
     start = time.perf_counter()
     t, steps = 0.0, 0
     dts = []
@@ -111,20 +123,29 @@ def run(
                bar_format="{l_bar}{bar}| t={n:.4g}/{total:.4g} [{elapsed}<{remaining}]")
     try:
         while t < problem.T * (1 - 1e-12):
-            base = problem.model.stable_dt(particles, grid, problem.cfl) if problem.dt is None else problem.dt
+            if problem.dt is not None:
+                base = problem.dt
+            elif fused is not None and steps > 0 and problem.particle_boundary is None:
+                base = problem.model.dt_for_speed(fused.speed, grid, problem.cfl)  # max speed of the fused pass
+            else:
+                base = problem.model.stable_dt(particles, grid, problem.cfl)
             dt = min(base / stages.refine, problem.T - t)
             if not (dt > 0 and np.isfinite(dt)):
                 raise FloatingPointError(f"time step {dt!r} at step {steps} (t={t:.6g}) is not positive and finite")
             if steps >= max_steps:
                 raise RuntimeError(f"{max_steps} steps did not reach T={problem.T} (t={t:.6g})")
             try:
-                new, state = explicit_step(grid, particles, problem.model, problem.boundary, t, dt, stages,
-                                           problem.exact_acceleration, problem.exact)
+                if fused is not None:
+                    new, state = fused.step(particles, t, dt)
+                else:
+                    new, state = explicit_step(grid, particles, problem.model, problem.boundary, t, dt, stages,
+                                               problem.exact_acceleration, problem.exact)
             except PositivityError as err:
                 raise err.at(steps, t) from None
             if problem.particle_boundary is not None:
                 new = problem.particle_boundary(new, grid, t + dt)
-            _check_finite(new, steps, t)
+            if fused is None or problem.particle_boundary is not None or not fused.finite:
+                _check_finite(new, steps, t)
             if observer is not None:
                 observer(steps, t, particles, new, state)
             particles = new

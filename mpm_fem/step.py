@@ -75,9 +75,11 @@ class Stages:
 
 
 class Model(Protocol):
-    """A material: its stress, its state update and its stable time step."""
+    """A material: its stress, its state update and its stable time step. A model whose stress
+    ignores ``(dv/dx)_p`` sets ``stress_uses_gradient = False`` (the step then gathers none); a
+    model with ``force == "slides"`` gives the nodal acceleration itself (``grid_acceleration``)."""
 
-    def stress(self, particles: Particles, grad_v: np.ndarray) -> np.ndarray: ...
+    def stress(self, particles: Particles, grad_v: np.ndarray | None) -> np.ndarray: ...
 
     def update(self, particles: Particles, grad_v: np.ndarray, dt: float, cell_size: np.ndarray) -> Particles: ...
 
@@ -164,8 +166,11 @@ def explicit_step(
         if exact_acceleration is None:
             raise ValueError("this problem has no exact acceleration to use")
         a_i = exact_acceleration(grid.nodes, t)
+    elif getattr(model, "force", "weak") == "slides":
+        a_i = model.grid_acceleration(grid, shape.cell, v_i)
     else:
-        stress = model.stress(particles, shape.gather_gradient(v_i))
+        grad_v = shape.gather_gradient(v_i) if getattr(model, "stress_uses_gradient", True) else None
+        stress = model.stress(particles, grad_v)
         a_i = grid_values(shape, m, m_i, nodal_internal_force(shape, V, stress), stages.mass)
     a_i = boundary.acceleration(grid, a_i, v_i, t, dt)
     v_new = v_i + dt * a_i

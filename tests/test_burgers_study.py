@@ -1,9 +1,10 @@
-"""Viscous Burgers study (C13, C3, C15): the fast loop, the orders of convergence, the source's table.
+"""Viscous Burgers study (C13, C3, C15): the fused run, the orders of convergence, the source's table.
 
 The numbers asserted here are measured by ``studies/burgers.py`` on the full set of meshes; these
 fast tests run the coarse meshes of the same settings.
 """
 
+from dataclasses import replace
 from functools import lru_cache
 
 import numpy as np
@@ -11,7 +12,7 @@ import pytest
 
 from baselines import fem_burgers
 from baselines.exact.burgers import make_solution
-from mpm_fem.problems import burgers, burgers_fast
+from mpm_fem.problems import burgers
 from studies import burgers as study
 
 
@@ -27,29 +28,39 @@ def _by_position(result):
     {"mass": "consistent", "cfl": 0.3},
     {"solution": "cole_hopf", "eps": 0.02},
     {"acceleration": "exact", "dt_rule": "advective", "refine": 2},
+    {"weights": "cell", "force": "slides"},
 ])
-def test_fast_loop_is_the_general_step_to_round_off(changes):
-    """The fused loop and ``run(explicit_step)`` take the same steps: same particles to 1e-12."""
+def test_fused_run_is_the_numpy_step(changes):
+    """The fused kernel and ``run(explicit_step)`` take the same steps: the same particles bit for bit."""
     settings = burgers.BurgersSettings(h=0.02, **changes)
-    general = burgers.simulate_general(settings, progress=False)
-    fast = burgers_fast.simulate(settings, progress=False)
-    assert fast.steps == general.steps and fast.particles.n == general.particles.n
-    for a, b, name in zip(_by_position(general), _by_position(fast), ("x", "v", "V")):
-        gap = float(np.max(np.abs(a - b)))
-        assert gap < 1e-12, f"{name}: fast and general loops differ by {gap:.3g}"
-    gap = float(np.max(np.abs(general.nodal_velocity - fast.nodal_velocity)))
-    assert gap < 1e-12, f"nodal velocity differs by {gap:.3g}"
+    numpy_run = burgers.simulate(replace(settings, kernel="numpy"), progress=False)
+    fused = burgers.simulate(settings, progress=False)
+    assert fused.steps == numpy_run.steps and fused.particles.n == numpy_run.particles.n
+    for a, b, name in zip(_by_position(numpy_run), _by_position(fused), ("x", "v", "V")):
+        assert np.array_equal(a, b), f"{name}: fused and numpy runs differ by {float(np.max(np.abs(a - b))):.3g}"
+    assert np.array_equal(numpy_run.nodal_velocity, fused.nodal_velocity)
 
 
-def test_settings_and_loops_refuse_what_they_do_not_implement():
+def test_slides_weights_are_h_over_the_cell_count():
+    """weights 'cell': every particle of a cell weighs h / N_p^i after each step, whatever the flow did."""
+    settings = burgers.BurgersSettings(h=0.05, weights="cell", T=0.1)
+    result = burgers.simulate(settings, progress=False)
+    P, grid = result.particles, result.grid
+    cell = np.minimum(((P.x - grid.nodes[0]) / settings.h).astype(int), grid.n_cells - 1)
+    count = np.bincount(cell, minlength=grid.n_cells)
+    assert np.allclose(P.volume, settings.h / count[cell], rtol=1e-12)
+    assert np.allclose(np.bincount(cell, P.volume, grid.n_cells)[count > 0], settings.h, rtol=1e-12)
+
+
+def test_settings_refuse_what_they_do_not_implement():
     with pytest.raises(ValueError, match="only the exact acceleration"):
         burgers.BurgersSettings(h=0.02, dt_rule="advective")
     with pytest.raises(ValueError, match="unknown weights"):
         burgers.BurgersSettings(h=0.02, weights="mass")
-    with pytest.raises(ValueError, match="point mass"):
-        burgers_fast.simulate(burgers.BurgersSettings(h=0.02, basis="gimp"))
-    with pytest.raises(ValueError, match="USL only"):
-        burgers.simulate(burgers.BurgersSettings(h=0.02, basis="gimp", force="slides"))
+    with pytest.raises(ValueError, match="point-mass second difference"):
+        burgers.BurgersSettings(h=0.02, basis="gimp", force="slides")
+    with pytest.raises(ValueError, match="unknown kernel"):
+        burgers.BurgersSettings(h=0.02, kernel="cuda")
 
 
 # ---------------------------------------------------------------- C13: orders of the study's settings

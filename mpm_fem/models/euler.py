@@ -34,6 +34,8 @@ class IdealGas:
     av_linear: float = 0.5
     av_quadratic: float = 2.0
 
+    stress_uses_gradient = False  # sigma = -p: the step need not gather (dv/dx)_p for the stress
+
     def __post_init__(self):
         if not self.gamma > 1:
             raise ValueError(f"gamma must exceed 1, got {self.gamma}")
@@ -53,8 +55,8 @@ class IdealGas:
         jump = cell_size * np.minimum(grad_v, 0.0)
         return density * (self.av_quadratic * jump**2 + self.av_linear * self.sound_speed(energy) * np.abs(jump))
 
-    def stress(self, particles: Particles, grad_v: np.ndarray) -> np.ndarray:
-        """``sigma_p = -p_p`` (artificial viscosity included in ``p_p``)."""
+    def stress(self, particles: Particles, grad_v: np.ndarray | None) -> np.ndarray:
+        """``sigma_p = -p_p`` (artificial viscosity included in ``p_p``); ``grad_v`` is not used."""
         return -particles.pressure
 
     def update(self, particles: Particles, grad_v: np.ndarray, dt: float, cell_size: np.ndarray) -> Particles:
@@ -72,7 +74,14 @@ class IdealGas:
             volume=particles.mass / density,
         )
 
+    def max_speed(self, particles: Particles) -> float:
+        """``max_p (c_p + |v_p|)``, the signal speed of the time step."""
+        return float(np.max(self.sound_speed(particles.energy) + np.abs(particles.velocity)))
+
+    def dt_for_speed(self, speed: float, grid, cfl: float) -> float:
+        """``dt = CFL h_min / speed``."""
+        return cfl * float(grid.h.min()) / speed
+
     def stable_dt(self, particles: Particles, grid, cfl: float) -> float:
         """``dt = CFL h_min / max_p (c_p + |v_p|)``."""
-        speed = float(np.max(self.sound_speed(particles.energy) + np.abs(particles.velocity)))
-        return cfl * float(grid.h.min()) / speed
+        return self.dt_for_speed(self.max_speed(particles), grid, cfl)

@@ -10,13 +10,14 @@ does in every step. Particles leave through the ends; a reservoir outside each e
 particles in, spaced ``h / N_p`` like the initial layout, so that the domain never empties (the
 pitfall of STUDY.md).
 
-Besides the stage switches, three settings reach the slides' own forms (:mod:`.burgers_fast`,
-which runs point mass with USL; the general loop the rest): ``weights`` ``"volume"`` (the
-volumes ``V_p`` carried by the flow, standard MPM) or ``"cell"`` (the slides' ``m_ip = h/N_p^i``);
-``force`` ``"weak"`` (``a_i = F_i/m_i`` with ``F_i = -sum_p V_p eps (dv/dx)_p G_ip``) or
-``"slides"`` (their count-normalised second difference ``eps (v_{i+1} - 2 v_i + v_{i-1})/h^2``);
+Besides the stage switches, three settings reach the slides' own forms: ``weights`` ``"volume"``
+(the volumes ``V_p`` carried by the flow, standard MPM) or ``"cell"`` (the slides' ``m_ip =
+h/N_p^i``: every particle of cell ``I_i`` weighs ``h / N_p^i``, reset after every step); ``force``
+``"weak"`` (``a_i = F_i/m_i`` with ``F_i = -sum_p V_p eps (dv/dx)_p G_ip``) or ``"slides"`` (their
+count-normalised second difference ``eps (v_{i+1} - 2 v_i + v_{i-1})/h^2``, point mass only);
 ``dt_rule`` ``"stable"`` (``dt = CFL min(h/max|v|, h^2/(2 eps))``) or ``"advective"`` (``CFL
 h/max|v|``: no viscous limit, for the exact acceleration, which computes no viscous force).
+``kernel`` and ``threads`` choose the step's implementation (:func:`mpm_fem.solve.run`).
 """
 
 from __future__ import annotations
@@ -30,15 +31,16 @@ from baselines.exact import burgers as exact_burgers
 from ..errors import norms
 from ..exact_stages import SmoothBurgersFields
 from ..grid import Grid, uniform_grid
-from ..models.burgers import ViscousBurgers
+from ..fused import check_kernel
+from ..models.burgers import FORCES, ViscousBurgers
 from ..particles import Particles, make_particles, seed_positions
+from ..shape import locate
 from ..solve import Problem, Result, run
 from ..step import ACCELERATIONS, Dirichlet, Stages
-from . import burgers_fast, check_run_settings
+from . import check_run_settings
 
 
 WEIGHTS = ("volume", "cell")
-FORCES = ("weak", "slides")
 DT_RULES = ("stable", "advective")
 
 
@@ -64,6 +66,8 @@ class BurgersSettings:
     weights: str = "volume"
     force: str = "weak"
     dt_rule: str = "stable"
+    kernel: str = "fused"
+    threads: int = 1
 
     def __post_init__(self):
         if not (np.isfinite(self.eps) and self.eps > 0):
@@ -76,6 +80,9 @@ class BurgersSettings:
                 raise ValueError(f"unknown {name} {getattr(self, name)!r}; choose one of {', '.join(allowed)}")
         if self.dt_rule == "advective" and self.acceleration != "exact":
             raise ValueError("dt_rule 'advective' drops the viscous limit: only the exact acceleration may use it")
+        if self.force == "slides" and self.basis != "mpm":
+            raise ValueError(f"force 'slides' is the point-mass second difference; basis {self.basis!r} has none")
+        check_kernel(self.kernel, self.threads)
 
     @property
     def exact(self):
@@ -97,10 +104,13 @@ class Reservoir:
 
     A gap between an end and the nearest particle wider than ``spacing`` is filled with particles
     ``spacing`` apart, counted from that particle, carrying the exact velocity and volume ``spacing``.
+    With ``weights="cell"`` every particle then weighs ``h / N_p^i`` (volume and mass), the slides'
+    ``m_ip`` of its cell ``I_i``.
     """
 
     spacing: float
     velocity: object  # callable (x, t) -> v
+    weights: str = "volume"
 
     def __call__(self, particles: Particles, grid: Grid, t: float) -> Particles:
         a, b = grid.domain
@@ -117,11 +127,19 @@ class Reservoir:
             new.append(particles.x.min() - s * np.arange(k_left, 0, -1))
         if k_right > 0:
             new.append(particles.x.max() + s * np.arange(1, k_right + 1))
-        if not new:
-            return particles
-        x = np.concatenate(new)
-        fed = make_particles(x, s, 1.0, self.velocity(x, t))
-        return particles.join(fed)
+        if new:
+            x = np.concatenate(new)
+            particles = particles.join(make_particles(x, s, 1.0, self.velocity(x, t)))
+        if self.weights == "cell":
+            particles = with_cell_weights(particles, grid)
+        return particles
+
+
+def with_cell_weights(particles: Particles, grid: Grid) -> Particles:
+    """Unit-density particles whose volume and mass are ``h / N_p^i`` in their cell ``I_i``."""
+    cell, _ = locate(grid, particles.x)
+    w = float(grid.h.mean()) / np.bincount(cell, minlength=grid.n_cells)[cell]
+    return particles.replace(volume=w, mass=w.copy())
 
 
 def initial_particles(settings: BurgersSettings, grid: Grid) -> Particles:
@@ -136,32 +154,23 @@ def exact_fields(settings: BurgersSettings) -> SmoothBurgersFields:
 
 
 def simulate(settings: BurgersSettings = BurgersSettings(), progress: bool | None = None, observer=None) -> Result:
-    """Run MPM on viscous Burgers with ``settings``: the fused loop of :mod:`.burgers_fast` where it
-    applies (point mass, USL, MPM projection and interpolation; the same steps to round-off), the
-    general :func:`simulate_general` otherwise."""
-    if burgers_fast.supports(settings):
-        return burgers_fast.simulate(settings, progress, observer)
-    return simulate_general(settings, progress, observer)
-
-
-def simulate_general(settings: BurgersSettings = BurgersSettings(), progress: bool | None = None, observer=None) -> Result:
-    """Run MPM on viscous Burgers with ``settings`` through :func:`mpm_fem.solve.run` (any stages;
-    the standard ``weights`` and ``force`` only)."""
-    if settings.weights != "volume" or settings.force != "weak":
-        raise ValueError("weights 'cell' and force 'slides' are implemented for point mass with USL only "
-                         "(mpm_fem.problems.burgers_fast)")
+    """Run MPM on viscous Burgers with ``settings`` through :func:`mpm_fem.solve.run`."""
     solution = settings.exact
     grid = uniform_grid(*solution.domain, settings.h)
     problem = Problem(
-        model=ViscousBurgers(settings.eps, viscous_limit=settings.dt_rule == "stable"),
+        model=ViscousBurgers(settings.eps, viscous_limit=settings.dt_rule == "stable", force=settings.force),
         boundary=Dirichlet(solution.v),
         T=settings.T,
         cfl=settings.cfl,
         exact_acceleration=lambda x, t: settings.eps * solution.v_xx(x, t),
-        particle_boundary=Reservoir(settings.h / settings.ppc, solution.v),
+        particle_boundary=Reservoir(settings.h / settings.ppc, solution.v, settings.weights),
         exact=exact_fields(settings),
     )
-    return run(problem, grid, initial_particles(settings, grid), settings.stages, progress, observer)
+    particles = initial_particles(settings, grid)
+    if settings.weights == "cell":
+        particles = with_cell_weights(particles, grid)
+    return run(problem, grid, particles, settings.stages, progress, observer,
+               kernel=settings.kernel, threads=settings.threads)
 
 
 def errors(settings: BurgersSettings, result: Result) -> dict:

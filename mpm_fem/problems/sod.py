@@ -17,6 +17,7 @@ from baselines.exact import riemann
 
 from ..errors import norms
 from ..exact_stages import RiemannFields
+from ..fused import check_kernel
 from ..grid import uniform_grid
 from ..models.euler import IdealGas
 from ..particles import make_particles, seed_positions
@@ -49,9 +50,12 @@ class SodSettings:
     projection: str = "mpm"
     interpolation: str = "mpm"
     refine: int = 1
+    kernel: str = "fused"
+    threads: int = 1
 
     def __post_init__(self):
         check_run_settings(self, DOMAIN)
+        check_kernel(self.kernel, self.threads)
 
     @property
     def stages(self) -> Stages:
@@ -90,7 +94,8 @@ def simulate(settings: SodSettings = SodSettings(), progress: bool | None = None
     grid = uniform_grid(*DOMAIN, settings.h)
     model = IdealGas(settings.gamma, settings.av_linear, settings.av_quadratic)
     problem = Problem(model=model, boundary=Walls(), T=settings.T, cfl=settings.cfl, exact=exact_fields(settings))
-    return run(problem, grid, initial_particles(settings, grid), settings.stages, progress, observer)
+    return run(problem, grid, initial_particles(settings, grid), settings.stages, progress, observer,
+               kernel=settings.kernel, threads=settings.threads)
 
 
 def errors(settings: SodSettings, result: Result) -> dict:

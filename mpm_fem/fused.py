@@ -1,0 +1,527 @@
+"""The fused step: :func:`mpm_fem.step.explicit_step` compiled, in a few passes over the particles.
+
+The numpy step builds ``S_ip``, ``G_ip`` and makes about thirty array passes per step (scatters,
+gathers, the gas update). The same step compiled with numba does each particle's work in one
+loop body, so a step reads the particle state about twice (USL):
+
+    pass 1   S_ip, G_ip at x_p^n;  m_i, P_i (and, for the gas, F_i = sum_p V_p p_p G_ip)
+    grid     v_i = P_i / m_i (or M^{-1} P_i), a_i, v_i^{n+1}, boundary conditions (numpy)
+    pass 2   v_p += dt sum_i S_ip a_i;  x_p += dt sum_i S_ip v_i^{n+1};  L_p = sum_i G_ip v_i^{n+1};
+             the model's state update; max_p (c_p + |v_p|) for the next time step; the
+             positivity and finiteness checks
+
+(viscous Burgers, USF and MUSL add one pass each: the stress needs ``(dv/dx)_p`` before the force,
+and MUSL re-projects the momentum). Every sum is taken in the numpy step's order (particles in
+index order, a particle's nodes left to right) with the same operations, so the fused step equals
+:func:`~mpm_fem.step.explicit_step` bit for bit on one thread. The grid stage calls the same numpy
+functions as the numpy step (``divide_by_lumped``, ``solve_consistent``, the boundary objects), so
+any :class:`~mpm_fem.step.Boundary` and both mass kinds are supported.
+
+Threads (``threads > 1``): the particles are cut into ``threads`` contiguous chunks; each chunk
+scatters into its own grid buffer and the buffers are summed in chunk order. The result depends
+only on ``threads``, not on scheduling (deterministic), but the sums are grouped differently, so
+it equals the one-thread step to round-off, not bit for bit.
+
+Supported: the three bases (``"mpm"``, ``"gimp"``, ``"bspline"``), USL, USF, MUSL, lumped and
+consistent mass, calculated or exact acceleration, the ideal gas and viscous Burgers (both its
+forces). Stages with an exact projection, mass or interpolation run the numpy step
+(:func:`supported` says which), as does any ``kernel="numpy"`` run.
+"""
+
+from __future__ import annotations
+
+import types
+
+import numba
+import numpy as np
+from numba import njit, prange
+
+from .grid import Grid
+from .models.burgers import ViscousBurgers
+from .models.euler import IdealGas
+from .particles import Particles, PositivityError
+from .shape import BASES, Shape, make_shape
+from .step import SCHEMES, GridState, Stages
+from .transfer import divide_by_lumped, solve_consistent
+
+KERNELS = ("fused", "numpy")
+GAS, BURGERS = 0, 1
+_BASIS_CODE = {name: k for k, name in enumerate(BASES)}  # mpm 0, gimp 1, bspline 2
+
+
+def supported(model, stages: Stages) -> str | None:
+    """``None`` if the fused step implements this model and these stages, else the reason."""
+    if stages.uses_exact_fields:
+        return "the exact projection, mass and interpolation stages run the numpy step"
+    if not isinstance(model, (IdealGas, ViscousBurgers)):
+        return f"the fused step has no kernel for the model {type(model).__name__}"
+    return None
+
+
+def check_kernel(kernel: str, threads: int) -> None:
+    """Raise ``ValueError`` for an unknown kernel or a thread count that is not an integer >= 1."""
+    if kernel not in KERNELS:
+        raise ValueError(f"unknown kernel {kernel!r}; choose one of {', '.join(KERNELS)}")
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise ValueError(f"the number of threads must be an integer >= 1, got {threads!r}")
+
+
+# --------------------------------------------------------------------------- per-particle helpers
+# Each repeats the numpy arithmetic of mpm_fem.shape / mpm_fem.models operation for operation.
+
+@njit(cache=True, inline="always")
+def _locate(nodes, inv_spacing, x):
+    """:func:`mpm_fem.shape.locate` for one point (inside the grid): cell ``c`` and ``xi``."""
+    last = nodes.size - 2
+    if inv_spacing > 0.0:
+        c = int((x - nodes[0]) * inv_spacing)
+        c = min(max(c, 0), last)
+        if x < nodes[c] or (x >= nodes[c + 1] and c < last):
+            c = min(np.searchsorted(nodes, x, side="right") - 1, last)
+    else:
+        c = min(np.searchsorted(nodes, x, side="right") - 1, last)
+    x0 = nodes[c]
+    return c, (x - x0) / (nodes[c + 1] - x0)
+
+
+@njit(cache=True, inline="always")
+def _hat_and_integral(nodes, i, y):
+    """:func:`mpm_fem.shape._hat_and_integral` for node ``i`` at ``y``: ``S_i(y)``, ``int^y S_i``."""
+    n = nodes.size
+    xl = nodes[max(i - 1, 0)]
+    xc = nodes[i]
+    xr = nodes[min(i + 1, n - 1)]
+    hl, hr = xc - xl, xr - xc
+    yl = min(max(y, xl), xc)
+    yr = min(max(y, xc), xr)
+    left = (yl - xl) * (yl - xl) / (2 * hl) if hl > 0 else 0.0
+    right = (hr * hr - (xr - yr) * (xr - yr)) / (2 * hr) if hr > 0 else 0.0
+    value = ((y - xl) / hl if (y >= xl and y < xc and hl > 0) else 0.0) + (
+        (xr - y) / hr if (y >= xc and y <= xr and hr > 0) else 0.0)
+    if y == xc and hr == 0 and hl > 0:
+        value = 1.0
+    return value, left + right
+
+
+@njit(cache=True)
+def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
+    """``S_ip``, ``G_ip`` of one particle into ``row``, ``S``, ``G`` (length K); returns its cell and
+    the K it needs (GIMP: ``c_hi - c_lo + 2``; the caller reruns with that K if it differs)."""
+    n_nodes = nodes.size
+    K = row.size
+    if basis == 0:  # point mass: S = (1 - xi, xi), G = (-1, 1)/h_c
+        c, xi = _locate(nodes, inv_spacing, x)
+        inv_h = 1.0 / h[c]
+        row[0], row[1] = c, c + 1
+        S[0], S[1] = 1.0 - xi, xi
+        G[0], G[1] = -inv_h, inv_h
+        return c, 2
+    if basis == 2:  # quadratic B-spline at the nodes c-1 .. c+2, ghosts folded into the ends
+        c, xi = _locate(nodes, inv_spacing, x)
+        for k in range(4):
+            r = xi - (k - 1)
+            a = abs(r)
+            if a <= 0.5:
+                value, slope = 0.75 - r * r, -2.0 * r
+            elif a < 1.5:
+                value = 0.5 * ((1.5 - a) * (1.5 - a))
+                slope = -(1.5 - a) * (1.0 if r > 0 else (-1.0 if r < 0 else 0.0))
+            else:
+                value, slope = 0.0, 0.0
+            row[k] = min(max(c + k - 1, 0), n_nodes - 1)
+            S[k] = value
+            G[k] = slope / h[0]
+        return c, 4
+    # GIMP: hats averaged over [x - V/2, x + V/2], cut at the ends of the grid
+    a, b = nodes[0], nodes[n_nodes - 1]
+    c, _ = _locate(nodes, inv_spacing, x)
+    lo = max(x - 0.5 * V, a)
+    hi = min(x + 0.5 * V, b)
+    c_lo, _ = _locate(nodes, inv_spacing, lo)
+    c_hi, _ = _locate(nodes, inv_spacing, hi)
+    need = c_hi - c_lo + 2
+    length = hi - lo
+    previous = -1
+    for k in range(K):
+        i = min(c_lo + k, n_nodes - 1)
+        row[k] = i
+        if i == previous:
+            S[k], G[k] = 0.0, 0.0
+        else:
+            s_hi, phi_hi = _hat_and_integral(nodes, i, hi)
+            s_lo, phi_lo = _hat_and_integral(nodes, i, lo)
+            S[k] = (phi_hi - phi_lo) / length
+            G[k] = (s_hi - s_lo) / length
+        previous = i
+    return c, need
+
+
+@njit(cache=True, inline="always")
+def _gas_update(rho, e, p, m, L, dt, l, gm1, g_gm1, c_lin, c_quad):
+    """:meth:`IdealGas.update` of one particle: factor, rho, eps, p, V and the sound speed."""
+    factor = 1.0 - L * dt
+    density = rho * factor
+    energy = e - p / rho * L * dt
+    c = np.sqrt(g_gm1 * max(energy, 0.0))
+    jump = l * min(L, 0.0)
+    q = density * (c_quad * (jump * jump) + c_lin * c * abs(jump))
+    return factor, density, energy, gm1 * density * energy + q, m / density, c
+
+
+@njit(cache=True, inline="always")
+def _finite(a, b, c, d, e, f):
+    return (np.isfinite(a) and np.isfinite(b) and np.isfinite(c) and np.isfinite(d) and np.isfinite(e)
+            and np.isfinite(f))
+
+
+def _chunk(n, chunks, k):
+    return k * n // chunks, (k + 1) * n // chunks
+
+
+_chunk = njit(cache=True, inline="always")(_chunk)
+
+
+# --------------------------------------------------------------------------- the passes
+# Written once; compiled serial (threads = 1) and parallel (threads > 1, prange over the chunks).
+
+def _project(basis, nodes, h, inv_spacing, x, V, m, v, p, gas_force, chunks,
+             rows, S, G, cell, m_i, P_i, F_i, flags):
+    """Pass 1: the shape of every particle (stored), ``m_i``, ``P_i`` and, if ``gas_force``,
+    ``F_i = sum_p V_p p_p G_ip``. ``flags[k] = (first particle outside the grid, first with V <= 0,
+    the K it needs)`` of chunk k."""
+    n, K = x.size, rows.shape[1]
+    n_nodes = nodes.size
+    a, b = nodes[0], nodes[n_nodes - 1]
+    buf = np.zeros((chunks, 3, n_nodes))
+    for k in prange(chunks):
+        lo, hi = _chunk(n, chunks, k)
+        outside, empty, need = -1, -1, 0
+        for q in range(lo, hi):
+            if not (x[q] >= a and x[q] <= b):
+                if outside < 0:
+                    outside = q
+                continue
+            if basis == 1 and not (V[q] > 0):
+                if empty < 0:
+                    empty = q
+                continue
+            c, kq = _shape_row(basis, nodes, h, inv_spacing, x[q], V[q], rows[q], S[q], G[q])
+            cell[q] = c
+            need = max(need, kq)
+            mv = m[q] * v[q]
+            Vp = V[q] * p[q]
+            for j in range(K):
+                i = rows[q, j]
+                buf[k, 0, i] += S[q, j] * m[q]
+                buf[k, 1, i] += S[q, j] * mv
+                if gas_force:
+                    buf[k, 2, i] += G[q, j] * Vp
+        flags[k, 0], flags[k, 1], flags[k, 2] = outside, empty, need
+    for i in range(n_nodes):
+        m_i[i], P_i[i], F_i[i] = buf[0, 0, i], buf[0, 1, i], buf[0, 2, i]
+    for k in range(1, chunks):
+        for i in range(n_nodes):
+            m_i[i] += buf[k, 0, i]
+            P_i[i] += buf[k, 1, i]
+            F_i[i] += buf[k, 2, i]
+
+
+def _viscous_force(rows, G, v_i, V, eps, chunks, F_i):
+    """Burgers' stress before the force: ``F_i = - sum_p V_p eps (sum_j G_jp v_j) G_ip``."""
+    n, K = rows.shape
+    n_nodes = F_i.size
+    buf = np.zeros((chunks, n_nodes))
+    for k in prange(chunks):
+        lo, hi = _chunk(n, chunks, k)
+        for q in range(lo, hi):
+            L = G[q, 0] * v_i[rows[q, 0]]
+            for j in range(1, K):
+                L += G[q, j] * v_i[rows[q, j]]
+            w = V[q] * (eps * L)
+            for j in range(K):
+                buf[k, rows[q, j]] += G[q, j] * w
+    for i in range(n_nodes):
+        F_i[i] = -buf[0, i]
+    for k in range(1, chunks):
+        for i in range(n_nodes):
+            F_i[i] -= buf[k, i]
+
+
+def _update(model, rows, G, v_i, cell, h, x, V, m, rho, e, p, dt, consts, force, chunks,
+            V_new, m_new, rho_new, e_new, p_new, F_i, flags, values):
+    """The model's state update from ``L_p = sum_i G_ip v_i`` (USF before the force, MUSL after the
+    move), and for USF the force of the updated state into ``F_i``. ``flags[k] = (first particle
+    with factor <= 0, first with energy <= 0)``, ``values[k]`` their values."""
+    n, K = rows.shape
+    n_nodes = F_i.size
+    gm1, g_gm1, c_lin, c_quad, eps = consts[0], consts[1], consts[2], consts[3], consts[4]
+    buf = np.zeros((chunks, n_nodes))
+    for k in prange(chunks):
+        lo, hi = _chunk(n, chunks, k)
+        bad_f, bad_e, val_f, val_e = -1, -1, 0.0, 0.0
+        for q in range(lo, hi):
+            factor, w = 0.0, 0.0
+            L = G[q, 0] * v_i[rows[q, 0]]
+            for j in range(1, K):
+                L += G[q, j] * v_i[rows[q, j]]
+            if model == GAS:
+                factor, rho_new[q], e_new[q], p_new[q], V_new[q], _ = _gas_update(
+                    rho[q], e[q], p[q], m[q], L, dt, h[cell[q]], gm1, g_gm1, c_lin, c_quad)
+                w = V_new[q] * p_new[q]
+                if bad_e < 0 and not (e_new[q] > 0):
+                    bad_e, val_e = q, e_new[q]
+            else:
+                factor = 1.0 + L * dt
+                V_new[q] = V[q] * factor
+                m_new[q] = V_new[q]
+                w = -(V_new[q] * (eps * L))
+            if bad_f < 0 and not (factor > 0):
+                bad_f, val_f = q, factor
+            if force:
+                for j in range(K):
+                    buf[k, rows[q, j]] += G[q, j] * w
+        flags[k, 0], flags[k, 1] = bad_f, bad_e
+        values[k, 0], values[k, 1] = val_f, val_e
+    if force:
+        for i in range(n_nodes):
+            F_i[i] = buf[0, i]
+        for k in range(1, chunks):
+            for i in range(n_nodes):
+                F_i[i] += buf[k, i]
+
+
+def _move(model, rows, S, G, a_i, v_n, cell, h, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
+          x_new, v_new, V_new, m_new, rho_new, e_new, p_new, P_i, flags, values, speed):
+    """Pass 2: ``v_p += dt sum S a``, ``x_p += dt sum S v^{n+1}``; USL: the state update from
+    ``L_p = sum G v^{n+1}``; MUSL: ``P_i = sum_p m_p v_p^{n+1} S_ip``. ``speed[k]``: max of
+    ``c_p + |v_p|`` (gas) or ``|v_p|`` (Burgers) over chunk k; ``flags[k] = (first bad factor,
+    first bad energy, first non-finite particle)``."""
+    n, K = rows.shape
+    n_nodes = P_i.size
+    gm1, g_gm1, c_lin, c_quad, eps = consts[0], consts[1], consts[2], consts[3], consts[4]
+    buf = np.zeros((chunks if musl else 1, n_nodes))
+    for k in prange(chunks):
+        lo, hi = _chunk(n, chunks, k)
+        bad_f, bad_e, bad_n, val_f, val_e, top = -1, -1, -1, 0.0, 0.0, 0.0
+        for q in range(lo, hi):
+            factor, c = 0.0, 0.0
+            r0 = rows[q, 0]
+            acc = S[q, 0] * a_i[r0]
+            vel = S[q, 0] * v_n[r0]
+            for j in range(1, K):
+                acc += S[q, j] * a_i[rows[q, j]]
+                vel += S[q, j] * v_n[rows[q, j]]
+            v_new[q] = v[q] + dt * acc
+            x_new[q] = x[q] + dt * vel
+            if musl:
+                mv = m[q] * v_new[q]
+                for j in range(K):
+                    buf[k, rows[q, j]] += S[q, j] * mv
+                continue
+            if usl:
+                L = G[q, 0] * v_n[r0]
+                for j in range(1, K):
+                    L += G[q, j] * v_n[rows[q, j]]
+                if model == GAS:
+                    factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
+                        rho[q], e[q], p[q], m[q], L, dt, h[cell[q]], gm1, g_gm1, c_lin, c_quad)
+                    if bad_e < 0 and not (e_new[q] > 0):
+                        bad_e, val_e = q, e_new[q]
+                else:
+                    factor = 1.0 + L * dt
+                    V_new[q] = V[q] * factor
+                    m_new[q] = V_new[q]
+                if bad_f < 0 and not (factor > 0):
+                    bad_f, val_f = q, factor
+            if model == GAS:
+                if not usl:
+                    c = np.sqrt(g_gm1 * max(e_new[q], 0.0))
+                top = max(top, c + abs(v_new[q]))
+                ok = _finite(x_new[q], v_new[q], rho_new[q], e_new[q], p_new[q], V_new[q])
+            else:
+                top = max(top, abs(v_new[q]))
+                ok = _finite(x_new[q], v_new[q], V_new[q], 0.0, 0.0, 0.0)
+            if bad_n < 0 and not ok:
+                bad_n = q
+        flags[k, 0], flags[k, 1], flags[k, 2] = bad_f, bad_e, bad_n
+        values[k, 0], values[k, 1] = val_f, val_e
+        speed[k] = top
+    if musl:
+        for i in range(n_nodes):
+            P_i[i] = buf[0, i]
+        for k in range(1, chunks):
+            for i in range(n_nodes):
+                P_i[i] += buf[k, i]
+
+
+def _finish(model, rows, G, v_n, cell, h, V, m, v, rho, e, p, dt, consts, chunks,
+            V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed):
+    """MUSL's last pass: the state update from ``L_p = sum_i G_ip v_i^{n+1}`` (re-projected),
+    the speed and the checks, as in :func:`_move`."""
+    n, K = rows.shape
+    gm1, g_gm1, c_lin, c_quad = consts[0], consts[1], consts[2], consts[3]
+    for k in prange(chunks):
+        lo, hi = _chunk(n, chunks, k)
+        bad_f, bad_e, bad_n, val_f, val_e, top = -1, -1, -1, 0.0, 0.0, 0.0
+        for q in range(lo, hi):
+            factor, c = 0.0, 0.0
+            L = G[q, 0] * v_n[rows[q, 0]]
+            for j in range(1, K):
+                L += G[q, j] * v_n[rows[q, j]]
+            if model == GAS:
+                factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
+                    rho[q], e[q], p[q], m[q], L, dt, h[cell[q]], gm1, g_gm1, c_lin, c_quad)
+                if bad_e < 0 and not (e_new[q] > 0):
+                    bad_e, val_e = q, e_new[q]
+                top = max(top, c + abs(v[q]))
+                ok = _finite(x_new[q], v[q], rho_new[q], e_new[q], p_new[q], V_new[q])
+            else:
+                factor = 1.0 + L * dt
+                V_new[q] = V[q] * factor
+                m_new[q] = V_new[q]
+                top = max(top, abs(v[q]))
+                ok = _finite(x_new[q], v[q], V_new[q], 0.0, 0.0, 0.0)
+            if bad_f < 0 and not (factor > 0):
+                bad_f, val_f = q, factor
+            if bad_n < 0 and not ok:
+                bad_n = q
+        flags[k, 0], flags[k, 1], flags[k, 2] = bad_f, bad_e, bad_n
+        values[k, 0], values[k, 1] = val_f, val_e
+        speed[k] = top
+
+
+def _compile(fn, parallel):
+    """``fn`` compiled serial or parallel; distinct qualified names keep their caches apart."""
+    if parallel:
+        fn = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_parallel", fn.__defaults__)
+        fn.__qualname__ = fn.__name__
+    return njit(cache=True, parallel=parallel)(fn)
+
+
+_PASSES = {parallel: {fn.__name__: _compile(fn, parallel) for fn in (_project, _viscous_force, _update, _move, _finish)}
+           for parallel in (False, True)}
+
+
+# --------------------------------------------------------------------------- the step
+
+class FusedStep:
+    """The fused step of one run: ``step(particles, t, dt) -> (particles, GridState)``, as
+    :func:`~mpm_fem.step.explicit_step` (the same numbers on one thread). After each step
+    ``speed`` holds ``max_p (c_p + |v_p|)`` (gas) or ``max_p |v_p|`` (Burgers) of the new particles
+    and ``finite`` whether their state is finite, for the time step and the run's checks."""
+
+    def __init__(self, grid: Grid, model, boundary, stages: Stages = Stages(), exact_acceleration=None,
+                 threads: int = 1):
+        reason = supported(model, stages)
+        if reason is not None:
+            raise ValueError(reason)
+        check_kernel("fused", threads)
+        if stages.scheme not in SCHEMES:
+            raise ValueError(f"unknown scheme {stages.scheme!r}")
+        self.grid, self.model, self.boundary, self.stages = grid, model, boundary, stages
+        self.exact_acceleration = exact_acceleration
+        self.threads = int(threads)
+        self.passes = _PASSES[self.threads > 1]
+        self.kind = GAS if isinstance(model, IdealGas) else BURGERS
+        self.basis = _BASIS_CODE[stages.basis]
+        if stages.basis == "bspline":
+            make_shape(grid, grid.nodes[:1], basis="bspline")  # raises on a non-uniform grid
+        self.nodes = np.ascontiguousarray(grid.nodes, dtype=float)
+        self.h = np.ascontiguousarray(grid.h, dtype=float)
+        self.inv_spacing = 1.0 / grid.uniform_spacing if grid.uniform_spacing is not None else 0.0
+        if self.kind == GAS:
+            g = model.gamma
+            self.consts = np.array([g - 1.0, g * (g - 1.0), model.av_linear, model.av_quadratic, 0.0])
+        else:
+            self.consts = np.array([0.0, 0.0, 0.0, 0.0, model.eps])
+        self.slides = self.kind == BURGERS and getattr(model, "force", "weak") == "slides"
+        self.K = {"mpm": 2, "bspline": 4, "gimp": 3}[stages.basis]
+        self.speed, self.finite = np.nan, True
+
+    def _solve(self, shape, mass, m_i, rhs):
+        if self.stages.mass == "lumped":
+            return divide_by_lumped(rhs, m_i)
+        return solve_consistent(shape, mass, rhs)
+
+    def _positivity(self, flags, values, x):
+        """Raise :class:`PositivityError` as the numpy model would (factor first, then energy)."""
+        name = "1 - (dv/dx) dt" if self.kind == GAS else "1 + (dv/dx) dt"
+        for col, quantity in ((0, name), (1, "internal energy")):
+            for k in range(flags.shape[0]):
+                q = int(flags[k, col])
+                if q >= 0:
+                    raise PositivityError(quantity, q, float(x[q]), float(values[k, col]))
+
+    def step(self, particles: Particles, t: float, dt: float) -> tuple[Particles, GridState]:
+        grid, P = self.grid, self.passes
+        n, chunks = particles.n, max(1, min(self.threads, particles.n))
+        x, V, m, v = particles.x, particles.volume, particles.mass, particles.velocity
+        rho, e, p = particles.density, particles.energy, particles.pressure
+        gas = self.kind == GAS
+        scheme, exact = self.stages.scheme, self.stages.acceleration == "exact"
+        gas_force = gas and scheme != "usf" and not exact
+        n_nodes = grid.n_nodes
+        m_i, P_i, F_i = np.empty(n_nodes), np.empty(n_nodes), np.empty(n_nodes)
+        flags = np.empty((chunks, 3), np.int64)
+        while True:
+            rows, S, G = np.empty((n, self.K), np.intp), np.empty((n, self.K)), np.empty((n, self.K))
+            cell = np.empty(n, np.intp)
+            P["_project"](self.basis, self.nodes, self.h, self.inv_spacing, x, V, m, v, p, gas_force, chunks,
+                          rows, S, G, cell, m_i, P_i, F_i, flags)
+            if (flags[:, :2] >= 0).any():
+                make_shape(grid, x, V, self.stages.basis)  # raises the numpy step's error
+                raise ValueError("a particle lies outside the grid or has no volume")  # not reached
+            need = int(flags[:, 2].max(initial=2))
+            if self.basis != 1 or need == self.K or n == 0:
+                break
+            self.K = need  # GIMP: a particle domain spans another cell; redo with the wider rows
+        shape = Shape(rows, S, G, n_nodes, cell)
+        v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
+
+        V_new, m_new = np.empty(n), (np.empty(n) if not gas else m)
+        rho_new, e_new, p_new = (np.empty(n), np.empty(n), np.empty(n)) if gas else (rho, e, p)
+        values = np.zeros((chunks, 2))
+        if scheme == "usf":
+            upd = np.empty((chunks, 2), np.int64)
+            P["_update"](self.kind, rows, G, v_i, cell, self.h, x, V, m, rho, e, p, dt, self.consts,
+                         not exact and not self.slides, chunks, V_new, m_new, rho_new, e_new, p_new, F_i, upd, values)
+            if (upd >= 0).any():
+                self._positivity(upd, values, x)
+        elif not gas and not exact and not self.slides:
+            P["_viscous_force"](rows, G, v_i, V, self.consts[4], chunks, F_i)
+        if exact:
+            if self.exact_acceleration is None:
+                raise ValueError("this problem has no exact acceleration to use")
+            a_i = self.exact_acceleration(grid.nodes, t)
+        elif self.slides:
+            a_i = self.model.grid_acceleration(grid, cell, v_i)
+        else:
+            a_i = self._solve(shape, m, m_i, F_i)
+        a_i = self.boundary.acceleration(grid, a_i, v_i, t, dt)
+        v_n = v_i + dt * a_i
+
+        x_new, vel_new = np.empty(n), np.empty(n)
+        speed = np.empty(chunks)
+        usl, musl = scheme == "usl", scheme == "musl"
+        if scheme == "usf":  # the state is updated already: the move reads it
+            rho_m, e_m, p_m, V_m, m_m = rho_new, e_new, p_new, V_new, m_new
+        else:
+            rho_m, e_m, p_m, V_m, m_m = rho, e, p, V, m
+        P_musl = np.empty(n_nodes)
+        P["_move"](self.kind, rows, S, G, a_i, v_n, cell, self.h, x, V_m, m, v, rho_m, e_m, p_m, dt,
+                   self.consts, usl, musl, chunks, x_new, vel_new,
+                   V_new if usl else V_m, m_new if usl else m_m,
+                   rho_new if usl else rho_m, e_new if usl else e_m, p_new if usl else p_m,
+                   P_musl, flags, values, speed)
+        if musl:
+            v_n = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_musl), t + dt)
+            P["_finish"](self.kind, rows, G, v_n, cell, self.h, V, m, vel_new, rho, e, p, dt, self.consts,
+                         chunks, V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed)
+        if usl or musl:
+            if (flags[:, :2] >= 0).any():
+                self._positivity(flags[:, :2], values, x_new)
+        self.speed = float(speed.max())
+        self.finite = bool((flags[:, 2] < 0).all())
+        new = Particles(x=x_new, volume=V_new, mass=m_new, velocity=vel_new, density=rho_new, energy=e_new,
+                        pressure=p_new)
+        return new, GridState(m_i, v_i, a_i, v_n)
