@@ -1,0 +1,195 @@
+"""The fused compiled step (mpm_fem.fused) against the numpy step it compiles (mpm_fem.step).
+
+Every combination of basis, scheme, mass, model and boundary runs 1,000 steps through
+``solve.run`` twice, ``kernel="numpy"`` and ``kernel="fused"``: the particle states must agree bit
+for bit (the kernel keeps the numpy step's arithmetic order). Threads group the sums differently:
+equal to round-off, and the same on every run. The checks of a run (positivity, finiteness,
+particles outside the grid) raise the same errors from both paths.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from mpm_fem.fused import FusedStep, supported
+from mpm_fem.grid import uniform_grid
+from mpm_fem.models.burgers import ViscousBurgers
+from mpm_fem.models.euler import IdealGas
+from mpm_fem.particles import PositivityError, make_particles, seed_positions
+from mpm_fem.problems.burgers import Reservoir
+from mpm_fem.problems.sod import SodSettings, simulate
+from mpm_fem.shape import OutsideGridError
+from mpm_fem.solve import Problem, run
+from mpm_fem.step import Dirichlet, Stages, Walls
+
+FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
+STEPS = 1000
+GRID = uniform_grid(0.0, 1.0, 0.1)
+
+
+def _seed(seed, regular):
+    """Four jittered particles per cell, or regular ones (a B-spline particle close to a wall can
+    cross it: the wall holds the node, not the particle; the regular layout keeps h/8 away)."""
+    return seed_positions(GRID, 4, "regular" if regular else "jittered", seed=seed)
+
+
+def _gas_particles(walls):
+    """A smooth acoustic wave: density, velocity and pressure perturbed by a sine."""
+    x, V = _seed(3, walls)
+    rho = 1.0 + 0.1 * np.sin(2 * np.pi * x)
+    p = rho**1.4
+    return make_particles(x, V, rho, 0.05 * np.sin(np.pi * x), p / (0.4 * rho), p)
+
+
+def _burgers_particles(walls):
+    x, V = _seed(4, walls)
+    return make_particles(x, V, 1.0, 0.3 + 0.2 * np.sin(2 * np.pi * x))
+
+
+def _burgers_inflow(x, t):
+    return 0.3 + 0.1 * np.sin(3.0 * t) + 0.0 * x
+
+
+def _case(model, boundary, steps=STEPS, basis="mpm"):
+    """(problem, particles) of ``steps`` fixed steps for the model and boundary named."""
+    walls = boundary == "walls" and basis == "bspline"
+    if model == "gas":
+        problem = dict(model=IdealGas(), T=steps * 1e-3, cfl=1.0, dt=1e-3)
+        particles = _gas_particles(walls)
+        g = lambda x, t: 0.02 * np.sin(5.0 * t) + 0.0 * x  # noqa: E731 (a small piston at both ends)
+    else:
+        problem = dict(model=ViscousBurgers(0.01), T=steps * 5e-4, cfl=1.0, dt=5e-4)
+        particles = _burgers_particles(walls)
+        g = _burgers_inflow
+    if boundary == "walls":
+        return Problem(boundary=Walls(), **problem), particles
+    inflow = Reservoir(0.025, g) if model == "burgers" else None
+    return Problem(boundary=Dirichlet(g), particle_boundary=inflow, **problem), particles
+
+
+def _assert_same(a, b):
+    assert a.steps == b.steps and a.particles.n == b.particles.n
+    for name in FIELDS:
+        u, v = getattr(a.particles, name), getattr(b.particles, name)
+        assert np.array_equal(u, v), f"{name} differs by {float(np.max(np.abs(u - v))):.3g}"
+    assert np.array_equal(a.nodal_mass, b.nodal_mass) and np.array_equal(a.nodal_velocity, b.nodal_velocity)
+
+
+def _compare(basis, scheme, mass, model, boundary, steps):
+    problem, particles = _case(model, boundary, steps, basis)
+    stages = Stages(basis=basis, scheme=scheme, mass=mass)
+    reference = run(problem, GRID, particles, stages, progress=False, kernel="numpy")
+    fused = run(problem, GRID, particles, stages, progress=False, kernel="fused")
+    assert reference.steps >= steps
+    _assert_same(reference, fused)
+    assert not np.array_equal(fused.particles.x[:10], particles.x[:10])  # the particles did move
+
+
+COMBINATIONS = pytest.mark.parametrize(("basis", "scheme", "model", "boundary"), [
+    (basis, scheme, model, boundary) for basis in ("mpm", "gimp", "bspline") for scheme in ("usl", "usf", "musl")
+    for model in ("gas", "burgers") for boundary in ("walls", "dirichlet")])
+
+
+@COMBINATIONS
+@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+def test_fused_equals_the_numpy_step_bit_for_bit(basis, scheme, mass, model, boundary):
+    """1,000 steps with the lumped mass; 100 with the consistent mass (its sparse solve is slow in
+    both paths: the 1,000-step runs are the slow test below)."""
+    _compare(basis, scheme, mass, model, boundary, STEPS if mass == "lumped" else 100)
+
+
+@pytest.mark.slow
+@COMBINATIONS
+def test_fused_equals_the_numpy_step_over_1000_steps_with_the_consistent_mass(basis, scheme, model, boundary):
+    _compare(basis, scheme, "consistent", model, boundary, STEPS)
+
+
+@pytest.mark.parametrize("model", ["gas", "burgers"])
+@pytest.mark.parametrize("acceleration", ["exact"])
+def test_fused_exact_acceleration_and_slides_force(model, acceleration):
+    """The exact nodal acceleration and the slides' second difference, through both paths."""
+    problem, particles = _case(model, "walls")
+    stages = Stages(acceleration=acceleration)
+    exact = lambda x, t: np.cos(x + t)  # noqa: E731 (any nodal field will do)
+    problem = Problem(model=problem.model, boundary=problem.boundary, T=problem.T, cfl=1.0, dt=problem.dt,
+                      exact_acceleration=exact)
+    _assert_same(run(problem, GRID, particles, stages, progress=False, kernel="numpy"),
+                 run(problem, GRID, particles, stages, progress=False, kernel="fused"))
+    if model == "burgers":
+        slides = Problem(model=ViscousBurgers(0.01, force="slides"), boundary=Walls(), T=problem.T, cfl=1.0,
+                         dt=problem.dt)
+        _assert_same(run(slides, GRID, particles, progress=False, kernel="numpy"),
+                     run(slides, GRID, particles, progress=False, kernel="fused"))
+
+
+@pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline"])
+def test_threads_agree_to_round_off_and_repeat_exactly(basis):
+    """Two threads sum the grid in two chunks: within 1e-12 of one thread, identical run to run."""
+    settings = SodSettings(h=0.01, ppc=4, T=0.02, basis=basis)
+    one = simulate(settings, progress=False)
+    two = simulate(SodSettings(h=0.01, ppc=4, T=0.02, basis=basis, threads=2), progress=False)
+    again = simulate(SodSettings(h=0.01, ppc=4, T=0.02, basis=basis, threads=2), progress=False)
+    assert one.steps == two.steps
+    for name in FIELDS:
+        u, v = getattr(one.particles, name), getattr(two.particles, name)
+        scale = float(np.max(np.abs(u)))
+        assert float(np.max(np.abs(u - v))) <= 1e-12 * scale, name
+        assert np.array_equal(v, getattr(again.particles, name)), f"{name} changes from run to run"
+
+
+def _error(fn):
+    try:
+        fn()
+    except Exception as err:  # noqa: BLE001 (the test compares what each path raises)
+        return err
+    raise AssertionError("no error raised")
+
+
+def test_positivity_loss_raises_the_same_error_from_both_paths():
+    settings = SodSettings(h=0.05, ppc=4, T=0.2, cfl=1.0, mass="consistent")
+    errors = [_error(lambda k=k: simulate(SodSettings(**{**settings.as_dict(), "kernel": k}), progress=False))
+              for k in ("numpy", "fused")]
+    assert all(isinstance(e, PositivityError) for e in errors), errors
+    assert str(errors[0]) == str(errors[1])
+    e = errors[1]
+    assert e.step is not None and e.particle >= 0 and np.isfinite(e.x)
+    assert f"step {e.step}" in str(e) and f"particle {e.particle}" in str(e) and "reduce the CFL" in str(e)
+
+
+def test_non_finite_state_raises_the_same_error_from_both_paths():
+    """An energy whose pressure overflows: both paths name the step, the field and the particle."""
+    x, V = seed_positions(GRID, 2)
+    particles = make_particles(x, V, 10.0, 0.0, 1e308, 1.0)
+    problem = Problem(model=IdealGas(), boundary=Walls(), T=1.0, cfl=0.5)
+    with np.errstate(over="ignore"):
+        errors = [_error(lambda k=k: run(problem, GRID, particles, progress=False, kernel=k))
+                  for k in ("numpy", "fused")]
+    assert all(isinstance(e, FloatingPointError) for e in errors), errors
+    assert str(errors[0]) == str(errors[1]) and "non-finite pressure at step 0" in str(errors[1])
+
+
+def test_a_particle_outside_the_grid_raises_the_same_error():
+    x, V = seed_positions(GRID, 2)
+    x[5] = 1.5
+    particles = make_particles(x, V, 1.0, 0.0, 1.0, 0.4)
+    problem = Problem(model=IdealGas(), boundary=Walls(), T=1.0, cfl=0.5)
+    errors = [_error(lambda k=k: run(problem, GRID, particles, progress=False, kernel=k)) for k in ("numpy", "fused")]
+    assert all(isinstance(e, OutsideGridError) for e in errors) and str(errors[0]) == str(errors[1])
+    assert "particle 5 at x=1.5" in str(errors[1])
+
+
+def test_what_the_fused_step_refuses():
+    @dataclass(frozen=True)
+    class Elastic:
+        E: float = 1.0
+
+    assert supported(Elastic(), Stages()) is not None
+    assert supported(IdealGas(), Stages(projection="exact")) is not None
+    assert supported(IdealGas(), Stages(basis="gimp", scheme="musl", mass="consistent")) is None
+    with pytest.raises(ValueError, match="exact projection"):
+        FusedStep(GRID, IdealGas(), Walls(), Stages(interpolation="exact"))
+    with pytest.raises(ValueError, match="threads"):
+        SodSettings(threads=0)
+    with pytest.raises(ValueError, match="unknown kernel"):
+        SodSettings(kernel="gpu")
