@@ -103,7 +103,7 @@ def _hat_and_integral(nodes, i, y):
     return value, left + right
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
     """``S_ip``, ``G_ip`` of one particle into ``row``, ``S``, ``G`` (length K); returns its cell and
     the K it needs (GIMP: ``c_hi - c_lo + 2``; the caller reruns with that K if it differs)."""
@@ -184,12 +184,13 @@ _chunk = njit(cache=True, inline="always")(_chunk)
 # --------------------------------------------------------------------------- the passes
 # Written once; compiled serial (threads = 1) and parallel (threads > 1, prange over the chunks).
 
-def _project(basis, nodes, h, inv_spacing, x, V, m, v, p, gas_force, chunks,
+def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, chunks,
              rows, S, G, cell, m_i, P_i, F_i, flags):
     """Pass 1: the shape of every particle (stored), ``m_i``, ``P_i`` and, if ``gas_force``,
     ``F_i = sum_p V_p p_p G_ip``. ``flags[k] = (first particle outside the grid, first with V <= 0,
     the K it needs)`` of chunk k."""
-    n, K = x.size, rows.shape[1]
+    n = x.size
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     n_nodes = nodes.size
     a, b = nodes[0], nodes[n_nodes - 1]
     buf = np.zeros((chunks, 3, n_nodes))
@@ -201,11 +202,11 @@ def _project(basis, nodes, h, inv_spacing, x, V, m, v, p, gas_force, chunks,
                 if outside < 0:
                     outside = q
                 continue
-            if basis == 1 and not (V[q] > 0):
+            if BASIS == 1 and not (V[q] > 0):
                 if empty < 0:
                     empty = q
                 continue
-            c, kq = _shape_row(basis, nodes, h, inv_spacing, x[q], V[q], rows[q], S[q], G[q])
+            c, kq = _shape_row(BASIS, nodes, h, inv_spacing, x[q], V[q], rows[q], S[q], G[q])
             cell[q] = c
             need = max(need, kq)
             mv = m[q] * v[q]
@@ -228,7 +229,8 @@ def _project(basis, nodes, h, inv_spacing, x, V, m, v, p, gas_force, chunks,
 
 def _viscous_force(rows, G, v_i, V, eps, chunks, F_i):
     """Burgers' stress before the force: ``F_i = - sum_p V_p eps (sum_j G_jp v_j) G_ip``."""
-    n, K = rows.shape
+    n = rows.shape[0]
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     n_nodes = F_i.size
     buf = np.zeros((chunks, n_nodes))
     for k in prange(chunks):
@@ -247,12 +249,13 @@ def _viscous_force(rows, G, v_i, V, eps, chunks, F_i):
             F_i[i] -= buf[k, i]
 
 
-def _update(model, rows, G, v_i, cell, h, x, V, m, rho, e, p, dt, consts, force, chunks,
+def _update(rows, G, v_i, cell, h, x, V, m, rho, e, p, dt, consts, force, chunks,
             V_new, m_new, rho_new, e_new, p_new, F_i, flags, values):
     """The model's state update from ``L_p = sum_i G_ip v_i`` (USF before the force, MUSL after the
     move), and for USF the force of the updated state into ``F_i``. ``flags[k] = (first particle
     with factor <= 0, first with energy <= 0)``, ``values[k]`` their values."""
-    n, K = rows.shape
+    n = rows.shape[0]
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     n_nodes = F_i.size
     gm1, g_gm1, c_lin, c_quad, eps = consts[0], consts[1], consts[2], consts[3], consts[4]
     buf = np.zeros((chunks, n_nodes))
@@ -264,7 +267,7 @@ def _update(model, rows, G, v_i, cell, h, x, V, m, rho, e, p, dt, consts, force,
             L = G[q, 0] * v_i[rows[q, 0]]
             for j in range(1, K):
                 L += G[q, j] * v_i[rows[q, j]]
-            if model == GAS:
+            if MODEL == GAS:
                 factor, rho_new[q], e_new[q], p_new[q], V_new[q], _ = _gas_update(
                     rho[q], e[q], p[q], m[q], L, dt, h[cell[q]], gm1, g_gm1, c_lin, c_quad)
                 w = V_new[q] * p_new[q]
@@ -290,13 +293,14 @@ def _update(model, rows, G, v_i, cell, h, x, V, m, rho, e, p, dt, consts, force,
                 F_i[i] += buf[k, i]
 
 
-def _move(model, rows, S, G, a_i, v_n, cell, h, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
+def _move(rows, S, G, a_i, v_n, cell, h, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
           x_new, v_new, V_new, m_new, rho_new, e_new, p_new, P_i, flags, values, speed):
     """Pass 2: ``v_p += dt sum S a``, ``x_p += dt sum S v^{n+1}``; USL: the state update from
     ``L_p = sum G v^{n+1}``; MUSL: ``P_i = sum_p m_p v_p^{n+1} S_ip``. ``speed[k]``: max of
     ``c_p + |v_p|`` (gas) or ``|v_p|`` (Burgers) over chunk k; ``flags[k] = (first bad factor,
     first bad energy, first non-finite particle)``."""
-    n, K = rows.shape
+    n = rows.shape[0]
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     n_nodes = P_i.size
     gm1, g_gm1, c_lin, c_quad, eps = consts[0], consts[1], consts[2], consts[3], consts[4]
     buf = np.zeros((chunks if musl else 1, n_nodes))
@@ -322,7 +326,7 @@ def _move(model, rows, S, G, a_i, v_n, cell, h, x, V, m, v, rho, e, p, dt, const
                 L = G[q, 0] * v_n[r0]
                 for j in range(1, K):
                     L += G[q, j] * v_n[rows[q, j]]
-                if model == GAS:
+                if MODEL == GAS:
                     factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
                         rho[q], e[q], p[q], m[q], L, dt, h[cell[q]], gm1, g_gm1, c_lin, c_quad)
                     if bad_e < 0 and not (e_new[q] > 0):
@@ -333,7 +337,7 @@ def _move(model, rows, S, G, a_i, v_n, cell, h, x, V, m, v, rho, e, p, dt, const
                     m_new[q] = V_new[q]
                 if bad_f < 0 and not (factor > 0):
                     bad_f, val_f = q, factor
-            if model == GAS:
+            if MODEL == GAS:
                 if not usl:
                     c = np.sqrt(g_gm1 * max(e_new[q], 0.0))
                 top = max(top, c + abs(v_new[q]))
@@ -354,11 +358,12 @@ def _move(model, rows, S, G, a_i, v_n, cell, h, x, V, m, v, rho, e, p, dt, const
                 P_i[i] += buf[k, i]
 
 
-def _finish(model, rows, G, v_n, cell, h, V, m, v, rho, e, p, dt, consts, chunks,
+def _finish(rows, G, v_n, cell, h, V, m, v, rho, e, p, dt, consts, chunks,
             V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed):
     """MUSL's last pass: the state update from ``L_p = sum_i G_ip v_i^{n+1}`` (re-projected),
     the speed and the checks, as in :func:`_move`."""
-    n, K = rows.shape
+    n = rows.shape[0]
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     gm1, g_gm1, c_lin, c_quad = consts[0], consts[1], consts[2], consts[3]
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
@@ -368,7 +373,7 @@ def _finish(model, rows, G, v_n, cell, h, V, m, v, rho, e, p, dt, consts, chunks
             L = G[q, 0] * v_n[rows[q, 0]]
             for j in range(1, K):
                 L += G[q, j] * v_n[rows[q, j]]
-            if model == GAS:
+            if MODEL == GAS:
                 factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
                     rho[q], e[q], p[q], m[q], L, dt, h[cell[q]], gm1, g_gm1, c_lin, c_quad)
                 if bad_e < 0 and not (e_new[q] > 0):
@@ -390,16 +395,35 @@ def _finish(model, rows, G, v_n, cell, h, V, m, v, rho, e, p, dt, consts, chunks
         speed[k] = top
 
 
-def _compile(fn, parallel):
-    """``fn`` compiled serial or parallel; distinct qualified names keep their caches apart."""
-    if parallel:
-        fn = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_parallel", fn.__defaults__)
-        fn.__qualname__ = fn.__name__
-    return njit(cache=True, parallel=parallel)(fn)
+def _compile(fn, parallel, **constants):
+    """``fn`` compiled serial or parallel, with ``constants`` (``BASIS``, ``MODEL``) as compile-time
+    globals, so that the branches of the other bases and models drop out; each variant has its own
+    name, which keeps the on-disk caches apart."""
+    suffix = "".join(f"_{k.lower()}{v}" for k, v in constants.items()) + ("_parallel" if parallel else "")
+    scope = dict(fn.__globals__, **constants)
+    variant = types.FunctionType(fn.__code__, scope, fn.__name__ + suffix, fn.__defaults__)
+    variant.__qualname__ = variant.__name__
+    return njit(cache=True, parallel=parallel)(variant)
 
 
-_PASSES = {parallel: {fn.__name__: _compile(fn, parallel) for fn in (_project, _viscous_force, _update, _move, _finish)}
-           for parallel in (False, True)}
+BASIS, MODEL = 0, 0  # replaced per compiled variant
+
+
+class _Passes:
+    """The compiled passes, made on first use: ``project[basis]``, and the others per model."""
+
+    def __init__(self, parallel: bool):
+        self.parallel = parallel
+        self._made = {}
+
+    def get(self, fn, **constants):
+        key = (fn.__name__, tuple(sorted(constants.items())))
+        if key not in self._made:
+            self._made[key] = _compile(fn, self.parallel, **constants)
+        return self._made[key]
+
+
+_PASSES = {parallel: _Passes(parallel) for parallel in (False, True)}
 
 
 # --------------------------------------------------------------------------- the step
@@ -421,9 +445,13 @@ class FusedStep:
         self.grid, self.model, self.boundary, self.stages = grid, model, boundary, stages
         self.exact_acceleration = exact_acceleration
         self.threads = int(threads)
-        self.passes = _PASSES[self.threads > 1]
+        passes = _PASSES[self.threads > 1]
         self.kind = GAS if isinstance(model, IdealGas) else BURGERS
         self.basis = _BASIS_CODE[stages.basis]
+        self.project = passes.get(_project, BASIS=self.basis)
+        self.update, self.move, self.finish = (passes.get(fn, BASIS=self.basis, MODEL=self.kind)
+                                               for fn in (_update, _move, _finish))
+        self.viscous_force = passes.get(_viscous_force, BASIS=self.basis)
         if stages.basis == "bspline":
             make_shape(grid, grid.nodes[:1], basis="bspline")  # raises on a non-uniform grid
         self.nodes = np.ascontiguousarray(grid.nodes, dtype=float)
@@ -453,7 +481,7 @@ class FusedStep:
                     raise PositivityError(quantity, q, float(x[q]), float(values[k, col]))
 
     def step(self, particles: Particles, t: float, dt: float) -> tuple[Particles, GridState]:
-        grid, P = self.grid, self.passes
+        grid = self.grid
         n, chunks = particles.n, max(1, min(self.threads, particles.n))
         x, V, m, v = particles.x, particles.volume, particles.mass, particles.velocity
         rho, e, p = particles.density, particles.energy, particles.pressure
@@ -466,7 +494,7 @@ class FusedStep:
         while True:
             rows, S, G = np.empty((n, self.K), np.intp), np.empty((n, self.K)), np.empty((n, self.K))
             cell = np.empty(n, np.intp)
-            P["_project"](self.basis, self.nodes, self.h, self.inv_spacing, x, V, m, v, p, gas_force, chunks,
+            self.project(self.nodes, self.h, self.inv_spacing, x, V, m, v, p, gas_force, chunks,
                           rows, S, G, cell, m_i, P_i, F_i, flags)
             if (flags[:, :2] >= 0).any():
                 make_shape(grid, x, V, self.stages.basis)  # raises the numpy step's error
@@ -483,12 +511,12 @@ class FusedStep:
         values = np.zeros((chunks, 2))
         if scheme == "usf":
             upd = np.empty((chunks, 2), np.int64)
-            P["_update"](self.kind, rows, G, v_i, cell, self.h, x, V, m, rho, e, p, dt, self.consts,
+            self.update(rows, G, v_i, cell, self.h, x, V, m, rho, e, p, dt, self.consts,
                          not exact and not self.slides, chunks, V_new, m_new, rho_new, e_new, p_new, F_i, upd, values)
             if (upd >= 0).any():
                 self._positivity(upd, values, x)
         elif not gas and not exact and not self.slides:
-            P["_viscous_force"](rows, G, v_i, V, self.consts[4], chunks, F_i)
+            self.viscous_force(rows, G, v_i, V, self.consts[4], chunks, F_i)
         if exact:
             if self.exact_acceleration is None:
                 raise ValueError("this problem has no exact acceleration to use")
@@ -508,14 +536,14 @@ class FusedStep:
         else:
             rho_m, e_m, p_m, V_m, m_m = rho, e, p, V, m
         P_musl = np.empty(n_nodes)
-        P["_move"](self.kind, rows, S, G, a_i, v_n, cell, self.h, x, V_m, m, v, rho_m, e_m, p_m, dt,
+        self.move(rows, S, G, a_i, v_n, cell, self.h, x, V_m, m, v, rho_m, e_m, p_m, dt,
                    self.consts, usl, musl, chunks, x_new, vel_new,
                    V_new if usl else V_m, m_new if usl else m_m,
                    rho_new if usl else rho_m, e_new if usl else e_m, p_new if usl else p_m,
                    P_musl, flags, values, speed)
         if musl:
             v_n = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_musl), t + dt)
-            P["_finish"](self.kind, rows, G, v_n, cell, self.h, V, m, vel_new, rho, e, p, dt, self.consts,
+            self.finish(rows, G, v_n, cell, self.h, V, m, vel_new, rho, e, p, dt, self.consts,
                          chunks, V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed)
         if usl or musl:
             if (flags[:, :2] >= 0).any():
