@@ -1,93 +1,139 @@
-"""Cost of one MPM step of Sod's tube as the particle count grows.
+"""Cost of one MPM step of Sod's tube, numpy against fused, as the particle count grows.
 
-Reports, for n_p = 1e3 ... 1e6 (add --max 1e7 where memory allows):
-  * particle-steps per second of the full step (``mpm_fem.step.explicit_step``, USL, lumped);
-  * the ratio of the full step to the bare numpy transfers it needs, timed in the same run:
-    the three ``np.bincount`` scatters (mass, momentum, force) and the three gathers
-    (acceleration, velocity, velocity gradient) on the same particles;
-  * memory per particle: the particle state plus the peak allocated during one step (tracemalloc).
-and the log-log slope of time against n_p (1.0 = linear). Ratios, not wall times, are the result:
-the machines are shared and noisy. Usage: ``python benchmarks/step_cost.py [--max 1e6] [--repeat 5]``.
+One run reports, for each basis (point mass, GIMP, B-spline; USL, lumped mass, 4 particles per
+cell) at n_p = 1e3 ... 1e7:
+  * particle-steps per second of the numpy step (``mpm_fem.step.explicit_step``) and of the fused
+    step (``mpm_fem.fused.FusedStep``, one thread), and their ratio;
+  * the log-log slope of step time against n_p (n_p >= 1e4; 1.0 = linear);
+  * bytes per particle held by a run: the particle state plus the fused step's buffers;
+  * the machine's triad bandwidth (numpy ``a = b + s c`` on 2e7 doubles, counted as 24 B per
+    element as STREAM does) and the fused step as a fraction of the bound ``bandwidth / (bytes
+    moved per particle-step)``;
+  * the speed-up of ``threads=2`` over one thread (wall time).
+Times are the best of ``--repeat`` steps, as CPU time of this process (``time.process_time``):
+the machines are shared, and CPU time is what a loaded machine gives the step. Ratios in one run
+are the result. Usage: ``python benchmarks/step_cost.py [--max 1e7] [--repeat 3]``.
 """
 
 from __future__ import annotations
 
 import argparse
 import time
-import tracemalloc
 
 import numpy as np
 
-from mpm_fem.problems.sod import SodSettings, initial_particles
+from mpm_fem.fused import FusedStep
 from mpm_fem.grid import uniform_grid
 from mpm_fem.models.euler import IdealGas
+from mpm_fem.problems.sod import SodSettings, initial_particles
 from mpm_fem.step import Stages, Walls, explicit_step
 
-
-def bare_transfers(nodes, S, G, q, f, n_nodes):
-    """What any MPM step must do: 3 scatters and 3 gathers of the compact (n_p, 2) kernel."""
-    flat, n0, n1 = nodes.ravel(), nodes[:, 0], nodes[:, 1]
-    m = np.bincount(flat, (S * q[:, None]).ravel(), n_nodes)
-    P = np.bincount(flat, (S * (q * f[n0])[:, None]).ravel(), n_nodes)
-    F = np.bincount(flat, (G * q[:, None]).ravel(), n_nodes)
-    a = S[:, 0] * F[n0] + S[:, 1] * F[n1]
-    v = S[:, 0] * P[n0] + S[:, 1] * P[n1]
-    L = G[:, 0] * m[n0] + G[:, 1] * m[n1]
-    return a, v, L
+BASES = ("mpm", "gimp", "bspline")
+PPC = 4
+STATE_FIELDS = ("x", "volume", "mass", "velocity", "density", "energy", "pressure")
 
 
-def best_time(fn, repeat):
-    times = []
+def bytes_moved(basis: str) -> int:
+    """Bytes the fused USL gas step reads and writes per particle (write-allocate not counted).
+
+    Pass 1 reads x, V, m, v, p (40 B) and writes the cell (8 B); pass 2 reads x, v, rho, eps, p, m
+    (48 B) and writes x, v, rho, eps, p, V (48 B). GIMP also stores its rows (node index, S, G: 24 B
+    per node, 3 nodes) in pass 1 and reads them back in pass 2.
+    """
+    return 40 + 8 + 48 + 48 + (2 * 24 * 3 if basis == "gimp" else 0)
+
+
+def triad_bandwidth(n: int = 20_000_000, repeat: int = 5) -> float:
+    """STREAM triad ``a = b + s c`` with numpy (in place, no temporaries): bytes/s, 24 B per element."""
+    b, c, a = np.random.default_rng(0).random(n), np.random.default_rng(1).random(n), np.empty(n)
+    best = np.inf
     for _ in range(repeat):
         t0 = time.perf_counter()
+        np.multiply(c, 3.0, out=a)
+        np.add(a, b, out=a)
+        best = min(best, time.perf_counter() - t0)
+    return 24.0 * n / best
+
+
+def best_time(fn, repeat: int, clock=time.process_time) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = clock()
         fn()
-        times.append(time.perf_counter() - t0)
+        times.append(clock() - t0)
     return min(times)
 
 
-def measure(n_particles: int, repeat: int) -> dict:
-    ppc = 8
-    n_cells = max(2, n_particles // ppc)
+def setup(n_particles: int):
+    n_cells = max(2, n_particles // PPC)
     h = 1.0 / n_cells
-    settings = SodSettings(h=h, ppc=ppc)
     grid = uniform_grid(0.0, 1.0, h)
-    particles = initial_particles(settings, grid)
-    gas, walls, stages = IdealGas(), Walls(), Stages()
-    dt = 0.1 * gas.stable_dt(particles, grid, 1.0)
-    full = best_time(lambda: explicit_step(grid, particles, gas, walls, 0.0, dt, stages), repeat)
+    particles = initial_particles(SodSettings(h=h, ppc=PPC), grid)
+    gas = IdealGas()
+    return grid, particles, gas, 0.1 * gas.stable_dt(particles, grid, 1.0)
 
-    from mpm_fem.shape import point_shape
 
-    shape = point_shape(grid, particles.x)
-    f = np.ones(grid.n_nodes)
-    bare = best_time(lambda: bare_transfers(shape.nodes, shape.S, shape.G, particles.mass, f, grid.n_nodes), repeat)
-
-    tracemalloc.start()
-    explicit_step(grid, particles, gas, walls, 0.0, dt, stages)
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
+def measure(basis: str, n_particles: int, repeat: int, numpy_too: bool = True) -> dict:
+    grid, particles, gas, dt = setup(n_particles)
+    stages = Stages(basis=basis)
+    fused = FusedStep(grid, gas, Walls(), stages, reuse=True)
+    fused.step(particles, 0.0, dt)  # compile (or load the cache) and fill the buffers
+    fused_s = best_time(lambda: fused.step(particles, 0.0, dt), repeat)
+    numpy_s = best_time(lambda: explicit_step(grid, particles, gas, Walls(), 0.0, dt, stages),
+                        repeat if n_particles <= 10**6 else 1) if numpy_too else np.nan
     n = particles.n
-    state = sum(getattr(particles, name).nbytes for name in ("x", "volume", "mass", "velocity", "density", "energy", "pressure"))
-    return {"n_p": n, "full_s": full, "bare_s": bare, "ratio": full / bare, "rate": n / full,
-            "bytes_per_particle": (state + peak) / n}
+    held = sum(getattr(particles, f).nbytes for f in STATE_FIELDS)
+    held += sum(a.nbytes for pool in fused._pools for a in pool.values())
+    return {"basis": basis, "n_p": n, "numpy_s": numpy_s, "fused_s": fused_s,
+            "numpy_rate": n / numpy_s, "fused_rate": n / fused_s, "bytes_per_particle": held / n}
+
+
+def threads_ratio(basis: str, n_particles: int, repeat: int) -> float:
+    """Wall time of the one-thread step over the two-thread step."""
+    grid, particles, gas, dt = setup(n_particles)
+    steps = [FusedStep(grid, gas, Walls(), Stages(basis=basis), threads=k, reuse=True) for k in (1, 2)]
+    for s in steps:
+        s.step(particles, 0.0, dt)
+    one, two = (best_time(lambda s=s: s.step(particles, 0.0, dt), repeat, time.perf_counter) for s in steps)
+    return one / two
+
+
+def slope(rows, key):
+    n = np.array([r["n_p"] for r in rows], float)
+    t = np.array([r[key] for r in rows])
+    keep = (n >= 1e4) & np.isfinite(t)
+    return np.polyfit(np.log(n[keep]), np.log(t[keep]), 1)[0] if keep.sum() >= 2 else float("nan")
 
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--max", type=float, default=1e6, help="largest particle count (default 1e6)")
-    parser.add_argument("--repeat", type=int, default=5, help="timings per size; the best is kept")
+    parser.add_argument("--max", type=float, default=1e7, help="largest particle count (default 1e7)")
+    parser.add_argument("--repeat", type=int, default=3, help="timed steps per size; the best is kept")
     args = parser.parse_args(argv)
-    sizes = [int(10**k) for k in np.arange(3, np.log10(args.max) + 0.01, 0.5)]
-    rows = [measure(n, args.repeat if n <= 10**6 else 2) for n in sizes]
-    print("| particles | particle-steps/s | full step / bare transfers | bytes per particle (state + step peak) |")
-    print("|---:|---:|---:|---:|")
-    for r in rows:
-        print(f"| {r['n_p']:.0e} | {r['rate']:.3g} | {r['ratio']:.2f} | {r['bytes_per_particle']:.0f} |")
-    n = np.array([r["n_p"] for r in rows], float)
-    t = np.array([r["full_s"] for r in rows])
-    big = n >= 1e4  # below that, fixed per-call overhead dominates
-    slope = np.polyfit(np.log(n[big]), np.log(t[big]), 1)[0] if big.sum() >= 2 else float("nan")
-    print(f"\nlog-log slope of step time against n_p (n_p >= 1e4): {slope:.3f} (1.0 = linear)")
+    sizes = [int(10**k) for k in range(3, int(round(np.log10(args.max))) + 1)]
+    bandwidth = triad_bandwidth()
+    print(f"triad bandwidth (numpy a = b + s c, 24 B/element): {bandwidth / 1e9:.1f} GB/s\n")
+    print("| basis | particles | numpy particle-steps/s | fused particle-steps/s | fused / numpy | "
+          "bytes per particle (state + buffers) |")
+    print("|---|---:|---:|---:|---:|---:|")
+    summary = []
+    for basis in BASES:
+        rows = [measure(basis, n, args.repeat) for n in sizes]
+        for r in rows:
+            print(f"| {basis} | {r['n_p']:.0e} | {r['numpy_rate']:.3g} | {r['fused_rate']:.3g} | "
+                  f"{r['fused_rate'] / r['numpy_rate']:.1f} | {r['bytes_per_particle']:.0f} |")
+        at = next((r for r in rows if r["n_p"] == 10**6), rows[-1])
+        summary.append((basis, at, slope(rows, "fused_s"), slope(rows, "numpy_s")))
+    print("\n| basis | fused at 1e6, particle-steps/s | fused / numpy | slope fused | slope numpy | "
+          "bytes moved per particle-step | bandwidth bound, particle-steps/s | fraction of the bound | "
+          "2 threads / 1 thread |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for basis, at, s_fused, s_numpy in summary:
+        moved = bytes_moved(basis)
+        bound = bandwidth / moved
+        ratio = threads_ratio(basis, at["n_p"], args.repeat)
+        print(f"| {basis} | {at['fused_rate']:.3g} | {at['fused_rate'] / at['numpy_rate']:.1f} | {s_fused:.2f} | "
+              f"{s_numpy:.2f} | {moved} | {bound:.3g} | {at['fused_rate'] / bound:.2f} | {ratio:.2f} |")
 
 
 if __name__ == "__main__":

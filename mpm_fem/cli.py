@@ -24,7 +24,7 @@ from .shape import BASES
 from .step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, SCHEMES, STAGE_MASS
 
 CHOICES = {"mass": STAGE_MASS, "basis": BASES, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
-           "projection": PROJECTIONS, "interpolation": INTERPOLATIONS}
+           "projection": PROJECTIONS, "interpolation": INTERPOLATIONS, "kernel": ("fused", "numpy")}
 HELP = {
     "h": "cell size (must divide the domain)",
     "ppc": "particles per cell N_p",
@@ -37,6 +37,8 @@ HELP = {
     "projection": "particle-to-grid projection: MPM sums or exact integrals of the exact fields",
     "interpolation": "grid-to-particle interpolation: MPM sums or exact for the exact fields",
     "refine": "time stage: the time step divided by this integer",
+    "kernel": "step implementation: compiled fused passes, or the numpy reference step",
+    "threads": "threads of the fused step (deterministic; equal to one thread to round-off)",
     "basis": "particle basis: point mass (mpm), particle domain (gimp) or quadratic B-spline (bspline)",
     "scheme": "stress update order",
     "layout": "initial particle layout in each cell",

@@ -181,14 +181,29 @@ def _chunk(n, chunks, k):
 _chunk = njit(cache=True, inline="always")(_chunk)
 
 
-# --------------------------------------------------------------------------- the passes
-# Written once; compiled serial (threads = 1) and parallel (threads > 1, prange over the chunks).
+@njit(cache=True, inline="always")
+def _row(basis, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl):
+    """Particle q's nodes and weights into ``r``, ``Sl``, ``Gl``, and its cell: recomputed from
+    ``x_q^n`` (point mass, B-spline: the same numbers as pass 1, and cheaper than reading them back)
+    or read from pass 1's rows (GIMP)."""
+    if basis == 1:
+        for j in range(r.size):
+            r[j], Sl[j], Gl[j] = rows[q, j], S[q, j], G[q, j]
+        return cell[q]
+    c, _ = _shape_row(basis, nodes, h, inv_spacing, x[q], 0.0, r, Sl, Gl)
+    return c
 
-def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, chunks,
+
+# --------------------------------------------------------------------------- the passes
+# Written once; compiled per basis and model, serial (threads = 1) or parallel (threads > 1,
+# prange over the chunks). BASIS and MODEL are compile-time globals of each variant (_compile).
+
+def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
              rows, S, G, cell, m_i, P_i, F_i, flags):
-    """Pass 1: the shape of every particle (stored), ``m_i``, ``P_i`` and, if ``gas_force``,
-    ``F_i = sum_p V_p p_p G_ip``. ``flags[k] = (first particle outside the grid, first with V <= 0,
-    the K it needs)`` of chunk k."""
+    """Pass 1: the shape of every particle, ``m_i``, ``P_i`` and, if ``gas_force``, ``F_i = sum_p
+    V_p p_p G_ip``. The cells are stored; the rows ``rows``, ``S``, ``G`` only if ``store`` (the
+    consistent mass and GIMP need them). ``flags[k] = (first particle outside the grid, first
+    with V <= 0, the K it needs)`` of chunk k."""
     n = x.size
     K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     n_nodes = nodes.size
@@ -197,6 +212,7 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, chunks,
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
         outside, empty, need = -1, -1, 0
+        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
         for q in range(lo, hi):
             if not (x[q] >= a and x[q] <= b):
                 if outside < 0:
@@ -206,17 +222,20 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, chunks,
                 if empty < 0:
                     empty = q
                 continue
-            c, kq = _shape_row(BASIS, nodes, h, inv_spacing, x[q], V[q], rows[q], S[q], G[q])
+            c, kq = _shape_row(BASIS, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
             cell[q] = c
             need = max(need, kq)
+            if store:
+                for j in range(K):
+                    rows[q, j], S[q, j], G[q, j] = r[j], Sl[j], Gl[j]
             mv = m[q] * v[q]
             Vp = V[q] * p[q]
             for j in range(K):
-                i = rows[q, j]
-                buf[k, 0, i] += S[q, j] * m[q]
-                buf[k, 1, i] += S[q, j] * mv
+                i = r[j]
+                buf[k, 0, i] += Sl[j] * m[q]
+                buf[k, 1, i] += Sl[j] * mv
                 if gas_force:
-                    buf[k, 2, i] += G[q, j] * Vp
+                    buf[k, 2, i] += Gl[j] * Vp
         flags[k, 0], flags[k, 1], flags[k, 2] = outside, empty, need
     for i in range(n_nodes):
         m_i[i], P_i[i], F_i[i] = buf[0, 0, i], buf[0, 1, i], buf[0, 2, i]
@@ -227,21 +246,23 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, chunks,
             F_i[i] += buf[k, 2, i]
 
 
-def _viscous_force(rows, G, v_i, V, eps, chunks, F_i):
+def _viscous_force(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i):
     """Burgers' stress before the force: ``F_i = - sum_p V_p eps (sum_j G_jp v_j) G_ip``."""
-    n = rows.shape[0]
+    n = x.size
     K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     n_nodes = F_i.size
     buf = np.zeros((chunks, n_nodes))
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
+        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
         for q in range(lo, hi):
-            L = G[q, 0] * v_i[rows[q, 0]]
+            _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            L = Gl[0] * v_i[r[0]]
             for j in range(1, K):
-                L += G[q, j] * v_i[rows[q, j]]
+                L += Gl[j] * v_i[r[j]]
             w = V[q] * (eps * L)
             for j in range(K):
-                buf[k, rows[q, j]] += G[q, j] * w
+                buf[k, r[j]] += Gl[j] * w
     for i in range(n_nodes):
         F_i[i] = -buf[0, i]
     for k in range(1, chunks):
@@ -249,12 +270,12 @@ def _viscous_force(rows, G, v_i, V, eps, chunks, F_i):
             F_i[i] -= buf[k, i]
 
 
-def _update(rows, G, v_i, cell, h, x, V, m, rho, e, p, dt, consts, force, chunks,
+def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, force, chunks,
             V_new, m_new, rho_new, e_new, p_new, F_i, flags, values):
-    """The model's state update from ``L_p = sum_i G_ip v_i`` (USF before the force, MUSL after the
-    move), and for USF the force of the updated state into ``F_i``. ``flags[k] = (first particle
-    with factor <= 0, first with energy <= 0)``, ``values[k]`` their values."""
-    n = rows.shape[0]
+    """USF: the model's state update from ``L_p = sum_i G_ip v_i`` before the force, and the force
+    of the updated state into ``F_i`` (if ``force``). ``flags[k] = (first particle with factor <= 0,
+    first with energy <= 0)``, ``values[k]`` their values."""
+    n = x.size
     K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     n_nodes = F_i.size
     gm1, g_gm1, c_lin, c_quad, eps = consts[0], consts[1], consts[2], consts[3], consts[4]
@@ -262,14 +283,16 @@ def _update(rows, G, v_i, cell, h, x, V, m, rho, e, p, dt, consts, force, chunks
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
         bad_f, bad_e, val_f, val_e = -1, -1, 0.0, 0.0
+        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
         for q in range(lo, hi):
             factor, w = 0.0, 0.0
-            L = G[q, 0] * v_i[rows[q, 0]]
+            c = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            L = Gl[0] * v_i[r[0]]
             for j in range(1, K):
-                L += G[q, j] * v_i[rows[q, j]]
+                L += Gl[j] * v_i[r[j]]
             if MODEL == GAS:
                 factor, rho_new[q], e_new[q], p_new[q], V_new[q], _ = _gas_update(
-                    rho[q], e[q], p[q], m[q], L, dt, h[cell[q]], gm1, g_gm1, c_lin, c_quad)
+                    rho[q], e[q], p[q], m[q], L, dt, h[c], gm1, g_gm1, c_lin, c_quad)
                 w = V_new[q] * p_new[q]
                 if bad_e < 0 and not (e_new[q] > 0):
                     bad_e, val_e = q, e_new[q]
@@ -282,7 +305,7 @@ def _update(rows, G, v_i, cell, h, x, V, m, rho, e, p, dt, consts, force, chunks
                 bad_f, val_f = q, factor
             if force:
                 for j in range(K):
-                    buf[k, rows[q, j]] += G[q, j] * w
+                    buf[k, r[j]] += Gl[j] * w
         flags[k, 0], flags[k, 1] = bad_f, bad_e
         values[k, 0], values[k, 1] = val_f, val_e
     if force:
@@ -293,42 +316,43 @@ def _update(rows, G, v_i, cell, h, x, V, m, rho, e, p, dt, consts, force, chunks
                 F_i[i] += buf[k, i]
 
 
-def _move(rows, S, G, a_i, v_n, cell, h, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
+def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
           x_new, v_new, V_new, m_new, rho_new, e_new, p_new, P_i, flags, values, speed):
     """Pass 2: ``v_p += dt sum S a``, ``x_p += dt sum S v^{n+1}``; USL: the state update from
     ``L_p = sum G v^{n+1}``; MUSL: ``P_i = sum_p m_p v_p^{n+1} S_ip``. ``speed[k]``: max of
     ``c_p + |v_p|`` (gas) or ``|v_p|`` (Burgers) over chunk k; ``flags[k] = (first bad factor,
     first bad energy, first non-finite particle)``."""
-    n = rows.shape[0]
+    n = x.size
     K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     n_nodes = P_i.size
-    gm1, g_gm1, c_lin, c_quad, eps = consts[0], consts[1], consts[2], consts[3], consts[4]
+    gm1, g_gm1, c_lin, c_quad = consts[0], consts[1], consts[2], consts[3]
     buf = np.zeros((chunks if musl else 1, n_nodes))
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
         bad_f, bad_e, bad_n, val_f, val_e, top = -1, -1, -1, 0.0, 0.0, 0.0
+        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
         for q in range(lo, hi):
             factor, c = 0.0, 0.0
-            r0 = rows[q, 0]
-            acc = S[q, 0] * a_i[r0]
-            vel = S[q, 0] * v_n[r0]
+            cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            acc = Sl[0] * a_i[r[0]]
+            vel = Sl[0] * v_n[r[0]]
             for j in range(1, K):
-                acc += S[q, j] * a_i[rows[q, j]]
-                vel += S[q, j] * v_n[rows[q, j]]
+                acc += Sl[j] * a_i[r[j]]
+                vel += Sl[j] * v_n[r[j]]
             v_new[q] = v[q] + dt * acc
             x_new[q] = x[q] + dt * vel
             if musl:
                 mv = m[q] * v_new[q]
                 for j in range(K):
-                    buf[k, rows[q, j]] += S[q, j] * mv
+                    buf[k, r[j]] += Sl[j] * mv
                 continue
             if usl:
-                L = G[q, 0] * v_n[r0]
+                L = Gl[0] * v_n[r[0]]
                 for j in range(1, K):
-                    L += G[q, j] * v_n[rows[q, j]]
+                    L += Gl[j] * v_n[r[j]]
                 if MODEL == GAS:
                     factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
-                        rho[q], e[q], p[q], m[q], L, dt, h[cell[q]], gm1, g_gm1, c_lin, c_quad)
+                        rho[q], e[q], p[q], m[q], L, dt, h[cq], gm1, g_gm1, c_lin, c_quad)
                     if bad_e < 0 and not (e_new[q] > 0):
                         bad_e, val_e = q, e_new[q]
                 else:
@@ -358,24 +382,26 @@ def _move(rows, S, G, a_i, v_n, cell, h, x, V, m, v, rho, e, p, dt, consts, usl,
                 P_i[i] += buf[k, i]
 
 
-def _finish(rows, G, v_n, cell, h, V, m, v, rho, e, p, dt, consts, chunks,
+def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p, dt, consts, chunks,
             V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed):
-    """MUSL's last pass: the state update from ``L_p = sum_i G_ip v_i^{n+1}`` (re-projected),
-    the speed and the checks, as in :func:`_move`."""
-    n = rows.shape[0]
+    """MUSL's last pass: the state update from ``L_p = sum_i G_ip v_i^{n+1}`` (re-projected; the
+    shape at ``x_p^n``), the speed and the checks, as in :func:`_move`."""
+    n = x.size
     K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
     gm1, g_gm1, c_lin, c_quad = consts[0], consts[1], consts[2], consts[3]
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
         bad_f, bad_e, bad_n, val_f, val_e, top = -1, -1, -1, 0.0, 0.0, 0.0
+        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
         for q in range(lo, hi):
             factor, c = 0.0, 0.0
-            L = G[q, 0] * v_n[rows[q, 0]]
+            cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            L = Gl[0] * v_n[r[0]]
             for j in range(1, K):
-                L += G[q, j] * v_n[rows[q, j]]
+                L += Gl[j] * v_n[r[j]]
             if MODEL == GAS:
                 factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
-                    rho[q], e[q], p[q], m[q], L, dt, h[cell[q]], gm1, g_gm1, c_lin, c_quad)
+                    rho[q], e[q], p[q], m[q], L, dt, h[cq], gm1, g_gm1, c_lin, c_quad)
                 if bad_e < 0 and not (e_new[q] > 0):
                     bad_e, val_e = q, e_new[q]
                 top = max(top, c + abs(v[q]))
@@ -435,7 +461,7 @@ class FusedStep:
     and ``finite`` whether their state is finite, for the time step and the run's checks."""
 
     def __init__(self, grid: Grid, model, boundary, stages: Stages = Stages(), exact_acceleration=None,
-                 threads: int = 1):
+                 threads: int = 1, reuse: bool = False):
         reason = supported(model, stages)
         if reason is not None:
             raise ValueError(reason)
@@ -465,6 +491,18 @@ class FusedStep:
         self.slides = self.kind == BURGERS and getattr(model, "force", "weak") == "slides"
         self.K = {"mpm": 2, "bspline": 4, "gimp": 3}[stages.basis]
         self.speed, self.finite = np.nan, True
+        self.reuse, self._pools, self._turn = reuse, ({}, {}), 0
+
+    def _empty(self, name, shape, dtype=float):
+        """A fresh array, or with ``reuse`` one of two alternating sets: a step never writes the
+        arrays it reads, and the particles it returns stay valid until the step after next."""
+        if not self.reuse:
+            return np.empty(shape, dtype)
+        pool = self._pools[self._turn]
+        a = pool.get(name)
+        if a is None or a.shape != shape or a.dtype != dtype:
+            a = pool[name] = np.empty(shape, dtype)
+        return a
 
     def _solve(self, shape, mass, m_i, rhs):
         if self.stages.mass == "lumped":
@@ -488,14 +526,19 @@ class FusedStep:
         gas = self.kind == GAS
         scheme, exact = self.stages.scheme, self.stages.acceleration == "exact"
         gas_force = gas and scheme != "usf" and not exact
+        store = self.basis == 1 or self.stages.mass == "consistent"
+        geometry = (self.nodes, self.h, self.inv_spacing)
         n_nodes = grid.n_nodes
-        m_i, P_i, F_i = np.empty(n_nodes), np.empty(n_nodes), np.empty(n_nodes)
+        self._turn = 1 - self._turn
+        empty = self._empty
+        m_i, P_i, F_i = empty("m_i", n_nodes), empty("P_i", n_nodes), empty("F_i", n_nodes)
         flags = np.empty((chunks, 3), np.int64)
+        cell = empty("cell", n, np.intp)
         while True:
-            rows, S, G = np.empty((n, self.K), np.intp), np.empty((n, self.K)), np.empty((n, self.K))
-            cell = np.empty(n, np.intp)
-            self.project(self.nodes, self.h, self.inv_spacing, x, V, m, v, p, gas_force, chunks,
-                          rows, S, G, cell, m_i, P_i, F_i, flags)
+            rows_n = n if store else 0
+            rows, S, G = (empty("rows", (rows_n, self.K), np.intp), empty("S", (rows_n, self.K)),
+                          empty("G", (rows_n, self.K)))
+            self.project(*geometry, x, V, m, v, p, gas_force, store, chunks, rows, S, G, cell, m_i, P_i, F_i, flags)
             if (flags[:, :2] >= 0).any():
                 make_shape(grid, x, V, self.stages.basis)  # raises the numpy step's error
                 raise ValueError("a particle lies outside the grid or has no volume")  # not reached
@@ -505,18 +548,19 @@ class FusedStep:
             self.K = need  # GIMP: a particle domain spans another cell; redo with the wider rows
         shape = Shape(rows, S, G, n_nodes, cell)
         v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
+        shape_args = (*geometry, x, rows, S, G, cell)
 
-        V_new, m_new = np.empty(n), (np.empty(n) if not gas else m)
-        rho_new, e_new, p_new = (np.empty(n), np.empty(n), np.empty(n)) if gas else (rho, e, p)
+        V_new, m_new = empty("V", n), (empty("m", n) if not gas else m)
+        rho_new, e_new, p_new = (empty("rho", n), empty("e", n), empty("p", n)) if gas else (rho, e, p)
         values = np.zeros((chunks, 2))
         if scheme == "usf":
             upd = np.empty((chunks, 2), np.int64)
-            self.update(rows, G, v_i, cell, self.h, x, V, m, rho, e, p, dt, self.consts,
-                         not exact and not self.slides, chunks, V_new, m_new, rho_new, e_new, p_new, F_i, upd, values)
+            self.update(*shape_args, v_i, V, m, rho, e, p, dt, self.consts, not exact and not self.slides, chunks,
+                        V_new, m_new, rho_new, e_new, p_new, F_i, upd, values)
             if (upd >= 0).any():
                 self._positivity(upd, values, x)
         elif not gas and not exact and not self.slides:
-            self.viscous_force(rows, G, v_i, V, self.consts[4], chunks, F_i)
+            self.viscous_force(*shape_args, v_i, V, self.consts[4], chunks, F_i)
         if exact:
             if self.exact_acceleration is None:
                 raise ValueError("this problem has no exact acceleration to use")
@@ -528,23 +572,21 @@ class FusedStep:
         a_i = self.boundary.acceleration(grid, a_i, v_i, t, dt)
         v_n = v_i + dt * a_i
 
-        x_new, vel_new = np.empty(n), np.empty(n)
+        x_new, vel_new = empty("x", n), empty("v", n)
         speed = np.empty(chunks)
         usl, musl = scheme == "usl", scheme == "musl"
-        if scheme == "usf":  # the state is updated already: the move reads it
-            rho_m, e_m, p_m, V_m, m_m = rho_new, e_new, p_new, V_new, m_new
-        else:
-            rho_m, e_m, p_m, V_m, m_m = rho, e, p, V, m
-        P_musl = np.empty(n_nodes)
-        self.move(rows, S, G, a_i, v_n, cell, self.h, x, V_m, m, v, rho_m, e_m, p_m, dt,
-                   self.consts, usl, musl, chunks, x_new, vel_new,
-                   V_new if usl else V_m, m_new if usl else m_m,
-                   rho_new if usl else rho_m, e_new if usl else e_m, p_new if usl else p_m,
-                   P_musl, flags, values, speed)
+        if usl:  # the move writes the new state
+            state = (V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new)
+        else:  # USF: updated already; MUSL: updated after the re-projection
+            V_m, m_m, rho_m, e_m, p_m = (V_new, m_new, rho_new, e_new, p_new) if scheme == "usf" else (V, m, rho, e, p)
+            state = (V_m, m, rho_m, e_m, p_m, V_m, m_m, rho_m, e_m, p_m)
+        P_musl = empty("P_musl", n_nodes)
+        self.move(*geometry, rows, S, G, cell, a_i, v_n, x, state[0], state[1], v, state[2], state[3], state[4],
+                  dt, self.consts, usl, musl, chunks, x_new, vel_new, *state[5:], P_musl, flags, values, speed)
         if musl:
             v_n = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_musl), t + dt)
-            self.finish(rows, G, v_n, cell, self.h, V, m, vel_new, rho, e, p, dt, self.consts,
-                         chunks, V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed)
+            self.finish(*shape_args, v_n, V, m, vel_new, rho, e, p, dt, self.consts, chunks,
+                        V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed)
         if usl or musl:
             if (flags[:, :2] >= 0).any():
                 self._positivity(flags[:, :2], values, x_new)

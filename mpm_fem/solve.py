@@ -114,7 +114,8 @@ def run(
     check_kernel(kernel, threads)
     fused = None
     if kernel == "fused" and supported(problem.model, stages) is None:
-        fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads)
+        fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads,
+                          reuse=observer is None)  # an observer may keep the particles of every step
     start = time.perf_counter()
     t, steps = 0.0, 0
     dts = []
