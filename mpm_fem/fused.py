@@ -205,7 +205,7 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
     consistent mass and GIMP need them). ``flags[k] = (first particle outside the grid, first
     with V <= 0, the K it needs)`` of chunk k."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
     n_nodes = nodes.size
     a, b = nodes[0], nodes[n_nodes - 1]
     buf = np.zeros((chunks, 3, n_nodes))
@@ -249,7 +249,7 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
 def _viscous_force(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i):
     """Burgers' stress before the force: ``F_i = - sum_p V_p eps (sum_j G_jp v_j) G_ip``."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
     n_nodes = F_i.size
     buf = np.zeros((chunks, n_nodes))
     for k in prange(chunks):
@@ -276,7 +276,7 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
     of the updated state into ``F_i`` (if ``force``). ``flags[k] = (first particle with factor <= 0,
     first with energy <= 0)``, ``values[k]`` their values."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
     n_nodes = F_i.size
     gm1, g_gm1, c_lin, c_quad, eps = consts[0], consts[1], consts[2], consts[3], consts[4]
     buf = np.zeros((chunks, n_nodes))
@@ -323,7 +323,7 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
     ``c_p + |v_p|`` (gas) or ``|v_p|`` (Burgers) over chunk k; ``flags[k] = (first bad factor,
     first bad energy, first non-finite particle)``."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
     n_nodes = P_i.size
     gm1, g_gm1, c_lin, c_quad = consts[0], consts[1], consts[2], consts[3]
     buf = np.zeros((chunks if musl else 1, n_nodes))
@@ -387,7 +387,7 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
     """MUSL's last pass: the state update from ``L_p = sum_i G_ip v_i^{n+1}`` (re-projected; the
     shape at ``x_p^n``), the speed and the checks, as in :func:`_move`."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else rows.shape[1])
+    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
     gm1, g_gm1, c_lin, c_quad = consts[0], consts[1], consts[2], consts[3]
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
@@ -432,7 +432,8 @@ def _compile(fn, parallel, **constants):
     return njit(cache=True, parallel=parallel)(variant)
 
 
-BASIS, MODEL = 0, 0  # replaced per compiled variant
+BASIS, MODEL, WIDTH = 0, 0, 3  # replaced per compiled variant
+_STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
 
 
 class _Passes:
@@ -474,10 +475,7 @@ class FusedStep:
         passes = _PASSES[self.threads > 1]
         self.kind = GAS if isinstance(model, IdealGas) else BURGERS
         self.basis = _BASIS_CODE[stages.basis]
-        self.project = passes.get(_project, BASIS=self.basis)
-        self.update, self.move, self.finish = (passes.get(fn, BASIS=self.basis, MODEL=self.kind)
-                                               for fn in (_update, _move, _finish))
-        self.viscous_force = passes.get(_viscous_force, BASIS=self.basis)
+        self._passes = passes
         if stages.basis == "bspline":
             make_shape(grid, grid.nodes[:1], basis="bspline")  # raises on a non-uniform grid
         self.nodes = np.ascontiguousarray(grid.nodes, dtype=float)
@@ -489,16 +487,24 @@ class FusedStep:
         else:
             self.consts = np.array([0.0, 0.0, 0.0, 0.0, model.eps])
         self.slides = self.kind == BURGERS and getattr(model, "force", "weak") == "slides"
-        self.K = {"mpm": 2, "bspline": 4, "gimp": 3}[stages.basis]
+        self._width({"mpm": 2, "bspline": 4, "gimp": 3}[stages.basis])
         self.speed, self.finite = np.nan, True
         self.reuse, self._pools, self._turn = reuse, ({}, {}), 0
+
+    def _width(self, K):
+        """Use the passes compiled for K nodes per particle (GIMP: 2 + the cells a domain spans)."""
+        self.K = K
+        constants = dict(BASIS=self.basis, MODEL=self.kind, WIDTH=K)
+        self.project = self._passes.get(_project, BASIS=self.basis, WIDTH=K)
+        self.update, self.move, self.finish = (self._passes.get(fn, **constants) for fn in (_update, _move, _finish))
+        self.viscous_force = self._passes.get(_viscous_force, BASIS=self.basis, WIDTH=K)
 
     def _empty(self, name, shape, dtype=float):
         """A fresh array, or with ``reuse`` one of two alternating sets: a step never writes the
         arrays it reads, and the particles it returns stay valid until the step after next."""
         if not self.reuse:
             return np.empty(shape, dtype)
-        pool = self._pools[self._turn]
+        pool = self._pools[self._turn if name in _STATE else 0]  # scratch arrays: one set
         a = pool.get(name)
         if a is None or a.shape != shape or a.dtype != dtype:
             a = pool[name] = np.empty(shape, dtype)
@@ -545,7 +551,7 @@ class FusedStep:
             need = int(flags[:, 2].max(initial=2))
             if self.basis != 1 or need == self.K or n == 0:
                 break
-            self.K = need  # GIMP: a particle domain spans another cell; redo with the wider rows
+            self._width(need)  # GIMP: a particle domain spans another cell; redo with the wider rows
         shape = Shape(rows, S, G, n_nodes, cell)
         v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
         shape_args = (*geometry, x, rows, S, G, cell)

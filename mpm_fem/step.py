@@ -19,7 +19,7 @@ ExactFields` for the projection, mass and interpolation switches; their equation
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Protocol
 
 import numpy as np
@@ -111,20 +111,31 @@ class Walls:
 
 @dataclass(frozen=True)
 class Dirichlet:
-    """Prescribed velocity ``g(x, t)`` at both ends; ``a_i`` makes ``v_i^{n+1} = g(x_i, t + dt)``."""
+    """Prescribed velocity ``g(x, t)`` at both ends; ``a_i`` makes ``v_i^{n+1} = g(x_i, t + dt)``.
+
+    The data at ``t + dt`` of one step are the data at ``t`` of the next: the last evaluation is
+    kept, so ``g`` is called once per step."""
 
     g: Callable[[np.ndarray, float], np.ndarray]
+    _last: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def _values(self, grid, t):
+        b = grid.boundary_nodes
+        key = (float(grid.nodes[b[0]]), float(grid.nodes[b[-1]]), t)
+        if self._last.get("key") != key:
+            self._last.update(key=key, value=self.g(grid.nodes[b], t))
+        return b, self._last["value"]
 
     def velocity(self, grid, v, t):
         v = v.copy()
-        b = grid.boundary_nodes
-        v[b] = self.g(grid.nodes[b], t)
+        b, g = self._values(grid, t)
+        v[b] = g
         return v
 
     def acceleration(self, grid, a, v, t, dt):
         a = a.copy()
-        b = grid.boundary_nodes
-        a[b] = (self.g(grid.nodes[b], t + dt) - v[b]) / dt
+        b, g = self._values(grid, t + dt)
+        a[b] = (g - v[b]) / dt
         return a
 
 
