@@ -123,3 +123,23 @@ def save(fig, path, title: str = "") -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def profile_grid(path, exact: dict, rows: dict, title: str = "") -> None:
+    """One column per field of ``exact = {field: (x, values)}`` (drawn as a black line in every row)
+    and one row per entry of ``rows = {row label: [(label, x, {field: values}, fmt, options)]}``; a
+    series draws only the fields it has."""
+    fig, axes = plt.subplots(len(rows), len(exact), figsize=(4 * len(exact), 3.2 * len(rows)), sharex=True,
+                             squeeze=False)
+    for axes_row, (row_label, series) in zip(axes, rows.items()):
+        for ax, (field, (xe, ye)) in zip(axes_row, exact.items()):
+            ax.plot(xe, ye, "k-", lw=1.0, label="exact")
+            ax.set_title(field, fontsize=9)
+            for label, x, values, fmt, options in series:
+                if field in values:
+                    ax.plot(x, values[field], fmt, label=label, **options)
+        axes_row[0].set_ylabel(row_label)
+        axes_row[0].legend(fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("x")
+    save(fig, path, title)

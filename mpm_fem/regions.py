@@ -93,6 +93,25 @@ def mean_by_region(x: np.ndarray, error: np.ndarray, weights: np.ndarray, region
     return np.divide(signed, total, out=np.zeros(n), where=total > 0)
 
 
+def by_region(x: np.ndarray, error: np.ndarray, weights: np.ndarray, regions: Regions) -> dict[str, list]:
+    """``{"L1": l1_by_region, "mean": mean_by_region}`` of one error, as lists (JSON-able)."""
+    return {"L1": l1_by_region(x, error, weights, regions).tolist(),
+            "mean": mean_by_region(x, error, weights, regions).tolist()}
+
+
+def first_below(x: np.ndarray, q: np.ndarray, level: float) -> float:
+    """First ``x`` (linear between points) where ``q`` drops below ``level``, from the left."""
+    k = int(np.argmax(q < level))
+    return float(x[k - 1] + (x[k] - x[k - 1]) * (q[k - 1] - level) / (q[k - 1] - q[k]))
+
+
+def head_shift(x: np.ndarray, rho: np.ndarray, exact, level: float = 0.99, window=(0.2, 0.4)) -> float:
+    """Where the computed density first drops below ``level`` minus where the exact one (``exact(x)``,
+    sampled finely over ``window``) does: the position error of the rarefaction head (> 0: it lags)."""
+    xe = np.linspace(*window, 20001)
+    return first_below(x, rho, level) - first_below(xe, exact(xe), level)
+
+
 def strict_extrema(q: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
     """Boolean mask of strict local extrema of ``q`` (ordered) beyond ``tol`` (module docstring)."""
     q = np.asarray(q, dtype=float)
