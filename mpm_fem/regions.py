@@ -93,6 +93,19 @@ def mean_by_region(x: np.ndarray, error: np.ndarray, weights: np.ndarray, region
     return np.divide(signed, total, out=np.zeros(n), where=total > 0)
 
 
+def describe(half_width: float, waves: dict, t: float) -> dict:
+    """The partition of :func:`sod_regions` in words, for a table's settings."""
+    w = half_width
+    x = {k: round(waves[k], 5) for k in ("rarefaction_head", "rarefaction_tail", "contact", "shock")}
+    return {
+        "0 undisturbed": f"[0, x_H - {w}) and [x_S + {w}, 1]", "1 rarefaction head": f"[x_H - {w}, x_H + {w})",
+        "2 smooth": f"[x_H + {w}, x_T - {w}) (fan) and [x_T + {w}, x_C - {w}) (plateau)",
+        "3 rarefaction tail": f"[x_T - {w}, x_T + {w})", "4 contact": f"[x_C - {w}, x_C + {w})",
+        "5 behind shock": f"[x_C + {w}, x_S - {w})", "6 shock front": f"[x_S - {w}, x_S + {w})",
+        f"waves at T={t}": ", ".join(f"x_{n} = {v}" for n, v in zip("HTCS", x.values())),
+    }
+
+
 def by_region(x: np.ndarray, error: np.ndarray, weights: np.ndarray, regions: Regions) -> dict[str, list]:
     """``{"L1": l1_by_region, "mean": mean_by_region}`` of one error, as lists (JSON-able)."""
     return {"L1": l1_by_region(x, error, weights, regions).tolist(),

@@ -14,12 +14,13 @@ import numpy as np
 
 from baselines import fem_euler, fv_euler
 from baselines.exact import riemann
-from mpm_fem import plots, source
-from mpm_fem.errors import norms, orders_column
+from mpm_fem import plots, shock_tube, source
+from mpm_fem.errors import orders_column
 from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
 from mpm_fem.problems import sod
-from mpm_fem.regions import REGION_NAMES, ExtremaCounter, by_region, head_shift, sod_regions
+from mpm_fem.regions import REGION_NAMES, ExtremaCounter, describe
+from mpm_fem.plots import Curve, Plot
 from mpm_fem.report import Page, View
 from mpm_fem.study import StudyOptions, script_main, write_table
 
@@ -37,85 +38,34 @@ PPC = (1, 2, 4, 8, 16, 32)
 PPC_H = (0.01, 0.0025, 0.000625)
 CONSISTENT_H = H[:4]  # the consistent particle mass costs ~2x: the two finest meshes are left out
 PLATEAU_H = (0.0025, 0.00125)
-PLATEAU_VARIANTS = {
-    "study settings": {}, "CFL 0.025": {"cfl": 0.025}, "CFL 0.1": {"cfl": 0.1}, "8 ppc": {"ppc": 8}, "32 ppc": {"ppc": 32},
-    "viscosity x0.5": {"av_linear": 0.25, "av_quadratic": 1.0}, "viscosity x2": {"av_linear": 1.0, "av_quadratic": 4.0},
-    "USF": {"scheme": "usf"}, "MUSL": {"scheme": "musl"}, "GIMP": {"basis": "gimp"}, "consistent mass": {"mass": "consistent"},
-}
+PLATEAU_VARIANTS = {"study settings": {}, "CFL 0.025": {"cfl": 0.025}, "CFL 0.1": {"cfl": 0.1}, "8 ppc": {"ppc": 8},
+                    "32 ppc": {"ppc": 32}, "viscosity x0.5": {"av_linear": 0.25, "av_quadratic": 1.0},
+                    "viscosity x2": {"av_linear": 1.0, "av_quadratic": 4.0}, "USF": {"scheme": "usf"}, "MUSL": {"scheme": "musl"},
+                    "GIMP": {"basis": "gimp"}, "consistent mass": {"mass": "consistent"}}
 QUICK = dict(H=H[:3], PPC_H=(0.01,), CONSISTENT_H=H[:2], PLATEAU_H=())
 
 
-# ---------------------------------------------------------------- one case (runs in a worker)
-
-def _exact_density(x, t=T):
-    return riemann.sample(x, t, sod.SodSettings.left, sod.SodSettings.right, x0=0.5, gamma=1.4)[0]
-
-
-def _measure(x, rho, weights, t, half_width) -> tuple[np.ndarray, dict]:
-    """The density error at ``x`` and its L1 and signed mean by region of the exact solution."""
-    e = rho - _exact_density(x, t)
-    regions = sod_regions(riemann.wave_positions(t, sod.SodSettings.left, sod.SodSettings.right), half_width)
-    return e, by_region(x, e, weights, regions)
-
-
-def _profile(values: dict) -> dict:
-    return {k: [float(f"{v:.7g}") for v in np.asarray(a)] for k, a in values.items()}
-
-
 def run_case(case: dict) -> dict:
-    """One run: ``case["solver"]`` is ``"mpm"`` (keys of :data:`MPM` and ``h``), ``"fem"`` (``h``,
-    ``mass`` and the keys of :data:`FEM`) or ``"fv"``. Density errors over particles and nodes, the
-    error by region, new-extrema counts (MPM), the head shift, and profiles when asked for."""
-    if case["solver"] != "mpm":
-        return {"fem": _run_fem, "fv": _run_fv}[case["solver"]](case)
-    settings = sod.SodSettings(h=case["h"], **{k: case[k] for k in MPM})
-    counter = ExtremaCounter(uniform_grid(0.0, 1.0, case["h"]))
+    """One run, measured (:mod:`mpm_fem.shock_tube`): ``case["solver"]`` is ``"mpm"`` (keys of
+    :data:`MPM` and ``h``), ``"fem"`` (``h``, ``mass`` and the keys of :data:`FEM`) or ``"fv"``."""
+    h, width, profiles = case["h"], case.get("region_half_width"), case.get("profiles", False)
+    if case["solver"] == "fv":
+        return shock_tube.fv(fv_euler.solve(h, cfl=case["cfl"]), h)
+    if case["solver"] == "fem":
+        try:
+            r = fem_euler.solve(h, mass=case["mass"], cfl=case["cfl"],
+                                viscosity=fem_euler.Viscosity(case["viscosity_linear"], case["viscosity_quadratic"]))
+        except fem_euler.PositivityError as err:
+            return {"ok": False, "error": str(err)}
+        return shock_tube.fem(r, uniform_grid(0.0, 1.0, h).lumped_mass, width, profiles)
+    settings = sod.SodSettings(h=h, **{k: case[k] for k in MPM})
+    counter = ExtremaCounter(uniform_grid(0.0, 1.0, h))
     try:
         result = sod.simulate(settings, progress=False, observer=counter)
     except (PositivityError, FloatingPointError) as err:
         return {"ok": False, "error": str(err), "steps": counter.steps}
-    errors = sod.errors(settings, result)
-    P, g, t, w = result.particles, result.grid, result.t, case["region_half_width"]
-    split = {"particles": _measure(P.x, P.density, P.volume, t, w)[1],
-             "nodes": _measure(g.nodes, result.nodal_density, g.lumped_mass, t, w)[1]}
-    out = {"ok": True, "steps": result.steps, "wall_s": result.wall_s, "particles": int(P.n),
-           **{k: errors[k] for k in ("density", "velocity", "pressure")},
-           "regions": {k: s["L1"] for k, s in split.items()}, "mean_error": {k: s["mean"] for k, s in split.items()},
-           "extrema": counter.summary(), "volume_drift": float(P.volume.sum() - 1.0),
-           "head_shift": head_shift(g.nodes, result.nodal_density, lambda x: _exact_density(x, t))}
-    if case.get("profiles"):
-        out["profile"] = _profile(dict(x=P.x, density=P.density, velocity=P.velocity, energy=P.energy,
-                                       pressure=(settings.gamma - 1.0) * P.density * P.energy, nodes=g.nodes,
-                                       nodal_density=result.nodal_density, nodal_velocity=result.nodal_velocity))
-    return out
+    return shock_tube.mpm(settings, result, sod.errors(settings, result), counter.summary(), width, profiles)
 
-
-def _run_fem(case: dict) -> dict:
-    visc = fem_euler.Viscosity(case["viscosity_linear"], case["viscosity_quadratic"])
-    try:
-        r = fem_euler.solve(case["h"], mass=case["mass"], cfl=case["cfl"], viscosity=visc)
-    except fem_euler.PositivityError as err:
-        return {"ok": False, "error": str(err)}
-    w = uniform_grid(0.0, 1.0, case["h"]).lumped_mass
-    e, split = _measure(r.nodes, r.rho, w, r.t, case["region_half_width"])
-    out = {"ok": True, "steps": r.steps, "density": {"nodes": norms(e, w)}, "regions": {"nodes": split["L1"]},
-           "mean_error": {"nodes": split["mean"]}, "mass": float(np.sum(w * r.rho)),
-           "head_shift": head_shift(r.nodes, r.rho, lambda x: _exact_density(x, r.t)), "settings": r.settings}
-    if case.get("profiles"):
-        out["profile"] = _profile(dict(x=r.nodes, density=r.rho, velocity=r.u, pressure=r.p, energy=r.e))
-    return out
-
-
-def _run_fv(case: dict) -> dict:
-    """The finite-volume reference on the cells of the same mesh: cell averages against the exact
-    density at the cell centres, weights h."""
-    r = fv_euler.solve(case["h"], cfl=case["cfl"])
-    e = r.rho - _exact_density(r.centres, r.t)
-    return {"ok": True, "steps": r.steps, "density": {"cells": norms(e, np.full(e.size, case["h"]))},
-            "mass": float(np.sum(r.rho) * case["h"])}
-
-
-# ---------------------------------------------------------------- the plan
 
 def mpm_case(h: float, **changes) -> dict:
     """The MPM case at ``h`` with the study settings, ``changes`` applied."""
@@ -159,15 +109,14 @@ def run(options: StudyOptions) -> None:
                 "quick": options.quick, "problem": sod.SodSettings().as_dict()}
     tables = {"convergence": _convergence(got), "regions": _regions(got), "extrema": _extrema(got), "ppc": _ppc(got),
               "mass": _mass(got), "plateau": _plateau(got) if got["plateau"] else []}
-    extra = {"regions": {"regions": _region_text()}, "extrema": {
+    waves = riemann.wave_positions(T, sod.SodSettings.left, sod.SodSettings.right)
+    extra = {"regions": {"regions": describe(REGION_HALF_WIDTH, waves, T)}, "extrema": {
         "rtol": 1e-9, "definition": "new strict local extremum among position-ordered particles"}}
     for name, rows in tables.items():
         if rows:
             write_table(folder, name, rows, {**settings, **extra.get(name, {})})
     _figures(folder, got, tables)
 
-
-# ---------------------------------------------------------------- the tables
 
 def _L1(r, where="nodes", norm="L1"):
     return r["density"][where][norm] if r["ok"] else float("nan")
@@ -213,17 +162,6 @@ def _regions(got) -> list[dict]:
                              **{f"L1_{k}_{n.replace(' ', '_')}": float(p) for k, (n, p) in enumerate(zip(REGION_NAMES, parts))},
                              **{f"share_{k}": float(p / total) for k, p in enumerate(parts)}})
     return rows
-
-
-def _region_text() -> dict:
-    w = REGION_HALF_WIDTH
-    return {
-        "0 undisturbed": f"[0, x_H - {w}) and [x_S + {w}, 1]", "1 rarefaction head": f"[x_H - {w}, x_H + {w})",
-        "2 smooth": f"[x_H + {w}, x_T - {w}) (fan) and [x_T + {w}, x_C - {w}) (plateau)",
-        "3 rarefaction tail": f"[x_T - {w}, x_T + {w})", "4 contact": f"[x_C - {w}, x_C + {w})",
-        "5 behind shock": f"[x_C + {w}, x_S - {w})", "6 shock front": f"[x_S - {w}, x_S + {w})",
-        "waves at T=0.2": "x_H = 0.26336, x_T = 0.48595, x_C = 0.68549, x_S = 0.85043",
-    }
 
 
 def _extrema(got) -> list[dict]:
@@ -283,39 +221,31 @@ def _plateau(got) -> list[dict]:
     return rows
 
 
-# ---------------------------------------------------------------- the figures
+_STYLES = {"density": "o-", "energy": "s--"}
+PLOTS = (
+    Plot("convergence.png", f"Sod, T = {T}: density L1 error against h, beside the source's table", "convergence", "h", (
+        Curve("MPM, grid nodes", "mpm_nodes_L1"), Curve("MPM, particles", "mpm_particles_L1", "s-"),
+        Curve("FEM consistent", "fem_consistent_L1", "^--"), Curve("FEM lumped", "fem_lumped_L1", "v--"),
+        Curve("FV (MUSCL-Hancock + HLLC)", "fv_L1", "x-."), Curve("source (slides)", "source_L1", "k*")),
+        ylabel="density error (L1)", slopes=(0.5, 1)),
+    Plot("extrema.png", "C14: new extrema of particle density and energy, per step and per particle-step", "extrema", "h",
+         tuple(Curve(n, f"{n}_new_per_step", f, panel="new extrema per step") for n, f in _STYLES.items())
+         + tuple(Curve(f"{n}: {who}", f"{n}_rate_{k}", f, panel="new extrema per particle-step", options=o)
+                 for n, f in _STYLES.items() for k, who, o in (("crossing", "particles crossing a node", {}),
+                                                               ("elsewhere", "other particles", {"alpha": 0.5}))),
+         ylabel="new extrema", size=(4.5, 3.6)),
+    Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", "ppc", "ppc", tuple(
+        Curve("h = {group}", f"{w}_L1", panel=f"over {name}", group="h", where={"ok": True})
+        for w, name in (("nodes", "grid nodes"), ("particles", "particles"))),
+        xlabel="particles per cell N_p", ylabel="density error (L1)", size=(4.5, 3.6)),
+)
+
 
 def _figures(folder, got, t) -> None:
-    conv, styles = t["convergence"], {"density": "o-", "energy": "s--"}
-    hs = [r["h"] for r in conv]
-    series = {label: (hs, [r[key] for r in conv], fmt) for label, key, fmt in (
-        ("MPM, grid nodes", "mpm_nodes_L1", "o-"), ("MPM, particles", "mpm_particles_L1", "s-"),
-        ("FEM consistent", "fem_consistent_L1", "^--"), ("FEM lumped", "fem_lumped_L1", "v--"),
-        ("FV (MUSCL-Hancock + HLLC)", "fv_L1", "x-."))}
-    series["MPM consistent mass, nodes"] = ([r["h"] for r in t["mass"]], [r["mpm_consistent_nodes_L1"] for r in t["mass"]], "d:")
-    series["source (slides)"] = (list(SOURCE), [v[0] for v in SOURCE.values()], "k*")
-    plots.panels(folder / "convergence.png", {f"Sod, T={T}: density L1 error vs h (MPM {MPM['ppc']} ppc, CFL {MPM['cfl']})":
-                 series}, "h", "density error (L1)", slopes=(0.5, 1), size=(5.2, 4.0))
-    shares = {m: [(f"{r['h']:g}", [r[f"share_{k}"] for k in range(len(REGION_NAMES))], r["L1"]) for r in t["regions"]
-                  if r["method"] == m] for m in dict.fromkeys(r["method"] for r in t["regions"])}
-    plots.stacked_shares(folder / "regions.png", shares, REGION_NAMES, f"C12: density L1 error by region of the exact "
+    for plot in PLOTS:
+        plots.draw(folder, plot, t[plot.table])
+    plots.stacked_shares(folder / "regions.png", t["regions"], REGION_NAMES, f"C12: density L1 error by region of the exact "
                          f"solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
-    ext, hx = t["extrema"], [r["h"] for r in t["extrema"]]
-    plots.panels(folder / "extrema.png", {
-        "new extrema per step": {n: (hx, [r[f"{n}_new_per_step"] for r in ext], f) for n, f in styles.items()},
-        "new extrema per particle-step": {
-            **{f"{n}: particles crossing a node": (hx, [r[f"{n}_rate_crossing"] for r in ext], f) for n, f in styles.items()},
-            **{f"{n}: other particles": (hx, [r[f"{n}_rate_elsewhere"] for r in ext], f, {"alpha": 0.5}) for n, f in styles.items()}}},
-        "h", "new extrema", f"C14: new extrema of particle density / energy (MPM, {MPM['ppc']} ppc, CFL {MPM['cfl']})")
-    ppc = {}
-    for where in ("nodes", "particles"):
-        panel = ppc.setdefault(f"over {'grid nodes' if where == 'nodes' else 'particles'}", {})
-        for h in sorted({r["h"] for r in t["ppc"]}, reverse=True):
-            ok = [r for r in t["ppc"] if r["h"] == h and r["ok"]]
-            panel[f"h = {h:g}"] = ([r["ppc"] for r in ok], [r[f"{where}_L1"] for r in ok], "o-")
-            panel[f"source, h = {h:g}"] = ((PPC[0], PPC[-1]), (SOURCE[h][0],) * 2, "k:", {"lw": 0.8})
-    plots.panels(folder / "ppc.png", ppc, "particles per cell N_p", "density error (L1)",
-                 "C3: error vs particles per cell (dotted: the source at that h)")
     _profiles(folder, got)
 
 
@@ -337,8 +267,6 @@ def _profiles(folder, got) -> None:
             f"FEM (P1, SSPRK3, CFL {FEM['cfl']})": fem},
             f"Sod at T = {T}, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh")
 
-
-# ---------------------------------------------------------------- the report page
 
 _CONVERGENCE = ("h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1",
                 "mpm_particles_L1", "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1", "order_fv_L1")
