@@ -56,3 +56,11 @@ def band_text(quantity: str) -> str:
     if isinstance(band, str):
         return f"order of {band}"
     return f"{band[0]}" if band[0] == band[1] else f"[{band[0]}, {band[1]}]"
+
+
+def burgers_value(row: str | None, eps: float, h: float) -> float | None:
+    """The source's Burgers error of ``row`` (``"exact"``, ``"calculated"``) at ``eps`` and ``h``;
+    ``None`` where the table has no entry."""
+    if row is None or eps not in BURGERS[row] or h not in BURGERS_H:
+        return None
+    return BURGERS[row][eps][BURGERS_H.index(h)]

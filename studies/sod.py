@@ -21,7 +21,6 @@ from mpm_fem.particles import PositivityError
 from mpm_fem.problems import sod
 from mpm_fem.regions import REGION_NAMES, ExtremaCounter, describe
 from mpm_fem.plots import Curve, Plot
-from mpm_fem.report import Page, View
 from mpm_fem.study import StudyOptions, script_main, write_table
 
 NAME = "sod"
@@ -235,7 +234,7 @@ PLOTS = (
                                                                ("elsewhere", "other particles", {"alpha": 0.5}))),
          ylabel="new extrema", size=(4.5, 3.6)),
     Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", "ppc", "ppc", tuple(
-        Curve("h = {group}", f"{w}_L1", panel=f"over {name}", group="h", where={"ok": True})
+        Curve("h = {h}", f"{w}_L1", panel=f"over {name}", group=("h",), where={"ok": True})
         for w, name in (("nodes", "grid nodes"), ("particles", "particles"))),
         xlabel="particles per cell N_p", ylabel="density error (L1)", size=(4.5, 3.6)),
 )
@@ -266,33 +265,6 @@ def _profiles(folder, got) -> None:
                                                           ("MPM grid nodes", mp["nodes"], nodal, "x", {"ms": 3, "color": "tab:red"})],
             f"FEM (P1, SSPRK3, CFL {FEM['cfl']})": fem},
             f"Sod at T = {T}, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh")
-
-
-_CONVERGENCE = ("h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1",
-                "mpm_particles_L1", "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1", "order_fv_L1")
-PAGE = Page(
-    NAME, "Sod's shock tube",
-    "Density error at the final time against the exact Riemann solution, with one set of MPM settings for every "
-    "mesh (recorded in the JSON beside each table), over particles and over grid nodes, beside P1 FEM with "
-    "consistent and lumped mass and a finite-volume reference on the same mesh, and beside the source's table.",
-    views=(
-        View("sod/convergence", "Density L1 against h, beside the source", _CONVERGENCE, {}, "convergence.png"),
-        View("sod/convergence", "What sets the floor: volume gained by the particles, signed mean error in the "
-             "smooth region, position error of the rarefaction head", ("h", "mpm_volume_drift",
-             "mpm_particles_mean_error_smooth", "mpm_nodes_mean_error_smooth", "mpm_head_shift", "fem_consistent_head_shift")),
-        View("sod/regions", "Share of the L1 error by region of the exact solution",
-             ("method", "h", "L1") + tuple(f"share_{k}" for k in range(len(REGION_NAMES))), {}, "regions.png"),
-        View("sod/extrema", "New extrema per step, at cell crossings and elsewhere", ("h", "steps", "crossings_per_step",
-             "density_new_per_step", "density_rate_crossing", "density_rate_elsewhere", "density_rate_ratio",
-             "energy_new_per_step", "energy_rate_ratio"), {}, "extrema.png"),
-        View("sod/ppc", "Error against particles per cell", ("h", "ppc", "ok", "nodes_L1", "particles_L1"), {}, "ppc.png"),
-        View("sod/mass", "Lumped against consistent mass, MPM and FEM"),
-        View("sod/plateau", "What moves the floor: one setting changed at a time", ("h", "variant", "ok", "nodes_L1",
-             "nodes_vs_study", "particles_L1", "particles_vs_study", "density_new_extrema_per_step")),
-    ),
-    figures=tuple((f"profiles_h{h:g}.png", "Profiles against the exact solution, MPM above and FEM below, on the "
-                   "mesh named in the file") for h in PROFILE_H),
-)
 
 
 if __name__ == "__main__":

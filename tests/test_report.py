@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from mpm_fem.claims import STATEMENTS
-from mpm_fem.report import Page, View, cell, markdown_table, render, study_pages, write_report
+from mpm_fem.report import Page, View, captions_of, cell, markdown_table, render, study_pages, write_report
 from mpm_fem.tables import load_tables
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"
@@ -22,7 +22,8 @@ def committed():
 
 
 def test_the_committed_report_is_the_rendering_of_the_committed_tables(committed):
-    rendered = render(load_tables(FIGURES), study_pages(FIGURES)) + "\n"
+    pages = study_pages(FIGURES)
+    rendered = render(load_tables(FIGURES), pages, {p.name: captions_of(FIGURES / p.name) for p in pages}) + "\n"
     assert rendered == committed, "figures/REPORT.md differs from `python -m mpm_fem.report --out figures`"
 
 
@@ -62,10 +63,11 @@ def test_a_quick_report_links_only_to_its_own_folder(tmp_path):
     (tmp_path / "toy").mkdir()
     (tmp_path / "toy" / "t.csv").write_text("h,quick_value\n0.5,1.25\n0.25,|x|\n")
     (tmp_path / "toy" / "t.json").write_text('{"settings": {"quick": true}, "code": "abc"}')
+    (tmp_path / "toy" / "figures.json").write_text('{"t.png": "A toy figure"}')
     page = Page("toy", "Toy", "A toy study.", views=(View("toy/t", "The toy table", (), {}, "t.png"),))
     text = write_report(tmp_path, [page]).read_text()
     assert "reproduce --quick" in text and "code version abc" in text
-    assert "![The toy table](toy/t.png)" in text and "[t.csv](toy/t.csv)" in text
+    assert "![A toy figure](toy/t.png)" in text and "[t.csv](toy/t.csv)" in text
     assert "| 0.25 | \\|x\\| |" in text
     assert "not measured" in text
 
