@@ -1,12 +1,9 @@
 """Viscous Burgers: MPM with exact and calculated acceleration beside FEM and the source's table.
 
-``v_t + v v_x = eps v_xx`` on [0, 2] up to T, data from an exact solution. MPM (point mass, USL, lumped
-mass, reservoir inflow) takes the nodal acceleration from the particles (``a_i = F_i/m_i``,
-"calculated") or from the exact solution ("exact"), beside P1 Galerkin FEM with consistent and lumped
-mass on the same mesh (:mod:`baselines.fem_burgers`). Time steps follow one rule on every mesh
-(``settings["time_steps"]``). Tables: ``errors`` and ``orders`` (C13), ``norms`` (which solution and
-norm match the source), ``timestep`` (time error at one mesh), ``ppc`` (C3), ``lumping`` (C15),
-``diagnosis`` (why the calculated acceleration stalls: one setting changed at a time).
+``v_t + v v_x = eps v_xx`` on [0, 2] up to T, data from an exact solution; MPM takes the nodal
+acceleration from the particles ("calculated") or from the exact solution ("exact"), beside P1 FEM
+with consistent and lumped mass on the same mesh. Tables: ``errors``, ``orders`` (C13), ``norms``
+(which solution and norm match the source), ``timestep``, ``ppc`` (C3), ``lumping`` (C15), ``diagnosis``.
 """
 
 from __future__ import annotations
@@ -23,7 +20,7 @@ from mpm_fem.claims import BURGERS_SHOWN
 from mpm_fem.errors import fitted_order, observed_orders, orders_row
 from mpm_fem.plots import Curve, Plot
 from mpm_fem.problems import burgers
-from mpm_fem.study import StudyOptions, script_main, write_table
+from mpm_fem.study import StudyOptions, publish, script_main
 
 NAME = "burgers"
 H = source.BURGERS_H
@@ -43,12 +40,12 @@ METHODS = {  # name: (label, solver, settings, the source's row it stands beside
     "fem_consistent": ("FEM consistent", "fem", {"mass": "consistent"}, None),
     "fem_lumped": ("FEM lumped", "fem", {"mass": "lumped"}, None),
 }
-# The meshes each method runs on. The explicit viscous limit makes a run at h cost ~ eps/h^3; the
-# finest meshes are spent on the default solution and on the methods that need them to show their order.
+# The meshes each method runs on: a run costs ~ eps/h^3 (viscous limit), the finest go where the order needs them.
 MESHES = {
     "default": {"mpm_calculated": H, "mpm_calculated_16": H[:3], "mpm_exact_dt_h": H, "mpm_exact": H[:3], "fem_consistent": H[:3], "fem_lumped": H[:3]},
     "other": {"mpm_calculated": H[:3], "mpm_exact_dt_h": H, "mpm_exact": H[:3], "fem_consistent": H[:2], "fem_lumped": H[:2]},
 }
+_MPM = ("mpm_calculated", "mpm_exact")
 PPC, PPC_H, TIME_H, REFINE, PROFILE_H = (1, 2, 4, 8, 16, 32), (0.01, 0.0025), 0.005, (1, 4, 16), 0.01
 LUMPING_CFL = 0.3  # the consistent particle mass needs dt <= h^2/(6 eps): both masses run with CFL 0.3
 DIAGNOSIS = {  # label: changes to the calculated-acceleration run
@@ -69,10 +66,8 @@ def run_case(case: dict) -> dict:
     if case["solver"] == "fem":
         solution = make_solution(case["solution"], case["eps"])
         r = fem_burgers.solve(solution, case["h"], T=T, mass=case["mass"], cfl=case["cfl"], cfl_visc=case["cfl_visc"])
-        out = {"ok": True, "nodes": fem_burgers.errors(r, solution), "steps": r.steps, "dt": r.dt}
-        if case.get("profile"):
-            out["profile"] = _rounded(dict(nodes=r.nodes, nodal_velocity=r.v))
-        return out
+        profile = {"profile": _rounded(dict(nodes=r.nodes, nodal_velocity=r.v))} if case.get("profile") else {}
+        return {"ok": True, "nodes": fem_burgers.errors(r, solution), "steps": r.steps, "dt": r.dt, **profile}
     settings = burgers.BurgersSettings(**{k: v for k, v in case.items() if k not in ("solver", "profile")})
     try:
         r = burgers.simulate(settings, progress=False)
@@ -110,42 +105,32 @@ def _cost(case: dict) -> float:
 
 def _plan(quick: bool) -> dict:
     q = QUICK if quick else {}
-    solutions, eps_list, skip = q.get("solutions", SOLUTIONS), q.get("eps", EPS), q.get("skip", ())
-    plan = defaultdict(dict)
-    for sol in solutions:
-        for m, hs in MESHES["default" if sol == DEFAULT else "other"].items():
-            for eps in eps_list:
-                for h in hs:
-                    if m not in skip and not (quick and (h not in q["H"] or (m in q["short"] and h not in q["H"][:2]))):
-                        plan["table"][(sol, m, eps, h)] = method_case(m, sol, eps, h)
-    for eps in (e for e in (EPS[0], EPS[-1]) if e in eps_list):
-        for m in (m for m in METHODS if m not in skip):
-            plan["profile"][(m, eps)] = {**method_case(m, DEFAULT, eps, PROFILE_H), "profile": True}
-    for eps in q.get("time_eps", (EPS[0], EPS[-1])):
-        for m in q.get("time_methods", ("mpm_calculated", "mpm_exact", "mpm_exact_dt_h")):
-            for k in REFINE:
-                plan["timestep"][(m, eps, k)] = method_case(m, DEFAULT, eps, q.get("TIME_H", TIME_H), **({"refine": k} if k > 1 else {}))
-    for m in ("mpm_calculated", "mpm_exact"):
-        for h in q.get("PPC_H", PPC_H):
-            for n in q.get("PPC", PPC):
-                plan["ppc"][(m, h, n)] = method_case(m, DEFAULT, EPS[0], h, ppc=n)
-    for h in q.get("lumping_H", H[:3]):
-        for m, mass in [(m, mass) for m in ("mpm_calculated", "mpm_exact") for mass in ("lumped", "consistent")]:
-            plan["lumping"][(m, mass, h)] = method_case(m, DEFAULT, EPS[0], h, mass=mass, cfl=LUMPING_CFL)
-        for m in ("fem_consistent", "fem_lumped"):
-            plan["lumping"][(m, METHODS[m][2]["mass"], h)] = method_case(m, DEFAULT, EPS[0], h)
-    for h in q.get("diagnosis_H", H[:3]):
-        for label, changes in DIAGNOSIS.items():
-            plan["diagnosis"][(label, h)] = method_case("mpm_calculated", DEFAULT, EPS[0], h, **changes)
-    return plan
+    eps_list, skip, time_h, fem = q.get("eps", EPS), q.get("skip", ()), q.get("TIME_H", TIME_H), ("fem_consistent", "fem_lumped")
+    kept = lambda m, h: m not in skip and not (quick and (h not in q["H"] or (m in q["short"] and h not in q["H"][:2])))  # noqa: E731
+    return {
+        "table": {(s, m, e, h): method_case(m, s, e, h) for s in q.get("solutions", SOLUTIONS)
+                  for m, hs in MESHES["default" if s == DEFAULT else "other"].items() for e in eps_list for h in hs if kept(m, h)},
+        "profile": {(m, e): {**method_case(m, DEFAULT, e, PROFILE_H), "profile": True}
+                    for e in (EPS[0], EPS[-1]) if e in eps_list for m in METHODS if m not in skip},
+        "timestep": {(m, e, k): method_case(m, DEFAULT, e, time_h, **({"refine": k} if k > 1 else {}))
+                     for e in q.get("time_eps", (EPS[0], EPS[-1])) for m in q.get("time_methods", _MPM + ("mpm_exact_dt_h",))
+                     for k in REFINE},
+        "ppc": {(m, h, n): method_case(m, DEFAULT, EPS[0], h, ppc=n) for m in _MPM for h in q.get("PPC_H", PPC_H)
+                for n in q.get("PPC", PPC)},
+        "lumping": {**{(m, mass, h): method_case(m, DEFAULT, EPS[0], h, mass=mass, cfl=LUMPING_CFL) for h in q.get("lumping_H", H[:3])
+                       for m in _MPM for mass in ("lumped", "consistent")},
+                    **{(m, METHODS[m][2]["mass"], h): method_case(m, DEFAULT, EPS[0], h) for h in q.get("lumping_H", H[:3]) for m in fem}},
+        "diagnosis": {(label, h): method_case("mpm_calculated", DEFAULT, EPS[0], h, **changes)
+                      for h in q.get("diagnosis_H", H[:3]) for label, changes in DIAGNOSIS.items()},
+    }
 
 
 def run(options: StudyOptions) -> None:
     """Every case in one sweep (shared cases run once, the longest first), then tables and figures."""
     got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
     folder = options.folder(NAME)
-    settings = {"quick": options.quick, "mpm": MPM, "fem": FEM, "T": T, "domain": [0, 2],
-                "default_solution": DEFAULT, "compared_norm": f"{NORM} over {WHERE}",
+    settings = {"quick": options.quick, "mpm": MPM, "fem": FEM, "T": T, "domain": [0, 2], "default_solution": DEFAULT,
+                "compared_norm": f"{NORM} over {WHERE}",
                 "methods": {k: {"label": v[0], "solver": v[1], "settings": v[2], "source_row": v[3]} for k, v in METHODS.items()},
                 "time_steps": {
                     "mpm_calculated and mpm_exact": f"dt = CFL min(h/max|v_p|, h^2/(2 eps)), CFL {MPM['cfl']}",
@@ -159,12 +144,7 @@ def run(options: StudyOptions) -> None:
     extra = {"timestep": {"refine": list(REFINE), "meaning": "time_error = |E(dt) - E(dt/16)|; time_below_space: time "
                           "error < E(dt/16) (the space error)"}, "lumping": {"mpm_cfl": LUMPING_CFL},
              "diagnosis": {"diagnosis": dict(DIAGNOSIS), "solution": DEFAULT}}
-    for name, rows in tables.items():
-        if rows:
-            write_table(folder, name, rows, {**settings, **extra.get(name, {})})
-    for plot in PLOTS:
-        if tables[plot.table]:
-            plots.draw(folder, plot, tables[plot.table])
+    publish(folder, tables, settings, extra, PLOTS)
     _profiles(folder / "profiles.png", got)
 
 
@@ -176,15 +156,11 @@ def _norms_of(r: dict, wheres=("particles", "nodes")) -> dict:
     return {f"{w}_{k}": _value(r, w, k) for w in wheres for k in ("L1", "L2", "max")}
 
 
-def _source(method: str, eps: float, h: float):
-    return source.burgers_value(METHODS[method][3], eps, h)
-
-
 def _errors(got: dict) -> tuple[list, list]:
     rows, order_rows, series = [], [], defaultdict(dict)
     key = lambda kv: (SOLUTIONS.index(kv[0][0]), list(METHODS).index(kv[0][1]), -kv[0][2], -kv[0][3])  # noqa: E731
     for (sol, m, eps, h), r in sorted(got["table"].items(), key=key):
-        src = _source(m, eps, h)
+        src = source.burgers_value(METHODS[m][3], eps, h)
         row = {"solution": sol, "method": m, "eps": eps, "h": h, **_norms_of(r)}
         row.update({"source": src if src is not None else "", "source_corrected": "yes" if (METHODS[m][3], eps, h) in CORRECTED else "",
                     f"ratio_{WHERE}_{NORM}": row[f"{WHERE}_{NORM}"] / src if src else "",
@@ -193,7 +169,7 @@ def _errors(got: dict) -> tuple[list, list]:
         series[(sol, m, eps)][h] = row
     for (sol, m, eps), by_h in series.items():
         hs = sorted(by_h, reverse=True)
-        src = [_source(m, eps, h) for h in hs]
+        src = [source.burgers_value(METHODS[m][3], eps, h) for h in hs]
         for where in ("particles", "nodes"):
             for norm in ("L1", "L2", "max"):
                 v = np.array([by_h[h][f"{where}_{norm}"] for h in hs])
@@ -208,7 +184,7 @@ def _norms(got: dict) -> list[dict]:
     (max/min over the common cells of the table), and the spread over eps on the finest common mesh."""
     groups = defaultdict(list)
     for (sol, m, eps, h), r in got["table"].items():
-        src = _source(m, eps, h)
+        src = source.burgers_value(METHODS[m][3], eps, h)
         for (where, norm), v in ({} if src is None else {tuple(k.split("_")): v for k, v in _norms_of(r).items()}).items():
             if np.isfinite(v) and v > 0:
                 groups[(sol, m, where, norm)].append((eps, h, v, src))
@@ -273,35 +249,31 @@ STYLE = {"mpm_calculated": ("o-", "tab:blue"), "mpm_calculated_16": ("o--", "tab
          "mpm_exact_dt_h": ("D-", "tab:red"), "fem_consistent": ("^--", "tab:green"), "fem_lumped": ("v--", "tab:olive")}
 
 
-def _curves(methods, label="{}", y=None, **where) -> tuple[Curve, ...]:
-    """A curve per method, in its style; ``y`` defaults to the compared norm (FEM: over nodes)."""
-    return tuple(Curve(label.format(METHODS[m][0]), y or f"{'nodes' if m.startswith('fem') else WHERE}_{NORM}", STYLE[m][0],
-                       {**where, "method": m}, options={"color": STYLE[m][1]}) for m in methods)
+def _curves(methods, label="{m}", y=None, group=(), **where) -> tuple[Curve, ...]:
+    """A curve per method in its style (``{m}`` in ``label``: its name); ``y`` defaults to the compared
+    norm (FEM: over nodes)."""
+    return tuple(Curve(label.replace("{m}", METHODS[m][0]), y or f"{'nodes' if m.startswith('fem') else WHERE}_{NORM}",
+                       STYLE[m][0], {**where, "method": m}, group=group, options={"color": STYLE[m][1]}) for m in methods)
 
 
-_BESIDE_SOURCE = _curves(METHODS) + (Curve("source, exact a", "source", "ks", {"method": "mpm_exact_dt_h"}),
-                                     Curve("source, calculated a", "source", "ko", {"method": "mpm_calculated"}))
-_ERROR = f"velocity error ({NORM}; MPM over {WHERE}, FEM over nodes)"
+def _beside_source(**where) -> tuple[Curve, ...]:
+    return _curves(METHODS, **where) + tuple(Curve(f"source, {row} a", "source", fmt, {**where, "method": m})
+                                             for row, fmt, m in (("exact", "ks", "mpm_exact_dt_h"), ("calculated", "ko", "mpm_calculated")))
+
+
+_ERROR = dict(ylabel=f"velocity error ({NORM}; MPM over {WHERE}, FEM over nodes)", slopes=(1, 2))
 PLOTS = (
     Plot("convergence.png", f"Burgers, T = {T}: velocity error against h ({DEFAULT} solution), open black: the source",
-         "errors", "h", tuple(Curve(c.label, c.y, c.fmt, {**c.where, "solution": DEFAULT}, options=c.options) for c in _BESIDE_SOURCE),
-         ylabel=_ERROR, slopes=(1, 2), split=("eps",), size=(4.2, 4.0)),
+         "errors", "h", _beside_source(solution=DEFAULT), split=("eps",), size=(4.2, 4.0), **_ERROR),
     Plot("solutions.png", "Every candidate exact solution: velocity error against h", "errors", "h",
-         tuple(Curve(c.label, c.y, c.fmt, {**c.where, "eps": (EPS[0], EPS[-1])}, options=c.options) for c in _BESIDE_SOURCE),
-         ylabel=_ERROR, slopes=(1, 2), split=("eps", "solution"), ncols=len(SOLUTIONS), size=(4.2, 3.8)),
+         _beside_source(eps=(EPS[0], EPS[-1])), split=("eps", "solution"), ncols=len(SOLUTIONS), size=(4.2, 3.8), **_ERROR),
     Plot("ppc.png", f"C3, Burgers: error against N_p ({DEFAULT}, eps = {EPS[0]})", "ppc", "ppc",
-         tuple(Curve(f"{METHODS[m][0]}, h = {{h}}", f"{WHERE}_{NORM}", STYLE[m][0], {"method": m}, group=("h",),
-                     options={"color": STYLE[m][1]}) for m in ("mpm_calculated", "mpm_exact")),
-         xlabel="particles per cell N_p", ylabel=f"velocity error ({NORM} over {WHERE})"),
+         _curves(_MPM, "{m}, h = {h}", group=("h",)), xlabel="particles per cell N_p", ylabel=_ERROR["ylabel"]),
     Plot("lumping.png", f"C15: lumped against consistent mass ({DEFAULT}, eps = {EPS[0]}; MPM CFL {LUMPING_CFL})", "lumping",
-         "h", tuple(Curve(f"{METHODS[m][0]}, {mass}", "L2", ("-" if mass == "consistent" else ":") + STYLE[m][0][0],
-                          {"method": m, "mass": mass}, options={"color": STYLE[m][1]})
-                    for m in METHODS if m != "mpm_calculated_16" and m != "mpm_exact_dt_h" for mass in ("consistent", "lumped")),
-         ylabel=f"velocity error (L2; MPM over {WHERE}, FEM over nodes)", slopes=(1, 2)),
+         "h", _curves(_MPM + ("fem_consistent", "fem_lumped"), "{m}, {mass}", "L2", ("mass",)), **{**_ERROR, "ylabel": "velocity error (L2)"}),
     Plot("timestep.png", f"Time error at fixed h: dt / {', '.join(map(str, REFINE))}", "timestep", "dt",
-         tuple(Curve(f"{METHODS[m][0]}, eps = {{eps}}", f"{WHERE}_{NORM}", STYLE[m][0], {"method": m}, group=("eps",),
-                     options={"color": STYLE[m][1]}) for m in ("mpm_calculated", "mpm_exact", "mpm_exact_dt_h")),
-         xlabel="dt (smallest step of the run)", ylabel=f"velocity error ({NORM} over {WHERE})"),
+         _curves(_MPM + ("mpm_exact_dt_h",), "{m}, eps = {eps}", group=("eps",)), xlabel="dt (smallest step of the run)",
+         ylabel=_ERROR["ylabel"]),
     Plot("diagnosis.png", f"Why the calculated acceleration stalls ({DEFAULT}, eps = {EPS[0]}): one change at a time",
          "diagnosis", "h", (Curve("{variant}", f"{WHERE}_L1", "o-", group=("variant",)),),
          ylabel=f"velocity error (L1 over {WHERE})", slopes=(1, 2), size=(6.2, 4.6)),
@@ -309,21 +281,19 @@ PLOTS = (
 
 
 def _profiles(path, got) -> None:
-    """Velocity and its error at T on the profile mesh, one row per eps shown."""
-    eps_list = sorted({e for (_, e) in got["profile"]}, reverse=True)
+    """Velocity and its error at T on the profile mesh, one row per eps: particles (MPM), nodes (FEM)."""
     xe, exact, rows = np.linspace(0, 2, 2001), {}, {}
-    for eps in eps_list:
-        v = make_solution(DEFAULT, eps).v
-        exact[f"eps = {eps}"] = {"velocity": (xe, v(xe, T)), "error v - v_exact at T": (xe, 0 * xe)}
-        rows[f"eps = {eps}"] = [("exact, t = 0", xe, {"velocity": v(xe, 0.0)}, "k:", {"lw": 0.8})] + [
-            (METHODS[m][0], x, {"velocity": u, "error v - v_exact at T": u - v(x, T)}, "." if METHODS[m][1] == "mpm" else "-",
-             {"ms": 1.5, "color": STYLE[m][1]} if METHODS[m][1] == "mpm" else {"lw": 0.9, "color": STYLE[m][1]})
-            for m in METHODS if got["profile"].get((m, eps), {}).get("ok")
-            for p in [got["profile"][(m, eps)]["profile"]]
-            for x, u in [(np.array(p["x"]), np.array(p["velocity"])) if "x" in p else (np.array(p["nodes"]), np.array(p["nodal_velocity"]))]]
+    for eps in sorted({e for (_, e) in got["profile"]}, reverse=True):
+        v, row = make_solution(DEFAULT, eps).v, f"eps = {eps}"
+        exact[row] = {"velocity": (xe, v(xe, T)), "error at T": (xe, 0 * xe)}
+        rows[row] = [("exact, t = 0", xe, {"velocity": v(xe, 0.0)}, "k:", {"lw": 0.8})]
+        for m in (m for m in METHODS if got["profile"].get((m, eps), {}).get("ok")):
+            p, mpm = got["profile"][(m, eps)]["profile"], METHODS[m][1] == "mpm"
+            x, u = (np.array(p[k]) for k in (("x", "velocity") if mpm else ("nodes", "nodal_velocity")))
+            rows[row].append((METHODS[m][0], x, {"velocity": u, "error at T": u - v(x, T)}, "." if mpm else "-",
+                              {"ms" if mpm else "lw": 1.5 if mpm else 0.9, "color": STYLE[m][1]}))
     if rows:
         plots.profile_grid(path, exact, rows, f"{DEFAULT} solution at T = {T}, h = {PROFILE_H}: particles (MPM), nodes (FEM)")
-
 
 
 if __name__ == "__main__":

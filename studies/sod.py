@@ -21,7 +21,7 @@ from mpm_fem.particles import PositivityError
 from mpm_fem.problems import sod
 from mpm_fem.regions import REGION_NAMES, ExtremaCounter, describe
 from mpm_fem.plots import Curve, Plot
-from mpm_fem.study import StudyOptions, script_main, write_table
+from mpm_fem.study import StudyOptions, publish, script_main
 
 NAME = "sod"
 H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)
@@ -111,10 +111,10 @@ def run(options: StudyOptions) -> None:
     waves = riemann.wave_positions(T, sod.SodSettings.left, sod.SodSettings.right)
     extra = {"regions": {"regions": describe(REGION_HALF_WIDTH, waves, T)}, "extrema": {
         "rtol": 1e-9, "definition": "new strict local extremum among position-ordered particles"}}
-    for name, rows in tables.items():
-        if rows:
-            write_table(folder, name, rows, {**settings, **extra.get(name, {})})
-    _figures(folder, got, tables)
+    publish(folder, tables, settings, extra, PLOTS)
+    plots.stacked_shares(folder / "regions.png", tables["regions"], REGION_NAMES, f"C12: density L1 error by region of "
+                         f"the exact solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
+    _profiles(folder, got)
 
 
 def _L1(r, where="nodes", norm="L1"):
@@ -238,14 +238,6 @@ PLOTS = (
         for w, name in (("nodes", "grid nodes"), ("particles", "particles"))),
         xlabel="particles per cell N_p", ylabel="density error (L1)", size=(4.5, 3.6)),
 )
-
-
-def _figures(folder, got, t) -> None:
-    for plot in PLOTS:
-        plots.draw(folder, plot, t[plot.table])
-    plots.stacked_shares(folder / "regions.png", t["regions"], REGION_NAMES, f"C12: density L1 error by region of the exact "
-                         f"solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
-    _profiles(folder, got)
 
 
 def _profiles(folder, got) -> None:
