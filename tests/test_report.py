@@ -75,3 +75,18 @@ def test_a_quick_report_links_only_to_its_own_folder(tmp_path):
 def test_cells_keep_four_significant_digits_and_escape_pipes():
     assert [cell("0.0083452"), cell("16"), cell("nan"), cell("a|b")] == ["0.008345", "16", "", "a\\|b"]
     assert markdown_table([{"a": "1", "b": "x"}]) == ["| a | b |", "|---|---|", "| 1 | x |"]
+
+
+def test_readme_results_in_brief_are_generated_from_the_committed_tables():
+    from mpm_fem.report import README_BEGIN, README_END, results_in_brief
+
+    readme = (FIGURES.parent / "README.md").read_text()
+    block = README_BEGIN + readme.split(README_BEGIN, 1)[1].split(README_END, 1)[0] + README_END
+    assert block == results_in_brief(load_tables(FIGURES)), "run `python -m mpm_fem.report --readme README.md`"
+
+
+def test_the_command_refuses_a_missing_folder(tmp_path, capsys):
+    from mpm_fem.report import main
+
+    assert main(["--out", str(tmp_path / "absent")]) == 2
+    assert "no folder" in capsys.readouterr().err
