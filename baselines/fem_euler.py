@@ -52,12 +52,13 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from mpm_fem.grid import Grid, GridError, uniform_grid
+from mpm_fem.grid import Grid
+
+from baselines.galerkin import MASS_KINDS, P1Cells, check_mass, check_settings, mesh, p1_cells
 
 SOD_LEFT = (1.0, 0.0, 1.0)
 SOD_RIGHT = (0.125, 0.0, 0.1)
 SOD_DIAPHRAGM = 0.5
-MASS_KINDS = ("consistent", "lumped")
 
 
 class PositivityError(ArithmeticError):
@@ -108,24 +109,15 @@ class EulerFEMResult:
 
 
 @dataclass(frozen=True, eq=False)
-class _Operators:
-    """Cell connectivity (``a``, ``b`` node of each cell), cell sizes, and the mass solves."""
+class _Operators(P1Cells):
+    """The P1 cells and the solves with the consistent mass."""
 
-    a: np.ndarray
-    b: np.ndarray
-    h: np.ndarray
-    n_nodes: int
-    mass: str
-    lumped: np.ndarray
     solve_free: object = None  # consistent M, for rho and E
     solve_wall: object = None  # consistent M with wall rows replaced by identity, for rho u
 
 
 def _operators(grid: Grid, mass: str) -> _Operators:
-    t = grid.mesh.t
-    x = grid.mesh.p[0]
-    a, b = t[0], t[1]
-    ops = dict(a=a, b=b, h=x[b] - x[a], n_nodes=grid.n_nodes, mass=mass, lumped=grid.lumped_mass)
+    ops = p1_cells(grid, mass)
     if mass == "consistent":
         M = grid.consistent_mass.tocsc()
         keep = np.ones(grid.n_nodes)
@@ -201,20 +193,8 @@ def sod_initial_state(nodes: np.ndarray, gamma: float) -> np.ndarray:
 
 def label(mass: str = "lumped", viscosity: Viscosity = Viscosity()) -> str:
     """The baseline's name with its variant, e.g. ``"FEM P1 lumped (compression-only viscosity)"``."""
-    if mass not in MASS_KINDS:
-        raise ValueError(f"unknown mass {mass!r}: expected one of {MASS_KINDS}")
+    check_mass(mass)
     return f"FEM P1 {mass} ({viscosity.name})"
-
-
-def _validate(h, T, mass, cfl, gamma) -> None:
-    if mass not in MASS_KINDS:
-        raise ValueError(f"unknown mass {mass!r}: expected one of {MASS_KINDS}")
-    if not (np.isfinite(cfl) and 0.0 < cfl <= 1.0):
-        raise ValueError(f"cfl must lie in (0, 1], got cfl={cfl}")
-    if not (np.isfinite(T) and T > 0):
-        raise ValueError(f"final time T must be positive and finite, got T={T}")
-    if not (np.isfinite(gamma) and gamma > 1):
-        raise ValueError(f"gamma must be > 1, got gamma={gamma}")
 
 
 def solve(
@@ -232,11 +212,10 @@ def solve(
     ``mass``) and :class:`PositivityError` naming the step and node if density or pressure
     stops being positive.
     """
-    _validate(h, T, mass, cfl, gamma)
-    try:
-        grid = uniform_grid(0.0, 1.0, h)
-    except GridError as err:
-        raise ValueError(str(err)) from err
+    check_settings(mass, T, cfl=cfl)
+    if not (np.isfinite(gamma) and gamma > 1):
+        raise ValueError(f"gamma must be > 1, got gamma={gamma}")
+    grid = mesh(0.0, 1.0, h)
     ops = _operators(grid, mass)
     U = sod_initial_state(grid.nodes, gamma)
     h_min = float(grid.h.min())
