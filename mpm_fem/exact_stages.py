@@ -103,7 +103,9 @@ def nodal_values(data: GridData, rhs: np.ndarray, kind: str) -> np.ndarray:
         return grid_values(data.shape, data.mass, data.m_i, rhs, kind)
     if kind == "lumped":
         return divide_by_lumped(rhs, data.m_i)
-    return spsolve(data.matrix.tocsc(), rhs)
+    if kind == "consistent":
+        return spsolve(data.matrix.tocsc(), rhs)
+    raise ValueError(f"unknown mass kind {kind!r}; choose one of lumped, consistent")
 
 
 def _pieces(grid: Grid, breakpoints=()) -> np.ndarray:

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from mpm_fem import exact_stages
-from mpm_fem.exact_stages import RiemannFields, exact_projection, fe_mass, quadrature
+from mpm_fem.exact_stages import RiemannFields, exact_projection, fe_mass, nodal_values, quadrature
 from mpm_fem.grid import uniform_grid
 from mpm_fem.models.euler import IdealGas
 from mpm_fem.problems import sod
@@ -118,3 +118,15 @@ def test_exact_projection_mass_agrees_with_and_without_scikit_fem():
     assert sums.matrix is None and fe.matrix is not None
     np.testing.assert_allclose(fe.m_i, sums.m_i, rtol=1e-14)
     np.testing.assert_array_equal(fe.P_i, sums.P_i)
+
+
+@pytest.mark.parametrize("kind", ["lumped", "consistent"])
+def test_solves_with_the_fe_mass_equal_those_with_the_gauss_point_particles(kind):
+    grid = uniform_grid(0.0, 1.0, 0.02)
+    fields = RiemannFields(*SOD, 0.5, 1.4, 0.01)
+    sums = exact_projection(grid, "mpm", fields, 0.1)
+    fe = exact_projection(grid, "mpm", fields, 0.1, with_fe_mass=True)
+    want = nodal_values(sums, sums.P_i, kind)
+    assert np.abs(nodal_values(fe, fe.P_i, kind) - want).max() < 1e-13 * np.abs(want).max()
+    with pytest.raises(ValueError, match="unknown mass kind"):
+        nodal_values(fe, fe.P_i, "diagonal")
