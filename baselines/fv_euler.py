@@ -101,7 +101,8 @@ def _minmod(a, b):
 
 
 def _mc(a, b):
-    return np.where(a * b > 0, np.sign(a) * np.minimum(2.0 * np.minimum(np.abs(a), np.abs(b)), 0.5 * np.abs(a + b)), 0.0)
+    steepest = 2.0 * np.minimum(np.abs(a), np.abs(b))
+    return np.where(a * b > 0, np.sign(a) * np.minimum(steepest, 0.5 * np.abs(a + b)), 0.0)
 
 
 _SLOPES = {"minmod": _minmod, "mc": _mc}
