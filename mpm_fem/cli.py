@@ -95,7 +95,7 @@ def build_parser() -> argparse.ArgumentParser:
     from .problems.burgers import DT_RULES, FORCES, WEIGHTS, BurgersSettings
     from .problems.sod import SodSettings
 
-    parser = argparse.ArgumentParser(
+    parser = guard.OneLineParser(
         prog="mpm-fem",
         description="Where does the error of the Material Point Method come from? "
         "MPM runs, studies and the reproduction of Tran & Berzins' error analysis.",

@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import socket
 import sys
@@ -23,6 +24,15 @@ SCHEDULER_TIMEOUT_S = 3.0
 
 class UsageError(Exception):
     """Bad input: reported on one line, exit status 2."""
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An ``argparse`` parser whose usage errors are one line (exit status 2), not the usage text."""
+
+    def error(self, message: str):
+        if "expected one argument" in message:
+            message += "; write a negative value as --option=VALUE"
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 def available_memory() -> int | None:

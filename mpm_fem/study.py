@@ -122,7 +122,7 @@ def run_study(name: str, options: StudyOptions) -> str:
 def script_main(name: str, argv=None) -> int:
     """Entry point of ``python studies/<name>.py``: the same options, errors and exit statuses as
     ``mpm-fem study <name>``."""
-    parser = argparse.ArgumentParser(prog=f"studies/{name}.py", description=f"Run the {name} study.")
+    parser = guard.OneLineParser(prog=f"studies/{name}.py", description=f"Run the {name} study.")
     add_study_options(parser)
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
 
