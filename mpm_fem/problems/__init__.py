@@ -68,7 +68,7 @@ def check_run_settings(settings, domain: tuple[float, float], cfl_limit: float) 
     if isinstance(settings.seed, bool) or not isinstance(settings.seed, int) or settings.seed < 0:
         raise ValueError(f"the random seed must be an integer >= 0, got {settings.seed!r}")
     if not (np.isfinite(settings.T) and settings.T >= 0):
-        raise ValueError(f"the final time T must be >= 0, got {settings.T}")
+        raise ValueError(f"the final time T must be finite and >= 0, got {settings.T}")
     if not (0 < settings.cfl <= cfl_limit):
         raise ValueError(f"the CFL number must lie in (0, {cfl_limit:g}] with {settings.mass} mass "
                          f"(the stable range of the explicit step), got {settings.cfl}")
