@@ -55,8 +55,8 @@ HELP = {
     "dt_rule": "time step: stable (CFL min(h/max|v|, h^2/(2 eps))) or advective (CFL h/max|v|, exact acceleration only)",
 }
 BURGERS_HELP = {
-    "cfl": "CFL number: dt = CFL min(h/max|v|, h^2/(2 eps)); stable range (0, 1] with lumped mass, (0, 1/3] with "
-           "consistent mass",
+    "cfl": "CFL number: dt = CFL min(h/max|v|, h^2/(2 eps)); stable range (0, 1], (0, 1/3] with consistent mass and the "
+           "calculated acceleration",
 }
 
 
@@ -141,6 +141,10 @@ def _prepare(args, problem: str, module, settings_cls):
     all before anything is allocated. A default folder (named by the settings hash, so it holds the
     same run) is replaced on a rerun; an explicit ``--out`` needs ``--overwrite`` if not empty."""
     settings = _settings(settings_cls, args)
+    try:
+        module.check_stable(settings)
+    except ValueError as err:
+        raise UsageError(str(err)) from None
     if args.save_fields is not None and args.save_fields < 1:
         raise UsageError(f"--save-fields takes a step interval >= 1, got {args.save_fields}")
     cost = module.cost(settings)
