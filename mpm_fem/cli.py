@@ -4,8 +4,12 @@
     mpm-fem burgers  [--h 0.01] [--eps 0.045] [--acceleration exact|calculated] [--solution NAME] ...
 
 Each option's default is the field default of the problem's settings dataclass (one place).
-Bad input ends with a one-line message and exit status 2; a run that fails (lost positivity)
-with a one-line message and exit status 1.
+Before a run allocates anything its cost is estimated from the settings and checked
+(:mod:`mpm_fem.guard`); the run then writes into a temporary folder renamed into place when done
+(:func:`mpm_fem.output.staged_dir`). Bad input ends with a one-line message and exit status 2; a
+run that fails (lost positivity) with a one-line message and exit status 1; Ctrl-C with one line
+and exit status 130. The study options are parsed by :mod:`mpm_fem.study`, which the study
+scripts use without this module.
 """
 
 from __future__ import annotations
