@@ -115,7 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     from studies import STUDIES
 
-    study = sub.add_parser("study", help="run one study: tables and figures into figures/<name>/",
+    study = sub.add_parser("study", help="run one study: tables and figures into figures/<name>/ (figures/quick/<name>/ with --quick)",
                            description="Run one study of the error analysis; results are cached per case.")
     study.add_argument("name", choices=STUDIES, help="which study")
     add_study_options(study)
