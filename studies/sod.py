@@ -151,7 +151,7 @@ def _convergence(got) -> list[dict]:
             "mpm_volume_drift": r.get("volume_drift", ""), "mpm_head_shift": r.get("head_shift", ""),
             "fem_consistent_head_shift": got["fem_consistent"][h].get("head_shift", ""),
             "mpm_steps": r.get("steps"), "mpm_particles": r.get("particles"),
-            "mpm_wall_s": round(r.get("wall_s", float("nan")), 2)})
+            "mpm_wall_s": round(r.get("wall_s", float("nan")), 2), "mpm_energy_drift": r.get("energy_drift", "")})
         rows.append(row)
     return rows
 
