@@ -1,6 +1,6 @@
 """Exact solutions of the viscous Burgers equation ``v_t + v v_x = eps v_xx``.
 
-Source: the candidates (a)-(d) of STUDY.md, "Problem settings" (the slides of Tran & Berzins do
+Source: the candidates (a)-(d) of docs/claims.md, "Problem settings" (the slides of Tran & Berzins do
 not say which exact solution their Burgers table used). All four are Cole-Hopf solutions
 
     v = -2 eps phi_x / phi,        phi_t = eps phi_xx                                   (CH)
@@ -26,7 +26,7 @@ The wave (c) and the rarefaction (d) state their formulas in their classes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from typing import ClassVar
 
 import numpy as np
@@ -37,6 +37,11 @@ __all__ = ["Front", "ThreeExponential", "ColeHopfWave", "Rarefaction", "SOLUTION
 
 def _broadcast(x, t):
     return np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(t, dtype=float))
+
+
+def _above(default: float, bound: float, why: str):
+    """A parameter that must exceed ``bound`` (checked by ``_BurgersSolution.__post_init__``)."""
+    return field(default=default, metadata={"above": bound, "why": why})
 
 
 @dataclass(frozen=True)
@@ -51,25 +56,32 @@ class _BurgersSolution:
     def __post_init__(self):
         if not np.isfinite(self.eps) or self.eps <= 0.0:
             raise ValueError(f"{self.name}: the viscosity must satisfy eps > 0, got eps = {self.eps}")
+        for parameter in fields(self):
+            if "above" in parameter.metadata:
+                value, bound = getattr(self, parameter.name), parameter.metadata["above"]
+                if not value > bound:
+                    raise ValueError(f"{self.name}: {parameter.name} must be > {bound:g} "
+                                     f"{parameter.metadata['why']}, got {parameter.name} = {value}")
 
     def _fields(self, x, t):
+        """``(v, v_x, v_xx, v_t)`` at the arrays ``x``, ``t`` of one shape."""
         raise NotImplementedError
 
     def fields(self, x, t):
         """``(v, v_x, v_xx, v_t)`` at ``(x, t)`` from one evaluation."""
-        return self._fields(x, t)
+        return self._fields(*_broadcast(x, t))
 
     def v(self, x, t):
-        return self._fields(x, t)[0]
+        return self.fields(x, t)[0]
 
     def v_x(self, x, t):
-        return self._fields(x, t)[1]
+        return self.fields(x, t)[1]
 
     def v_xx(self, x, t):
-        return self._fields(x, t)[2]
+        return self.fields(x, t)[2]
 
     def v_t(self, x, t):
-        return self._fields(x, t)[3]
+        return self.fields(x, t)[3]
 
 
 def _exponential_mixture(x, t, eps, kappa, tau, c):
@@ -98,7 +110,7 @@ def _exponential_mixture(x, t, eps, kappa, tau, c):
 
 @dataclass(frozen=True)
 class Front(_BurgersSolution):
-    """(a) Travelling front ``v = 0.5 - 0.5 tanh((x - x0 - t/2) / (4 eps))``, STUDY.md (a).
+    """(a) Travelling front ``v = 0.5 - 0.5 tanh((x - x0 - t/2) / (4 eps))``, docs/claims.md (a).
 
     The viscous shock from 1 (left) to 0 (right) moving at the Rankine-Hugoniot speed 1/2, width
     ~ 4 eps. It is the two-term mixture ``phi = exp(-(x - x0 - t/2)/(2 eps)) + 1`` (values 1, 0),
@@ -121,7 +133,7 @@ class Front(_BurgersSolution):
 
 @dataclass(frozen=True)
 class ThreeExponential(_BurgersSolution):
-    """(b) Berzins' three-exponential solution, STUDY.md (b):
+    """(b) Berzins' three-exponential solution, docs/claims.md (b):
 
         v = (0.1 e^-a + 0.5 e^-b + e^-c) / (e^-a + e^-b + e^-c),
         a = 0.05/eps (x - 0.5 + 4.95 t),  b = 0.25/eps (x - 0.5 + 0.75 t),  c = 0.5/eps (x - 0.375).
@@ -145,7 +157,7 @@ class ThreeExponential(_BurgersSolution):
 
 @dataclass(frozen=True)
 class ColeHopfWave(_BurgersSolution):
-    """(c) Decaying Cole-Hopf wave, STUDY.md (c), from ``phi = A + E cos(pi x)``,
+    """(c) Decaying Cole-Hopf wave, docs/claims.md (c), from ``phi = A + E cos(pi x)``,
     ``E = exp(-pi^2 eps t)``:
 
         v    = 2 eps pi E sin(pi x) / D,                     D = A + E cos(pi x),
@@ -157,17 +169,11 @@ class ColeHopfWave(_BurgersSolution):
     sqrt(A^2 - 1)``, so the amplitude is proportional to eps.
     """
 
-    A: float = 2.0
+    A: float = _above(2.0, 1.0, "so that phi > 0")
 
     name: ClassVar[str] = "cole_hopf"
 
-    def __post_init__(self):
-        super().__post_init__()
-        if not self.A > 1.0:
-            raise ValueError(f"cole_hopf: A must be > 1 so that phi > 0, got A = {self.A}")
-
     def _fields(self, x, t):
-        x, t = _broadcast(x, t)
         eps, big_a, pi = self.eps, self.A, np.pi
         decay = np.exp(-(pi**2) * eps * t)
         sin, cos = np.sin(pi * x), np.cos(pi * x)
@@ -189,7 +195,7 @@ def _log_erfcx(z):
 
 @dataclass(frozen=True)
 class Rarefaction(_BurgersSolution):
-    """(d) Viscous rarefaction, STUDY.md (d): the Cole-Hopf solution of the step ``v = u_left``
+    """(d) Viscous rarefaction, docs/claims.md (d): the Cole-Hopf solution of the step ``v = u_left``
     for ``x < x_step``, ``u_right`` for ``x > x_step``, at time ``s = t0 + t`` (``t0 > 0`` makes the
     data at ``t = 0`` smooth).
 
@@ -222,17 +228,11 @@ class Rarefaction(_BurgersSolution):
     u_left: float = 0.5
     u_right: float = 1.0
     x_step: float = 0.5
-    t0: float = 0.05
+    t0: float = _above(0.05, 0.0, "so that the data are smooth")
 
     name: ClassVar[str] = "rarefaction"
 
-    def __post_init__(self):
-        super().__post_init__()
-        if not self.t0 > 0.0:
-            raise ValueError(f"rarefaction: t0 must be > 0 so that the data are smooth, got t0 = {self.t0}")
-
     def _fields(self, x, t):
-        x, t = _broadcast(x, t)
         eps, u_l, u_r = self.eps, self.u_left, self.u_right
         du = u_r - u_l
         s = self.t0 + t
