@@ -128,12 +128,23 @@ def main(argv=None) -> None:
           "bytes moved per particle-step | bandwidth bound, particle-steps/s | fraction of the bound | "
           "2 threads / 1 thread |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    verdicts = []
     for basis, at, s_fused, s_numpy in summary:
         moved = bytes_moved(basis)
         bound = bandwidth / moved
         ratio = threads_ratio(basis, at["n_p"], args.repeat)
-        print(f"| {basis} | {at['fused_rate']:.3g} | {at['fused_rate'] / at['numpy_rate']:.1f} | {s_fused:.2f} | "
+        speedup = at["fused_rate"] / at["numpy_rate"]
+        print(f"| {basis} | {at['fused_rate']:.3g} | {speedup:.1f} | {s_fused:.2f} | "
               f"{s_numpy:.2f} | {moved} | {bound:.3g} | {at['fused_rate'] / bound:.2f} | {ratio:.2f} |")
+        rate_target = 3e7 if basis == "mpm" else 1e7
+        verdicts.append(f"{basis}: {at['fused_rate']:.3g} particle-steps/s at {at['n_p']:.0e} "
+                        f"(target >= {rate_target:.0e}: {'met' if at['fused_rate'] >= rate_target else 'NOT met'})")
+        if basis == "mpm":
+            verdicts.append(f"mpm: fused / numpy {speedup:.1f} (target >= 5: {'met' if speedup >= 5 else 'NOT met'})")
+        verdicts.append(f"{basis}: slope {s_fused:.2f} (target 1.0 +- 0.1: {'met' if abs(s_fused - 1) <= 0.1 else 'NOT met'})")
+        held = at["bytes_per_particle"]
+        verdicts.append(f"{basis}: {held:.0f} B per particle (target <= 250: {'met' if held <= 250 else 'NOT met'})")
+    print("\nTargets:\n" + "\n".join(f"- {v}" for v in verdicts))
 
 
 if __name__ == "__main__":
