@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import types
 
-import numba
 import numpy as np
 from numba import njit, prange
 
@@ -459,7 +458,10 @@ class FusedStep:
     """The fused step of one run: ``step(particles, t, dt) -> (particles, GridState)``, as
     :func:`~mpm_fem.step.explicit_step` (the same numbers on one thread). After each step
     ``speed`` holds ``max_p (c_p + |v_p|)`` (gas) or ``max_p |v_p|`` (Burgers) of the new particles
-    and ``finite`` whether their state is finite, for the time step and the run's checks."""
+    and ``finite`` whether their state is finite, for the time step and the run's checks. With
+    ``reuse`` the step writes into two alternating sets of arrays instead of fresh ones (no page
+    faults on a new 8 MB array per field and step): the particles a step returns are overwritten
+    two steps later, so a run that hands them to an observer does not reuse."""
 
     def __init__(self, grid: Grid, model, boundary, stages: Stages = Stages(), exact_acceleration=None,
                  threads: int = 1, reuse: bool = False):
