@@ -1,0 +1,255 @@
+"""The time error of the step (C1) and the jump of d^3 x_p / dt^3 at a node crossing (C2).
+
+C1, ``time_order.csv``: at fixed h and particles, a fixed dt refined 1, 2, 4, 8, 16 times against
+dt / 256 (pulse) or dt / 64 (Burgers), for a smooth acoustic pulse in a gas without viscosity
+(:class:`mpm_fem.timing.PulseSettings`) and for viscous Burgers (the rarefaction, eps = 0.045,
+4 particles per cell, CFL 0.5: the viscous limit fixes dt); ``local_error.csv``: one step from a
+common state (T/2) against 256 substeps, for dt/2 ... dt/16. C2, ``crossing.csv``: the jump of
+``d^3 x_p / dt^3`` at each node crossing of one particle (Burgers rarefaction, h = 0.02, exact and
+calculated acceleration), measured and by the slides' formula (:mod:`mpm_fem.timing`). Every
+basis: point-mass P1 ("mpm"), GIMP and the C1 quadratic B-spline ("bspline").
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from matplotlib.ticker import NullFormatter
+
+from mpm_fem.grid import uniform_grid
+from mpm_fem.models.burgers import ViscousBurgers
+from mpm_fem.plots import plt
+from mpm_fem.problems import burgers
+from mpm_fem.solve import Problem
+from mpm_fem.step import Dirichlet
+from mpm_fem.study import StudyOptions, markdown_table, read_table, script_main, write_table
+from mpm_fem.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, observed_order,
+                            pulse_setup, simulate_pulse, state_at)
+
+NAME = "time"
+BASES = ("mpm", "gimp", "bspline")
+BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
+               scheme="usl", layout="regular", seed=0)
+PULSE = PulseSettings(h=0.02, ppc=8)
+TIME_REFINES = (1, 2, 4, 8, 16)
+TIME_REFERENCE = {"pulse": 256, "burgers": 64}
+LOCAL_SUBSTEPS = 256
+LOCAL_REFINES = (2, 4, 8, 16)  # the full step is pre-asymptotic when a particle crosses a node within it
+CROSSING = dict(h=0.02, ppc=4, solution="rarefaction", eps=0.045, cfl=0.05, T=0.3)
+CROSSING_PARTICLE = 4 * 27 + 1  # starts at x = 0.565, in the fan; it never leaves before T
+QUICK = {"bases": ("mpm", "bspline"), "refines": (1, 2, 4), "reference": {"pulse": 32, "burgers": 16}}
+
+
+# ---------------------------------------------------------------- the plan
+
+def plan(quick: bool) -> dict:
+    bases = QUICK["bases"] if quick else BASES
+    refines, reference = (QUICK["refines"], QUICK["reference"]) if quick else (TIME_REFINES, TIME_REFERENCE)
+    time = {(problem, basis): {"kind": "time", "problem": problem, "basis": basis, "h": 0.02, "refines": list(refines),
+                               "reference": reference[problem]} for problem in ("pulse", "burgers") for basis in bases}
+    crossing = {(basis, acc): {"kind": "crossing", "basis": basis, "acceleration": acc}
+                for basis in bases for acc in ("exact", "calculated")}
+    return {"time": time, "crossing": crossing}
+
+
+# ---------------------------------------------------------------- one case
+
+def _burgers_setup(base):
+    """Problem at the fixed viscous step ``dt = CFL h^2 / (2 eps)``, grid, particles, stages."""
+    a, b = base.exact.domain
+    dt = base.cfl * base.h**2 / (2 * base.eps)
+    problem = Problem(model=ViscousBurgers(base.eps), boundary=Dirichlet(base.exact.v), T=base.T, cfl=1.0, dt=dt,
+                      particle_boundary=burgers.Reservoir(base.h / base.ppc, base.exact.v))
+    grid = uniform_grid(a, b, base.h)
+    return problem, grid, burgers.initial_particles(base, grid), base.stages
+
+
+def time_case(case: dict) -> dict:
+    """C1 at fixed h: global error of a fixed dt refined ``refines`` times against ``reference``,
+    and the local error of one step from the state at T/2."""
+    basis, refines, reference = case["basis"], case["refines"], case["reference"]
+    rows = []
+    if case["problem"] == "pulse":
+        base = replace(PULSE, basis=basis)
+        ref = simulate_pulse(replace(base, refine=reference)).particles
+        for k in refines:
+            P = simulate_pulse(replace(base, refine=k)).particles
+            rows.append({"refine": k, "dt": base.dt / k, **{q: float(np.abs(getattr(P, q) - getattr(ref, q)).mean())
+                                                           for q in ("x", "velocity", "density")}})
+        setup = pulse_setup(base)
+    else:
+        base = burgers.BurgersSettings(h=case["h"], basis=basis, **BURGERS)
+        ref = burgers.simulate(replace(base, refine=reference), progress=False).particles
+        a, b = base.exact.domain
+        for k in refines:
+            result = burgers.simulate(replace(base, refine=k), progress=False)
+            if result.dt_max > result.dt_min * (1 + 1e-9) and result.t - result.dt_min < base.T * (1 - 1e-9):
+                raise RuntimeError("the Burgers time step is not fixed: the advective limit binds")
+            rows.append({"refine": k, "dt": result.dt_max, "velocity": field_difference(
+                result.particles, ref, (a + 0.05 * (b - a), b - 0.05 * (b - a)), "velocity")})
+        setup = _burgers_setup(base)
+    problem, grid, particles, stages = setup
+    dt0 = problem.dt
+    t_mid = round(0.5 * problem.T / dt0) * dt0
+    mid = state_at(problem, grid, particles, stages, t_mid)
+    local = local_errors(problem, grid, mid, stages, t_mid, [dt0 / k for k in LOCAL_REFINES], LOCAL_SUBSTEPS)
+    return {"global": rows, "local": local}
+
+
+def crossing_case(case: dict) -> dict:
+    """C2: one particle's path through the fan of the Burgers rarefaction; the jump of
+    ``dA/dt`` at each node crossing, measured and predicted."""
+    settings = burgers.BurgersSettings(basis=case["basis"], acceleration=case["acceleration"], **CROSSING)
+    recorder = Recorder(CROSSING_PARTICLE)
+    result = burgers.simulate(settings, progress=False, observer=recorder)
+    track = recorder.track()
+    rounded = lambda a: [float(f"{v:.8g}") for v in a]  # noqa: E731
+    return {"rows": crossing_jumps(track, result.grid.nodes),
+            "trace": {"t": rounded(track.t), "A": rounded(track.A), "x": rounded(track.x)}}
+
+
+def run_case(case: dict) -> dict:
+    return {"time": time_case, "crossing": crossing_case}[case["kind"]](case)
+
+
+def run(options: StudyOptions) -> None:
+    """Every case in one sweep, then the tables and figures."""
+    got = options.sweep_plan(NAME, run_case, plan(options.quick))
+    folder = options.folder(NAME)
+    settings = {"burgers": BURGERS, "quick": options.quick, "pulse": PULSE.as_dict(), "crossing": CROSSING,
+                "crossing_particle": CROSSING_PARTICLE, "time_refines": TIME_REFINES,
+                "time_reference": TIME_REFERENCE, "local_substeps": LOCAL_SUBSTEPS, "local_refines": LOCAL_REFINES}
+    rows, local_rows = time_rows(got["time"])
+    write_table(folder, "time_order", rows, settings)
+    write_table(folder, "local_error", local_rows, settings)
+    time_figure(folder / "time_order.png", rows, local_rows)
+    rows = crossing_rows(got["crossing"])
+    write_table(folder, "crossing", rows, settings)
+    crossing_figure(folder / "crossing.png", got["crossing"], rows)
+
+
+# ---------------------------------------------------------------- tables
+
+def _orders(rows: list[dict], q: str) -> tuple[list, float]:
+    """Orders between successive steps and the least-squares order of ``q`` against ``dt``."""
+    dts, errs = [r["dt"] for r in rows], [r[q] for r in rows]
+    return [""] + [float(o) for o in observed_order(dts, errs)], float(np.polyfit(np.log(dts), np.log(errs), 1)[0])
+
+
+def time_rows(got: dict) -> tuple[list, list]:
+    """``time_order``: one row per problem, basis, quantity and dt (global error); ``local_error``:
+    the same for one step from T/2."""
+    rows, local_rows = [], []
+    for (problem, basis), r in got.items():
+        for table, runs, quantities in ((rows, r["global"], ("x", "velocity", "density")),
+                                        (local_rows, r["local"], ("x", "velocity"))):
+            for q in (q for q in quantities if q in runs[0]):
+                orders, fit = _orders(runs, q)
+                table += [{"problem": problem, "basis": basis, "quantity": q, **({"refine": row["refine"]} if "refine" in row else {}),
+                           "dt": row["dt"], "error": row[q], "order": o, "fitted_order": fit} for row, o in zip(runs, orders)]
+    return rows, local_rows
+
+
+def crossing_rows(got: dict) -> list[dict]:
+    """One row per node crossing: measured and predicted jump of dA/dt, and their ratio."""
+    return [{"basis": basis, "acceleration": acc, **row,
+             "ratio": row["measured"] / row["predicted"] if row["predicted"] else float("nan")}
+            for (basis, acc), r in got.items() for row in r["rows"]]
+
+
+# ---------------------------------------------------------------- figures
+
+def _slope_guide(ax, k: int) -> None:
+    line = ax.get_lines()[0]
+    x, y0 = np.asarray(line.get_xdata(), float), float(line.get_ydata()[0])
+    ax.loglog(x, y0 * (x / x[0]) ** k, ":", color="gray", lw=1)
+    ax.annotate(f"slope {k}", (x[-1], y0 * (x[-1] / x[0]) ** k), fontsize=7, color="gray")
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
+def time_figure(path: Path, rows: list[dict], local_rows: list[dict]) -> None:
+    """Global error against dt (pulse, Burgers) with slope 1; local error of x_p with slope 2."""
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4.0))
+    for ax, problem in zip(axes, ("pulse", "burgers")):
+        for basis in BASES:
+            sub = [r for r in rows if (r["problem"], r["basis"], r["quantity"]) == (problem, basis, "velocity")]
+            if sub:
+                ax.loglog([r["dt"] for r in sub], [r["error"] for r in sub], "o-", ms=4,
+                          label=f"{basis} (order {sub[0]['fitted_order']:.2f})")
+        _slope_guide(ax, 1)
+        ax.set(xlabel="dt (fixed h, fixed particles)", ylabel="global velocity error at T (mean |v - v_ref|)")
+        ax.set_title(f"C1, {problem}: global error", fontsize=9)
+        ax.legend(fontsize=7)
+    for problem in ("pulse", "burgers"):
+        for basis in BASES:
+            sub = [r for r in local_rows if (r["problem"], r["basis"], r["quantity"]) == (problem, basis, "x")]
+            if sub:
+                axes[2].loglog([r["dt"] for r in sub], [r["error"] for r in sub], "o-" if problem == "pulse" else "s--",
+                               ms=4, label=f"{problem}, {basis} ({sub[0]['fitted_order']:.2f})")
+    _slope_guide(axes[2], 2)
+    axes[2].set(xlabel="dt", ylabel="local error of one step, max |x_p - x_p^ref|")
+    axes[2].set_title("C1: local error", fontsize=9)
+    axes[2].legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def crossing_figure(path: Path, got: dict, rows: list[dict]) -> None:
+    """dA/dt along the particle's path (exact acceleration) and A itself (calculated), node crossings dotted."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 3.9))
+    for ax, acc in zip(axes, ("exact", "calculated")):
+        for basis in (b for b in BASES if (b, acc) in got):
+            t, A = (np.asarray(got[(basis, acc)]["trace"][k]) for k in ("t", "A"))
+            if acc == "exact":  # d^3 x_p/dt^3 = dA/dt, by differences of successive steps
+                ax.plot(0.5 * (t[1:] + t[:-1]), np.diff(A) / np.diff(t), "-", lw=1, label=basis)
+            else:
+                ax.plot(t, A, "-", lw=0.8, label=basis)
+        for r in rows:
+            if r["basis"] == "mpm" and r["acceleration"] == acc:
+                ax.axvline(r["t_cross"], color="gray", lw=0.5, ls=":")
+        ax.set_xlabel("t")
+        ax.set_ylabel("dA/dt = d^3 x_p / dt^3" if acc == "exact" else "A = sum_i S_ip a_i = d^2 x_p / dt^2")
+        ax.set_title("C2, exact nodal acceleration: P1 jumps at every node crossing (dotted)" if acc == "exact" else
+                     "calculated acceleration: a_i jumps when any particle crosses a node", fontsize=8)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+# ---------------------------------------------------------------- report (tables and captions only)
+
+CAPTIONS = {"time_order.png": "C1: global error against dt at fixed h (slope 1), and the local error of one step (slope 2).",
+            "crossing.png": "C2: dA/dt along one particle's path; P1 jumps at each node crossing, GIMP and the B-spline do not."}
+
+
+def report(folder: Path) -> str:
+    """The fitted orders and the crossing ratios as tables, the figures with their captions."""
+    folder = Path(folder)
+    out = ["## Time error (C1) and grid crossing (C2)", ""]
+    if not (folder / "crossing.csv").exists():
+        return "\n".join(out + ["Not run.", ""])
+    fits = {(r["problem"], r["basis"], r["quantity"]): r for r in read_table(folder / "time_order.csv")}
+    local = {(r["problem"], r["basis"], r["quantity"]): r for r in read_table(folder / "local_error.csv")}
+    rows = [{"problem": p, "basis": b, "quantity": q, "global order": r["fitted_order"],
+             "local order (x)": local.get((p, b, "x"), {}).get("fitted_order", "")} for (p, b, q), r in fits.items()]
+    out += ["### C1: fitted orders in dt", ""] + markdown_table(rows, list(rows[0]))
+    crossing = read_table(folder / "crossing.csv")
+    groups = sorted({(r["basis"], r["acceleration"]) for r in crossing}, key=lambda k: (BASES.index(k[0]), k[1]))
+    summary = []
+    for basis, acc in groups:
+        ratio = np.array([float(r["ratio"]) for r in crossing if (r["basis"], r["acceleration"]) == (basis, acc)])
+        summary.append({"basis": basis, "acceleration": acc, "crossings": len(ratio),
+                        "median measured/predicted": np.median(ratio), "max abs(ratio - 1)": np.max(np.abs(ratio - 1))})
+    out += ["### C2: jump of d^3x_p/dt^3 at node crossings", ""] + markdown_table(summary, list(summary[0]))
+    for name, caption in CAPTIONS.items():
+        out += [f"![{caption}](time/{name})", "", f"*{caption}*", ""]
+    return "\n".join(out)
+
+
+if __name__ == "__main__":
+    sys.exit(script_main(NAME))
