@@ -28,19 +28,14 @@ from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
 from mpm_fem.problems import sod
 from mpm_fem.regions import REGION_NAMES, ExtremaCounter, l1_by_region, mean_by_region, sod_regions
-from mpm_fem.study import StudyOptions, read_table, script_main, write_table
+from mpm_fem import source
+from mpm_fem.report import Page, View
+from mpm_fem.study import StudyOptions, script_main, write_table
 
 NAME = "sod"
 H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)
-# The source's density error table (slides, "Final Error Combination(cont.)")
-SOURCE = {
-    0.01: (0.00830833, 0.0158701),
-    0.005: (0.00433578, 0.0104553),
-    0.0025: (0.00230507, 0.0075895),
-    0.00125: (0.00126351, 0.0057596),
-    0.000625: (0.00109963, 0.0061870),
-    0.0003125: (0.00101256, 0.0062115),
-}
+SOURCE = source.SOD
+T = sod.SodSettings.T
 # One set of MPM settings for every h (never tuned per mesh); why these: ppc.csv and plateau.csv
 MPM = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", scheme="usl", basis="mpm", layout="regular", seed=0)
 FEM = dict(cfl=0.3, viscosity_linear=0.1, viscosity_quadratic=1.0)  # baselines.fem_euler defaults
@@ -219,7 +214,7 @@ def run(options: StudyOptions) -> None:
     plan = _plan(options.quick)
     got = options.sweep_plan(NAME, run_case, plan, cost=_cost)
     folder = options.folder(NAME)
-    settings = {"mpm": MPM, "fem": FEM, "fv": {"cfl": FV_CFL, "scheme": "MUSCL-Hancock + HLLC"}, "region_half_width": REGION_HALF_WIDTH, "T": 0.2,
+    settings = {"mpm": MPM, "fem": FEM, "fv": {"cfl": FV_CFL, "scheme": "MUSCL-Hancock + HLLC"}, "region_half_width": REGION_HALF_WIDTH, "T": T,
                 "quick": options.quick, "problem": sod.SodSettings().as_dict()}
     _convergence(folder, got, settings)
     _regions(folder, got, settings)
@@ -293,7 +288,7 @@ def _convergence(folder, got, settings) -> None:
         series["MPM consistent mass, nodes"] = (cons, [d(got["mpm_consistent"][h], "nodes", "L1") for h in cons], "d:")
     series["source (slides)"] = (hs_src, [SOURCE[h][0] for h in hs_src], "k*")
     plots.convergence(folder / "convergence.png", series, ylabel="density error (L1)", slopes=(0.5, 1),
-                      title="Sod, T=0.2: density L1 error vs h (MPM 16 ppc, CFL 0.05)")
+                      title=f"Sod, T={T}: density L1 error vs h (MPM {MPM['ppc']} ppc, CFL {MPM['cfl']})")
 
 
 def _regions(folder, got, settings) -> None:
@@ -357,7 +352,7 @@ def _region_figure(path, rows) -> None:
     axes[0][0].set_ylabel("share of the density L1 error (total above)")
     handles, labels = axes[0][0].get_legend_handles_labels()
     fig.legend(handles[::-1], labels[::-1], fontsize=7, loc="center right")
-    fig.suptitle(f"C12: density L1 error by region of the exact solution at T = 0.2 (half-width {REGION_HALF_WIDTH})",
+    fig.suptitle(f"C12: density L1 error by region of the exact solution at T = {T} (half-width {REGION_HALF_WIDTH})",
                  fontsize=9)
     fig.tight_layout(rect=(0, 0, 0.89, 1))
     fig.savefig(path, dpi=120)
@@ -396,7 +391,7 @@ def _extrema(folder, got, settings) -> None:
     axes[1].set(xlabel="h", ylabel="new extrema per particle-step")
     for ax in axes:
         ax.legend(fontsize=7)
-    fig.suptitle("C14: new extrema of particle density / energy (MPM, 16 ppc, CFL 0.05)", fontsize=9)
+    fig.suptitle(f"C14: new extrema of particle density / energy (MPM, {MPM['ppc']} ppc, CFL {MPM['cfl']})", fontsize=9)
     fig.tight_layout()
     fig.savefig(folder / "extrema.png", dpi=120)
     plt.close(fig)
@@ -503,227 +498,42 @@ def _profiles(folder, got) -> None:
             ax.set_xlabel("x")
         axes[0][0].legend(fontsize=7)
         axes[1][0].legend(fontsize=7)
-        fig.suptitle(f"Sod at T = 0.2, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh", fontsize=10)
+        fig.suptitle(f"Sod at T = {T}, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh", fontsize=10)
         fig.tight_layout()
         fig.savefig(folder / f"profiles_h{h:g}.png", dpi=110)
         plt.close(fig)
 
 
-# ---------------------------------------------------------------- the report
+# ---------------------------------------------------------------- the report page
 
-def report(folder: Path) -> str:
-    """Markdown section: C11, C12, C14, C3, C15 with verdicts read from the tables."""
-    folder = Path(folder)
-    path = folder / "convergence.csv"
-    if not path.exists():
-        return "## Sod's shock tube (C11, C12, C14, C3, C15)\n\nNot run.\n"
-    return "\n".join(_report_lines(folder)) + "\n"
-
-
-def _f(row, key):
-    v = row.get(key, "")
-    return float(v) if v not in ("", None) else float("nan")
-
-
-def claims(folder: Path) -> list[dict]:
-    """Verdicts on C11, C12, C14, C3, C15 from the written tables."""
-    folder = Path(folder)
-    if not (folder / "convergence.csv").exists():
-        return []
-    conv = read_table(folder / "convergence.csv")
-    out = [_c11(conv)]
-    regions = read_table(folder / "regions.csv")
-    nodes = [r for r in regions if r["method"] == "MPM nodes"]
-    if nodes:
-        b = nodes[-1]
-        top = sorted(range(len(REGION_NAMES)), key=lambda k: -_f(b, f"share_{k}"))[:3]
-        out.append({"id": "C12", "verdict": "measured",
-                    "evidence": f"at h = {b['h']} the nodal L1 splits " + ", ".join(
-                        f"{k} {REGION_NAMES[k]} {_f(b, f'share_{k}'):.0%}" for k in top)
-                    + f"; the shock front carries {_f(nodes[0], 'share_6'):.0%} at h = {nodes[0]['h']}"})
-    ext = read_table(folder / "extrema.csv")
-    rr = [_f(r, "density_rate_ratio") for r in ext]
-    out.append({"id": "C14", "verdict": "confirmed" if min(rr) > 2 else "differs",
-                "evidence": f"a particle crossing a node becomes a new density extremum {min(rr):.0f}-{max(rr):.0f}x more "
-                            f"often than one that does not; new extrema per step grow from "
-                            f"{_f(ext[0], 'density_new_per_step'):.2g} (h = {ext[0]['h']}) to "
-                            f"{_f(ext[-1], 'density_new_per_step'):.2g} (h = {ext[-1]['h']})"})
-    out.append(_c3_claim(read_table(folder / "ppc.csv")))
-    if "fv_L1" in conv[0]:
-        first, last = conv[0], conv[-1]
-        out.append({"id": "E3", "verdict": "measured", "evidence": (
-            "density L1 on the same meshes (convergence.csv, profiles_h*.png): "
-            + "; ".join(f"h = {r['h']}: MPM nodes {_f(r, 'mpm_nodes_L1'):.3g}, FEM lumped {_f(r, 'fem_lumped_L1'):.3g}, "
-                        f"FEM consistent {_f(r, 'fem_consistent_L1'):.3g}, FV {_f(r, 'fv_L1'):.3g}" for r in (first, last))
-            + ". The fixed-mesh methods keep converging where MPM's nodal error levels off")})
-    mass = read_table(folder / "mass.csv")
-    cm = [_f(r, "mpm_consistent_over_lumped_nodes") for r in mass]
-    cf = [_f(r, "fem_consistent_over_lumped") for r in mass]
-    out.append({"id": "C15", "verdict": "partly",
-                "evidence": f"lumping is not where this error comes from: MPM with the consistent particle mass has "
-                            f"x{min(cm):.2f}-{max(cm):.2f} the nodal L1 of the lumped one (h = {mass[0]['h']} ... "
-                            f"{mass[-1]['h']}); fixed-mesh FEM consistent/lumped x{min(cf):.2f}-{max(cf):.2f}"})
-    return out
-
-
-def _c3_claim(rows) -> dict:
-    """Per mesh: the N_p of the smallest error, and the smallest N_p within 5% of it (saturation)."""
-    parts, saturated = [], []
-    for h in dict.fromkeys(r["h"] for r in rows):
-        ok = [r for r in rows if r["h"] == h and r["ok"] == "True"]
-        text = []
-        for where in ("nodes", "particles"):
-            best = min(_f(r, f"{where}_L1") for r in ok)
-            argmin = min(ok, key=lambda r: _f(r, f"{where}_L1"))["ppc"]
-            enough = min(int(r["ppc"]) for r in ok if _f(r, f"{where}_L1") <= 1.05 * best)
-            saturated.append(enough)
-            text.append(f"{where} smallest at N_p = {argmin}, within 5% from N_p = {enough}")
-        parts.append(f"h = {h}: " + ", ".join(text))
-    in_band = [n for n in saturated if 4 <= n <= 8]
-    verdict = "confirmed" if len(in_band) == len(saturated) else ("partly" if in_band else "refuted")
-    return {"id": "C3", "verdict": verdict, "evidence": "; ".join(parts)}
-
-
-def _report_lines(folder: Path) -> list[str]:
-    conv = read_table(folder / "convergence.csv")
-    out = ["## Sod's shock tube (C11, C12, C14, C3, C15)", "",
-           f"MPM with one set of settings for every mesh: {MPM}. FEM: P1, SSPRK3, {FEM}. "
-           "Density error at T = 0.2 against the exact Riemann solution.", "",
-           "### C11: density error vs h, beside the source", "",
-           "| h | source L1 | MPM nodes L1 | ratio | order | source order | source L2 | MPM nodes L2 | ratio | MPM particles L1 | order | FEM cons. L1 | FEM lumped L1 | FV L1 |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in conv:
-        out.append("| " + " | ".join([r["h"], r["source_L1"], f"{_f(r, 'mpm_nodes_L1'):.4g}", f"{_f(r, 'ratio_nodes_L1'):.3f}",
-                                      _o(r, "order_nodes_L1"), _o(r, "source_order_L1"), r["source_L2"],
-                                      f"{_f(r, 'mpm_nodes_L2'):.4g}", f"{_f(r, 'ratio_nodes_L2'):.3f}",
-                                      f"{_f(r, 'mpm_particles_L1'):.4g}", _o(r, "order_particles_L1"),
-                                      f"{_f(r, 'fem_consistent_L1'):.4g}", f"{_f(r, 'fem_lumped_L1'):.4g}",
-                                      f"{_f(r, 'fv_L1'):.4g}" if "fv_L1" in r else ""]) + " |")
-    c = _c11(conv)
-    out += ["", f"**C11** (the density error stops converging): {c['verdict']}; {c['evidence']}.", ""]
-    out += _floor_report(conv) + _regions_report(folder) + _extrema_report(folder) + _ppc_report(folder) + _mass_report(folder)
-    if (folder / "plateau.csv").exists():
-        out += _plateau_report(folder)
-    return out
-
-
-def _o(row, key) -> str:
-    v = row.get(key, "")
-    return f"{float(v):.2f}" if v not in ("", None) else ""
-
-
-def _c11(conv) -> dict:
-    """Verdict on C11: first order on the coarse meshes, then orders below 1/2 (a floor)."""
-    orders = [_f(r, "order_nodes_L1") for r in conv[1:]]
-    ratios = [_f(r, "ratio_nodes_L1") for r in conv]
-    last = conv[-1]
-    full = len(conv) >= 5
-    floor = full and max(orders[-2:]) < 0.5 and min(orders[:3]) > 0.7
-    text = (f"nodal density L1 / source {', '.join(f'{q:.2f}' for q in ratios)} for h = {conv[0]['h']} ... {last['h']}; "
-            f"orders {', '.join(f'{o:.2f}' for o in orders)} (source {', '.join(_o(r, 'source_order_L1') for r in conv[1:])}); "
-            f"over particles {_f(last, 'mpm_particles_L1'):.2g} at h = {last['h']} "
-            f"({_f(last, 'ratio_particles_L1'):.1f}x the source), orders "
-            f"{', '.join(_o(r, 'order_particles_L1') for r in conv[1:])}; nodal L2 / source {_f(last, 'ratio_nodes_L2'):.2f} "
-            "at the finest mesh")
-    if not full:
-        text += " (quick run: the floor lies on the finer meshes of the full run)"
-    return {"id": "C11", "verdict": "confirmed" if floor else "partly", "evidence": text}
-
-
-def _floor_report(conv) -> list[str]:
-    """The diagnostics that explain the floor, per mesh."""
-    out = ["What sets the floor: the particle volume gained by grid-crossing noise (sum V_p - 1: 0 at t = 0, and "
-           "the walls keep the true length 1), the signed mean density error in the smooth region (2), and the position error of the "
-           "rarefaction head (where the density first drops below 0.99; > 0: behind the exact head).", "",
-           "| h | sum V_p - 1 | mean error, region 2, particles | mean error, region 2, nodes | head shift MPM | head shift FEM |",
-           "|---|---|---|---|---|---|"]
-    for r in conv:
-        out.append(f"| {r['h']} | {_f(r, 'mpm_volume_drift'):.2e} | {_f(r, 'mpm_particles_mean_error_smooth'):+.4f} | "
-                   f"{_f(r, 'mpm_nodes_mean_error_smooth'):+.4f} | {_f(r, 'mpm_head_shift'):+.4f} | "
-                   f"{_f(r, 'fem_consistent_head_shift'):+.4f} |")
-    return out + [""]
-
-
-def _regions_report(folder) -> list[str]:
-    rows = read_table(folder / "regions.csv")
-    out = ["### C12: share of the L1 error by region of the exact solution", "",
-           f"Regions of half-width {REGION_HALF_WIDTH} around each wave ({_region_text()['waves at T=0.2']}); "
-           "0 undisturbed, 1 rarefaction head, 2 smooth (fan and plateau), 3 rarefaction tail, 4 contact, "
-           "5 behind the shock, 6 shock front. The shares add up to 1 (column 'sum').", "",
-           "| method | h | L1 | 0 | 1 | 2 | 3 | 4 | 5 | 6 | sum |", "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        if r["method"] not in ("MPM nodes", "MPM particles", "FEM lumped"):
-            continue
-        shares = [_f(r, f"share_{k}") for k in range(len(REGION_NAMES))]
-        out.append(f"| {r['method']} | {r['h']} | {_f(r, 'L1'):.3g} | " + " | ".join(f"{s:.2f}" for s in shares)
-                   + f" | {sum(shares):.3f} |")
-    by = {m: [r for r in rows if r["method"] == m] for m in ("MPM nodes", "MPM particles", "FEM lumped")}
-    if all(by.values()):
-        (n0, n1), (p0, p1), (f0, f1) = ((v[0], v[-1]) for v in by.values())
-        s = lambda r, k: f"{_f(r, f'share_{k}'):.0%}"  # noqa: E731
-        out += ["", f"**C12**: over nodes the smooth region (2) carries {s(n0, 2)} of the MPM error at h = {n0['h']} and "
-                f"{s(n1, 2)} at h = {n1['h']}; the rarefaction head (1) {s(n0, 1)} -> {s(n1, 1)}; the shock front (6) "
-                f"{s(n0, 6)} -> {s(n1, 6)}; the contact (4) {s(n0, 4)} -> {s(n1, 4)}. Over particles region 2 grows "
-                f"{s(p0, 2)} -> {s(p1, 2)} (the density bias of the volume gain above) and region 5 carries "
-                f"{s(p1, 5)} (noise behind the shock, which the nodal average removes). The fixed-mesh FEM's error "
-                f"moves to the contact ({s(f0, 4)} -> {s(f1, 4)}), which MPM, moving with the material, keeps sharp.", ""]
-    return out
-
-
-def _extrema_report(folder) -> list[str]:
-    rows = read_table(folder / "extrema.csv")
-    out = ["### C14: new extrema when particles cross cells", "",
-           "| h | steps | crossings/step | new density extrema/step | rate at crossing | rate elsewhere | ratio | new energy extrema/step | ratio |",
-           "|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        out.append(f"| {r['h']} | {r['steps']} | {_f(r, 'crossings_per_step'):.1f} | {_f(r, 'density_new_per_step'):.2f} | "
-                   f"{_f(r, 'density_rate_crossing'):.2e} | {_f(r, 'density_rate_elsewhere'):.2e} | "
-                   f"{_f(r, 'density_rate_ratio'):.0f} | {_f(r, 'energy_new_per_step'):.2f} | {_f(r, 'energy_rate_ratio'):.0f} |")
-    ratios = [_f(r, "density_rate_ratio") for r in rows]
-    out += ["", f"**C14**: confirmed if a particle that crosses a node is more likely to become a new extremum than one "
-            f"that does not: the ratio of the two rates is {min(ratios):.0f}-{max(ratios):.0f} for density "
-            "(the exact density is monotone, so every extremum is spurious).", ""]
-    return out
-
-
-def _ppc_report(folder) -> list[str]:
-    rows = read_table(folder / "ppc.csv")
-    out = ["### C3: particles per cell", "", "| h | N_p | nodes L1 | particles L1 |", "|---|---|---|---|"]
-    for r in rows:
-        if r["ok"] == "True":
-            out.append(f"| {r['h']} | {r['ppc']} | {_f(r, 'nodes_L1'):.4g} | {_f(r, 'particles_L1'):.4g} |")
-        else:
-            out.append(f"| {r['h']} | {r['ppc']} | failed: {r['error'][:80]} | |")
-    c = _c3_claim(rows)
-    out += ["", f"**C3** (4-8 particles per cell optimal): {c['verdict']}; {c['evidence']}.", ""]
-    return out
-
-
-def _mass_report(folder) -> list[str]:
-    rows = read_table(folder / "mass.csv")
-    out = ["### C15: lumped vs consistent mass", "",
-           "| h | MPM lumped (nodes) | MPM consistent (nodes) | ratio | MPM lumped (particles) | MPM consistent (particles) | FEM lumped | FEM consistent | ratio |",
-           "|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        out.append(f"| {r['h']} | {_f(r, 'mpm_lumped_nodes_L1'):.4g} | {_f(r, 'mpm_consistent_nodes_L1'):.4g} | "
-                   f"{_f(r, 'mpm_consistent_over_lumped_nodes'):.2f} | {_f(r, 'mpm_lumped_particles_L1'):.4g} | "
-                   f"{_f(r, 'mpm_consistent_particles_L1'):.4g} | {_f(r, 'fem_lumped_L1'):.4g} | "
-                   f"{_f(r, 'fem_consistent_L1'):.4g} | {_f(r, 'fem_consistent_over_lumped'):.2f} |")
-    out += [""]
-    return out
-
-
-def _plateau_report(folder) -> list[str]:
-    rows = read_table(folder / "plateau.csv")
-    out = ["### What moves the floor (one setting changed at a time)", "",
-           "| h | variant | nodes L1 | vs study | particles L1 | vs study | new extrema/step |", "|---|---|---|---|---|---|---|"]
-    for r in rows:
-        if r["ok"] == "True":
-            out.append(f"| {r['h']} | {r['variant']} | {_f(r, 'nodes_L1'):.4g} | {_f(r, 'nodes_vs_study'):.2f} | "
-                       f"{_f(r, 'particles_L1'):.4g} | {_f(r, 'particles_vs_study'):.2f} | {_f(r, 'density_new_extrema_per_step'):.2f} |")
-        else:
-            out.append(f"| {r['h']} | {r['variant']} | failed: {r['error'][:60]} | | | | |")
-    return out + [""]
+_CONVERGENCE = ("h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1",
+                "mpm_particles_L1", "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1", "order_fv_L1")
+_FLOOR = ("h", "mpm_volume_drift", "mpm_particles_mean_error_smooth", "mpm_nodes_mean_error_smooth", "mpm_head_shift",
+          "fem_consistent_head_shift")
+_EXTREMA = ("h", "steps", "crossings_per_step", "density_new_per_step", "density_rate_crossing",
+            "density_rate_elsewhere", "density_rate_ratio", "energy_new_per_step", "energy_rate_ratio")
+_SHARES = ("method", "h", "L1") + tuple(f"share_{k}" for k in range(len(REGION_NAMES)))
+_VARIANTS = ("h", "variant", "ok", "nodes_L1", "nodes_vs_study", "particles_L1", "particles_vs_study",
+             "density_new_extrema_per_step")
+PAGE = Page(
+    NAME, "Sod's shock tube",
+    "Density error at the final time against the exact Riemann solution, with one set of MPM settings for every "
+    "mesh (recorded in the JSON beside each table), over particles and over grid nodes, beside P1 FEM with "
+    "consistent and lumped mass and a finite-volume reference on the same mesh, and beside the source's table.",
+    views=(
+        View("sod/convergence", "Density L1 against h, beside the source", _CONVERGENCE, {}, "convergence.png"),
+        View("sod/convergence", "What sets the floor: volume gained by the particles, signed mean error in the "
+             "smooth region, position error of the rarefaction head", _FLOOR),
+        View("sod/regions", "Share of the L1 error by region of the exact solution", _SHARES, {}, "regions.png"),
+        View("sod/extrema", "New extrema per step, at cell crossings and elsewhere", _EXTREMA, {}, "extrema.png"),
+        View("sod/ppc", "Error against particles per cell", ("h", "ppc", "ok", "nodes_L1", "particles_L1"), {},
+             "ppc.png"),
+        View("sod/mass", "Lumped against consistent mass, MPM and FEM"),
+        View("sod/plateau", "What moves the floor: one setting changed at a time", _VARIANTS),
+    ),
+    figures=tuple((f"profiles_h{h:g}.png", "Profiles against the exact solution, MPM above and FEM below, on the "
+                   "mesh named in the file") for h in PROFILE_H),
+)
 
 
 if __name__ == "__main__":
