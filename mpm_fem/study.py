@@ -88,14 +88,3 @@ def script_main(name: str, argv=None) -> int:
 
     return main(["study", name, *(sys.argv[1:] if argv is None else argv)])
 
-
-def markdown_table(rows: list[dict], columns: list[str], digits: int = 3) -> list[str]:
-    """Lines of a Markdown table of ``rows`` (numbers, as text or not, to ``digits`` significant digits)."""
-    def cell(value) -> str:
-        try:
-            return f"{float(value):.{digits}g}" if str(value) not in ("", "True", "False") else str(value)
-        except (TypeError, ValueError):
-            return str(value)
-
-    return (["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-            + ["| " + " | ".join(cell(r.get(c, "")) for c in columns) + " |" for r in rows] + [""])

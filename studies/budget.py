@@ -21,12 +21,9 @@ terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) -
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Tables: ``subsets.csv`` (problem, h, basis, norm, mpm_stages, error = v(S)); ``shapley.csv``
-(stage, shapley, share of v(all MPM) - v(all exact), and the one-at-a-time views: removed =
-v(all) - v(all but the stage), alone = v(the stage) - v(none)); ``interactions.csv`` (every
-Moebius term of order >= 2); ``regions.csv`` (Sod: each Shapley field's L1 by the regions of
-C12); ``runs.csv`` (every run); E2, ``bases.csv``: Sod with each basis in MPM form down to
-h = 0.00125 (density L1, plateau velocity scatter).
+Tables: ``subsets.csv`` (v(S)), ``shapley.csv``, ``interactions.csv`` (Moebius terms of order >= 2),
+``regions.csv`` (Sod: each Shapley field's L1 by the regions of C12), ``runs.csv``; E2, ``bases.csv``:
+Sod with each basis in MPM form down to h = 0.00125 (density L1, plateau velocity scatter).
 """
 
 from __future__ import annotations
@@ -40,10 +37,11 @@ from baselines.exact import riemann
 from mpm_fem.decomposition import decompose, label, subsets
 from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
-from mpm_fem.plots import plt
+from mpm_fem.plots import convergence, plt
 from mpm_fem.problems import burgers, sod
-from mpm_fem.regions import REGION_NAMES, l1_by_region, sod_regions
-from mpm_fem.study import StudyOptions, markdown_table, read_table, script_main, write_table
+from mpm_fem.regions import REGION_NAMES, l1_by_region, plateau_velocity, sod_regions
+from mpm_fem.report import Page, View
+from mpm_fem.study import StudyOptions, script_main, write_table
 from mpm_fem.timing import field_on
 
 NAME = "budget"
@@ -87,18 +85,8 @@ def cost(case: dict) -> float:
 # ---------------------------------------------------------------- one case
 
 def _settings(problem: str, h: float, basis: str, changes: dict):
-    if problem == "sod":
-        return sod.SodSettings(h=h, basis=basis, **{**SOD, **changes})
-    return burgers.BurgersSettings(h=h, basis=basis, **{**BURGERS, **changes})
-
-
-def _plateau(settings, result) -> dict:
-    """Sod: scatter (std) of the particle velocities on the post-shock plateau (contact + 3h,
-    shock - 3h), the force-quadrature noise, and the offset of their mean from the exact ``u*``."""
-    w = riemann.wave_positions(result.t, settings.left, settings.right)
-    P = result.particles
-    v = P.velocity[(P.x > w["contact"] + 3 * settings.h) & (P.x < w["shock"] - 3 * settings.h)]
-    return {"plateau_noise": float(np.std(v)), "plateau_offset": float(np.mean(v) - w["u_star"])}
+    kind, default = (sod.SodSettings, SOD) if problem == "sod" else (burgers.BurgersSettings, BURGERS)
+    return kind(h=h, basis=basis, **{**default, **changes})
 
 
 def _run(problem: str, settings, points: np.ndarray) -> tuple[dict, dict]:
@@ -111,7 +99,8 @@ def _run(problem: str, settings, points: np.ndarray) -> tuple[dict, dict]:
     if problem == "sod":
         fields = {"particles": field_on(points, P.x, P.density) - sod.exact(settings, points, result.t)[0],
                   "nodes": result.nodal_density - sod.exact(settings, nodes, result.t)[0]}
-        extra = _plateau(settings, result)
+        extra = plateau_velocity(P.x, P.velocity, riemann.wave_positions(result.t, settings.left, settings.right),
+                                 3 * settings.h)
     else:
         fields, extra = {"particles": field_on(points, P.x, P.velocity) - settings.exact.v(points, result.t)}, {}
     errors = (sod if problem == "sod" else burgers).errors(settings, result)["density" if problem == "sod" else "velocity"]
@@ -195,7 +184,9 @@ def run(options: StudyOptions) -> None:
     if got["bases"]:
         e2 = [{"h": h, "basis": b, **r} for (h, b), r in sorted(got["bases"].items(), key=lambda kv: (-kv[0][0], BASES.index(kv[0][1])))]
         write_table(folder, "bases", e2, settings)
-        bases_figure(folder / "bases.png", [r for r in e2 if r["ok"]])
+        convergence(folder / "bases.png", {f"{b}, {w}": ([r["h"] for r in e2 if r["basis"] == b and r["ok"]],
+                    [r[f"{w}_L1"] for r in e2 if r["basis"] == b and r["ok"]], style) for b in BASES
+                    for w, style in (("nodes", "o-"), ("particles", "s--"))}, ylabel="Sod density error (L1)", slopes=(1,))
 
 
 def subset_rows(got: dict) -> list[dict]:
@@ -225,14 +216,14 @@ def decomposition_rows(rows: list[dict]) -> tuple[list, list]:
 
 
 def region_rows(got: dict) -> list[dict]:
-    """``regions.csv``: L1 of each Shapley error field (particles) by the regions of C12, and its share."""
-    out = []
-    for (p, h, b), r in got.items():
-        for name, parts in r.get("regions", {}).items():
-            total = sum(parts)
-            out += [{"problem": p, "h": h, "basis": b, "field": name, "region": REGION_NAMES[k], "L1": x,
-                     "share": x / total if total else float("nan")} for k, x in enumerate(parts)]
-    return out
+    """``regions.csv``: L1 of each Shapley error field (particles) and its share in each region of C12."""
+    return [{"problem": p, "h": h, "basis": b, "field": name, "L1": sum(parts),
+             **{f"share_{_slug(n)}": x / sum(parts) for n, x in zip(REGION_NAMES, parts)}}
+            for (p, h, b), r in got.items() for name, parts in r.get("regions", {}).items()]
+
+
+def _slug(name: str) -> str:
+    return name.replace(" ", "_")
 
 
 # ---------------------------------------------------------------- figures
@@ -285,64 +276,32 @@ def fields_figure(path: Path, problem: str, fields: dict) -> None:
     plt.close(fig)
 
 
-def bases_figure(path: Path, rows: list[dict]) -> None:
-    """E2: Sod density L1 (nodes, particles) and the plateau velocity scatter against h, per basis."""
-    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
-    for basis in BASES:
-        sub = [r for r in rows if r["basis"] == basis]
-        hs = [r["h"] for r in sub]
-        axes[0].loglog(hs, [r["nodes_L1"] for r in sub], "o-", ms=4, label=f"{basis}, nodes")
-        axes[0].loglog(hs, [r["particles_L1"] for r in sub], "s--", ms=4, label=f"{basis}, particles")
-        axes[1].loglog(hs, [r["plateau_noise"] for r in sub], "o-", ms=4, label=basis)
-    axes[0].set(xlabel="h", ylabel="Sod density error (L1)")
-    axes[1].set(xlabel="h", ylabel="std of v_p on the post-shock plateau")
-    for ax in axes:
-        ax.legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+# ---------------------------------------------------------------- the report's section
 
-
-# ---------------------------------------------------------------- report (tables and captions only)
-
-CAPTIONS = {
-    "shapley_{p}.png": "{p}: the error of the all-exact run (grey floor) and each stage's Shapley value stacked on "
-                       "it, signed; the black mark is the MPM error.",
-    "fields_{p}.png": "{p}: each stage's Shapley error field at the finest mesh; they add up to e_MPM - e_exact "
-                      "(black) at every point.",
-}
-
-
-def report(folder: Path) -> str:
-    """Shapley shares per mesh, the regions of the fields and E2 as tables; the figures with captions."""
-    folder = Path(folder)
-    out = ["## Error budget (E1) and bases (E2)", ""]
-    if not (folder / "shapley.csv").exists():
-        return "\n".join(out + ["Not run.", ""])
-    rows = read_table(folder / "shapley.csv")
-    for problem in dict.fromkeys(r["problem"] for r in rows):
-        table = {}
-        for r in (r for r in rows if r["problem"] == problem):
-            row = table.setdefault((r["h"], r["basis"], r["norm"]), {
-                "h": r["h"], "basis": r["basis"], "norm": r["norm"], "all MPM": r["mpm_error"], "all exact": r["exact_error"]})
-            row[f"{r['stage']} share"] = r["share"]
-        out += [f"### E1, {problem}: Shapley shares of v(all MPM) - v(all exact)", ""]
-        out += markdown_table(list(table.values()), list(next(iter(table.values()))), digits=2)
-        out += [f"![{c.format(p=problem)}](budget/{n.format(p=problem)})\n\n*{c.format(p=problem)}*\n"
-                for n, c in CAPTIONS.items()]
-    if (folder / "regions.csv").exists():
-        regions = read_table(folder / "regions.csv")
-        finest = {(r["problem"], r["basis"]): min(float(x["h"]) for x in regions if x["basis"] == r["basis"]) for r in regions}
-        table = {}
-        for r in (r for r in regions if float(r["h"]) == finest[(r["problem"], r["basis"])]):
-            table.setdefault((r["basis"], r["field"]), {"basis": r["basis"], "h": r["h"], "field": r["field"]})[r["region"]] = r["share"]
-        out += ["### E1, sod: share of each Shapley field's L1 by region (C12), finest mesh", ""]
-        out += markdown_table(list(table.values()), ["basis", "h", "field", *REGION_NAMES], digits=2)
-    if (folder / "bases.csv").exists():
-        out += ["### E2: Sod with each basis", ""] + markdown_table(
-            read_table(folder / "bases.csv"), ["basis", "h", "particles_L1", "nodes_L1", "plateau_noise", "plateau_offset"])
-        out += ["![E2](budget/bases.png)", "", "*E2: Sod density L1 and the plateau velocity scatter against h.*", ""]
-    return "\n".join(out)
+_SHAPLEY = ("h", "basis", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error")
+_REGIONS = ("h", "basis", "field", "L1", *(f"share_{_slug(n)}" for n in REGION_NAMES))
+PAGE = Page(
+    NAME, "Error budget (E1) and bases (E2)",
+    "Every combination of the four stages in MPM or exact form, on each mesh and basis: the error of each "
+    "combination, its exact decomposition into each stage's Shapley value (main effect plus an equal share of "
+    "every interaction the stage takes part in) and the interactions; each stage's signed error field and where "
+    "along the tube it sits; and Sod with each basis.",
+    views=(
+        View("budget/shapley", "Sod, particle density L1: each stage's Shapley value and share of v(all MPM) - "
+             "v(all exact); removed and alone are the one-at-a-time views", _SHAPLEY,
+             {"problem": "sod", "norm": "particles"}, "shapley_sod.png"),
+        View("budget/shapley", "Sod, nodal density L1", _SHAPLEY, {"problem": "sod", "norm": "nodes"}),
+        View("budget/shapley", "Burgers, particle velocity L1", _SHAPLEY, {"problem": "burgers"}, "shapley_burgers.png"),
+        View("budget/interactions", "Sod, point-mass P1, particles: the interactions (Moebius terms of two and more "
+             "stages)", ("h", "stages", "term", "share"), {"problem": "sod", "basis": "mpm", "norm": "particles"}),
+        View("budget/regions", "Sod, point-mass P1: share of each Shapley error field's L1 by region of the exact "
+             "solution (C12)", _REGIONS, {"basis": "mpm"}, "fields_sod.png"),
+        View("budget/bases", "E2: Sod with each basis, MPM stages", ("basis", "h", "ok", "particles_L1", "nodes_L1",
+             "plateau_noise", "plateau_offset"), {}, "bases.png"),
+    ),
+    figures=(("fields_burgers.png", "Each stage's Shapley error field of Burgers at the finest mesh; they add up "
+              "to e_MPM - e_exact (black) at every point"),),
+)
 
 
 if __name__ == "__main__":

@@ -25,7 +25,8 @@ from mpm_fem.plots import plt
 from mpm_fem.problems import burgers
 from mpm_fem.solve import Problem
 from mpm_fem.step import Dirichlet
-from mpm_fem.study import StudyOptions, markdown_table, read_table, script_main, write_table
+from mpm_fem.report import Page, View
+from mpm_fem.study import StudyOptions, script_main, write_table
 from mpm_fem.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, observed_order,
                             pulse_setup, simulate_pulse, state_at)
 
@@ -128,6 +129,7 @@ def run(options: StudyOptions) -> None:
     time_figure(folder / "time_order.png", rows, local_rows)
     rows = crossing_rows(got["crossing"])
     write_table(folder, "crossing", rows, settings)
+    write_table(folder, "crossing_summary", crossing_summary(rows), settings)
     crossing_figure(folder / "crossing.png", got["crossing"], rows)
 
 
@@ -158,6 +160,19 @@ def crossing_rows(got: dict) -> list[dict]:
     return [{"basis": basis, "acceleration": acc, **row,
              "ratio": row["measured"] / row["predicted"] if row["predicted"] else float("nan")}
             for (basis, acc), r in got.items() for row in r["rows"]]
+
+
+def crossing_summary(rows: list[dict]) -> list[dict]:
+    """Per basis and acceleration: the crossings, the median and worst measured/predicted ratio,
+    and the median size of the measured jump."""
+    out = []
+    for basis, acc in dict.fromkeys((r["basis"], r["acceleration"]) for r in rows):
+        sub = [r for r in rows if (r["basis"], r["acceleration"]) == (basis, acc)]
+        ratio = np.array([r["ratio"] for r in sub])
+        out.append({"basis": basis, "acceleration": acc, "crossings": len(sub), "median_ratio": float(np.median(ratio)),
+                    "max_ratio_error": float(np.max(np.abs(ratio - 1))),
+                    "median_abs_measured": float(np.median(np.abs([r["measured"] for r in sub])))})
+    return out
 
 
 # ---------------------------------------------------------------- figures
@@ -221,34 +236,23 @@ def crossing_figure(path: Path, got: dict, rows: list[dict]) -> None:
     plt.close(fig)
 
 
-# ---------------------------------------------------------------- report (tables and captions only)
+# ---------------------------------------------------------------- the report's section
 
-CAPTIONS = {"time_order.png": "C1: global error against dt at fixed h (slope 1), and the local error of one step (slope 2).",
-            "crossing.png": "C2: dA/dt along one particle's path; P1 jumps at each node crossing, GIMP and the B-spline do not."}
-
-
-def report(folder: Path) -> str:
-    """The fitted orders and the crossing ratios as tables, the figures with their captions."""
-    folder = Path(folder)
-    out = ["## Time error (C1) and grid crossing (C2)", ""]
-    if not (folder / "crossing.csv").exists():
-        return "\n".join(out + ["Not run.", ""])
-    fits = {(r["problem"], r["basis"], r["quantity"]): r for r in read_table(folder / "time_order.csv")}
-    local = {(r["problem"], r["basis"], r["quantity"]): r for r in read_table(folder / "local_error.csv")}
-    rows = [{"problem": p, "basis": b, "quantity": q, "global order": r["fitted_order"],
-             "local order (x)": local.get((p, b, "x"), {}).get("fitted_order", "")} for (p, b, q), r in fits.items()]
-    out += ["### C1: fitted orders in dt", ""] + markdown_table(rows, list(rows[0]))
-    crossing = read_table(folder / "crossing.csv")
-    groups = sorted({(r["basis"], r["acceleration"]) for r in crossing}, key=lambda k: (BASES.index(k[0]), k[1]))
-    summary = []
-    for basis, acc in groups:
-        ratio = np.array([float(r["ratio"]) for r in crossing if (r["basis"], r["acceleration"]) == (basis, acc)])
-        summary.append({"basis": basis, "acceleration": acc, "crossings": len(ratio),
-                        "median measured/predicted": np.median(ratio), "max abs(ratio - 1)": np.max(np.abs(ratio - 1))})
-    out += ["### C2: jump of d^3x_p/dt^3 at node crossings", ""] + markdown_table(summary, list(summary[0]))
-    for name, caption in CAPTIONS.items():
-        out += [f"![{caption}](time/{name})", "", f"*{caption}*", ""]
-    return "\n".join(out)
+PAGE = Page(
+    NAME, "Time error (C1) and grid crossing (C2)",
+    "At a fixed mesh and fixed particles, the time step alone is refined against a much smaller step: the global "
+    "error at the final time and the local error of one step from a common state; and the third time derivative "
+    "of one particle's position along its path, measured at each node crossing beside the slides' formula.",
+    views=(
+        View("time/time_order", "Global error against dt: fitted order per problem, basis and quantity",
+             ("problem", "basis", "quantity", "fitted_order"), {"order": ""}, "time_order.png"),
+        View("time/local_error", "Local error of one step: fitted order", ("problem", "basis", "quantity", "fitted_order"),
+             {"order": ""}),
+        View("time/crossing_summary", "Jump of dA/dt at node crossings, measured against the slides' formula",
+             ("basis", "acceleration", "crossings", "median_ratio", "max_ratio_error", "median_abs_measured"), {},
+             "crossing.png"),
+    ),
+)
 
 
 if __name__ == "__main__":
