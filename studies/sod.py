@@ -28,7 +28,7 @@ from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
 from mpm_fem.problems import sod
 from mpm_fem.regions import REGION_NAMES, ExtremaCounter, l1_by_region, mean_by_region, sod_regions
-from mpm_fem import source
+from mpm_fem import plots, source
 from mpm_fem.report import Page, View
 from mpm_fem.study import StudyOptions, script_main, write_table
 
@@ -273,8 +273,6 @@ def _convergence(folder, got, settings) -> None:
             "mpm_wall_s": round(mpm[k].get("wall_s", float("nan")), 2),
         })
     write_table(folder, "convergence", rows, settings)
-    from mpm_fem import plots
-
     hs_src = list(SOURCE)
     series = {
         "MPM, grid nodes": (hs, cols["nodes_L1"], "o-"),
@@ -329,34 +327,11 @@ def _region_text() -> dict:
 
 
 def _region_figure(path, rows) -> None:
-    """Stacked shares of the L1 error by region (each bar sums to 1), total L1 above each bar."""
-    import matplotlib.pyplot as plt
-
-    methods = list(dict.fromkeys(r["method"] for r in rows))
-    fig, axes = plt.subplots(1, len(methods), figsize=(3.6 * len(methods), 4.0), sharey=True, squeeze=False)
-    colors = plt.cm.tab10(np.arange(len(REGION_NAMES)))
-    for ax, method in zip(axes[0], methods):
-        sub = [r for r in rows if r["method"] == method]
-        labels = [f"{r['h']:g}" for r in sub]
-        bottom = np.zeros(len(sub))
-        for k, name in enumerate(REGION_NAMES):
-            vals = np.array([r[f"share_{k}"] for r in sub])
-            ax.bar(labels, vals, bottom=bottom, color=colors[k], label=f"{k} {name}")
-            bottom += vals
-        for j, r in enumerate(sub):
-            ax.annotate(f"{r['L1']:.2g}", (j, 1.01), ha="center", fontsize=6)
-        ax.set_ylim(0, 1.08)
-        ax.set_title(method, fontsize=9)
-        ax.set_xlabel("h")
-        ax.tick_params(axis="x", labelrotation=45, labelsize=7)
-    axes[0][0].set_ylabel("share of the density L1 error (total above)")
-    handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles[::-1], labels[::-1], fontsize=7, loc="center right")
-    fig.suptitle(f"C12: density L1 error by region of the exact solution at T = {T} (half-width {REGION_HALF_WIDTH})",
-                 fontsize=9)
-    fig.tight_layout(rect=(0, 0, 0.89, 1))
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    methods = dict.fromkeys(r["method"] for r in rows)
+    groups = {m: [(f"{r['h']:g}", [r[f"share_{k}"] for k in range(len(REGION_NAMES))], r["L1"])
+                  for r in rows if r["method"] == m] for m in methods}
+    plots.stacked_shares(path, groups, REGION_NAMES, f"C12: density L1 error by region of the exact solution at "
+                         f"T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
 
 
 def _extrema(folder, got, settings) -> None:
@@ -379,22 +354,14 @@ def _extrema(folder, got, settings) -> None:
         rows.append(row)
     write_table(folder, "extrema", rows, {**settings, "rtol": 1e-9,
                                           "definition": "new strict local extremum among position-ordered particles"})
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
-    hs = [r["h"] for r in rows]
-    for name, style in (("density", "o-"), ("energy", "s--")):
-        axes[0].loglog(hs, [r[f"{name}_new_per_step"] for r in rows], style, label=name)
-        axes[1].loglog(hs, [r[f"{name}_rate_crossing"] for r in rows], style, label=f"{name}: particles crossing a node")
-        axes[1].loglog(hs, [r[f"{name}_rate_elsewhere"] for r in rows], style, alpha=0.5, label=f"{name}: other particles")
-    axes[0].set(xlabel="h", ylabel="new extrema per step")
-    axes[1].set(xlabel="h", ylabel="new extrema per particle-step")
-    for ax in axes:
-        ax.legend(fontsize=7)
-    fig.suptitle(f"C14: new extrema of particle density / energy (MPM, {MPM['ppc']} ppc, CFL {MPM['cfl']})", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(folder / "extrema.png", dpi=120)
-    plt.close(fig)
+    hs, styles = [r["h"] for r in rows], {"density": "o-", "energy": "s--"}
+    plots.panels(folder / "extrema.png", {
+        "new extrema per step": {n: (hs, [r[f"{n}_new_per_step"] for r in rows], f) for n, f in styles.items()},
+        "new extrema per particle-step": {
+            **{f"{n}: particles crossing a node": (hs, [r[f"{n}_rate_crossing"] for r in rows], f) for n, f in styles.items()},
+            **{f"{n}: other particles": (hs, [r[f"{n}_rate_elsewhere"] for r in rows], f, {"alpha": 0.5})
+               for n, f in styles.items()}}},
+        "h", "new extrema", f"C14: new extrema of particle density / energy (MPM, {MPM['ppc']} ppc, CFL {MPM['cfl']})")
 
 
 def _ppc(folder, got, settings) -> None:
@@ -410,24 +377,16 @@ def _ppc(folder, got, settings) -> None:
                         "wall_s": "", "error": r["error"]})
         rows.append(row)
     write_table(folder, "ppc", rows, settings)
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
-    for ax, where in zip(axes, ("nodes", "particles")):
+    content = {}
+    for where in ("nodes", "particles"):
+        panel = content.setdefault(f"over {'grid nodes' if where == 'nodes' else 'particles'}", {})
         for h in sorted({r["h"] for r in rows}, reverse=True):
-            sub = [r for r in rows if r["h"] == h and r["ok"]]
-            ax.loglog([r["ppc"] for r in sub], [r[f"{where}_L1"] for r in sub], "o-", label=f"h = {h:g}")
+            ok = [r for r in rows if r["h"] == h and r["ok"]]
+            panel[f"h = {h:g}"] = ([r["ppc"] for r in ok], [r[f"{where}_L1"] for r in ok], "o-")
             if h in SOURCE:
-                ax.axhline(SOURCE[h][0], color=ax.lines[-1].get_color(), ls=":", lw=0.8)
-        ax.axvspan(4, 8, color="0.9", zorder=0)
-        ax.set(xlabel="particles per cell N_p", title=f"over {'grid nodes' if where == 'nodes' else 'particles'}")
-        ax.set_xticks(PPC, [str(n) for n in PPC])
-    axes[0].set_ylabel("density error (L1)")
-    axes[0].legend(fontsize=7)
-    fig.suptitle("C3: error vs particles per cell (shaded: 4-8, the source's optimum; dotted: source at that h)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(folder / "ppc.png", dpi=120)
-    plt.close(fig)
+                panel[f"source, h = {h:g}"] = ((PPC[0], PPC[-1]), (SOURCE[h][0],) * 2, "k:", {"lw": 0.8})
+    plots.panels(folder / "ppc.png", content, "particles per cell N_p", "density error (L1)",
+                 "C3: error vs particles per cell (dotted: the source at that h)")
 
 
 def _mass(folder, got, settings) -> None:
