@@ -37,7 +37,7 @@ from baselines.exact import riemann
 from mpm_fem.decomposition import decompose, label, subsets
 from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
-from mpm_fem.plots import convergence, plt
+from mpm_fem.plots import convergence, plt, save
 from mpm_fem.problems import burgers, sod
 from mpm_fem.regions import REGION_NAMES, l1_by_region, plateau_velocity, sod_regions
 from mpm_fem.report import Page, View
@@ -108,11 +108,11 @@ def _run(problem: str, settings, points: np.ndarray) -> tuple[dict, dict]:
             "nodes_L1": errors["nodes"]["L1"], **extra}, fields
 
 
-def budget_case(case: dict) -> dict:
-    """The sixteen subsets of one (problem, h, basis): v(S) per norm, the runs, the Shapley error
-    fields (sampled for the figure) and, for Sod, their L1 by region."""
-    problem, h, basis = case["problem"], case["h"], case["basis"]
-    base = _settings(problem, h, basis, {})
+def subset_fields(problem: str, h: float, basis: str, settings: dict | None = None) -> tuple:
+    """Error fields of the sixteen subsets (module docstring): ``(fields, weights, points, runs)``
+    with ``fields[S][norm]`` and the norm's quadrature ``weights[norm]``; ``fields`` is None when a
+    run fails. ``settings`` replace the study's (tests run small cases)."""
+    base = _settings(problem, h, basis, settings or {})
     a, b = sod.DOMAIN if problem == "sod" else base.exact.domain
     margin = 0.0 if problem == "sod" else 0.05 * (b - a)
     points = np.linspace(a + margin, b - margin, max(4001, 4 * round((b - a) / h) * base.ppc + 1))
@@ -123,28 +123,34 @@ def budget_case(case: dict) -> dict:
     for S3 in subsets(STAGES[:3]):
         changes = {k: v for s in STAGES[:3] if s not in S3 for k, v in EXACT_FORM[s].items()}
         for refine in (1, K):
-            row, e[(S3, refine)] = _run(problem, _settings(problem, h, basis, {**changes, "refine": refine}), points)
+            row, e[(S3, refine)] = _run(problem, _settings(problem, h, basis, {**(settings or {}), **changes,
+                                                                               "refine": refine}), points)
             runs.append({"mpm_stages": label(S3), "refine": refine, **row})
             if not row["ok"]:
-                return {"ok": False, "runs": runs}
-    out = {"ok": True, "runs": runs, "subsets": {}}
-    for norm, w in weights.items():
-        field = {S: e[(S - {"time"}, 1)][norm] if "time" in S else (K * e[(S, K)][norm] - e[(S, 1)][norm]) / (K - 1)
-                 for S in subsets(STAGES)}
-        out["subsets"][norm] = {label(S): float(np.sum(w * np.abs(f))) for S, f in field.items()}
-        if norm == "particles":
-            d = decompose(field, STAGES)
-            shown = {**d.shapley, GAP: d.gap}
-            step = max(1, points.size // FIELD_POINTS)
-            out["fields"] = {"x": _rounded(points[::step]), **{k: _rounded(f[::step]) for k, f in shown.items()}}
-            if problem == "sod":
-                regions = sod_regions(riemann.wave_positions(base.T, base.left, base.right), REGION_HALF_WIDTH)
-                out["regions"] = {k: l1_by_region(points, f, w, regions).tolist() for k, f in shown.items()}
+                return None, weights, points, runs
+    fields = {S: {norm: e[(S - {"time"}, 1)][norm] if "time" in S else (K * e[(S, K)][norm] - e[(S, 1)][norm]) / (K - 1)
+                  for norm in weights} for S in subsets(STAGES)}
+    return fields, weights, points, runs
+
+
+def budget_case(case: dict) -> dict:
+    """One (problem, h, basis): v(S) per norm and subset, the runs, the Shapley error fields
+    (sampled for the figure) and, for Sod, their L1 by region."""
+    problem, h, basis = case["problem"], case["h"], case["basis"]
+    fields, weights, points, runs = subset_fields(problem, h, basis)
+    if fields is None:
+        return {"ok": False, "runs": runs}
+    out = {"ok": True, "runs": runs, "subsets": {norm: {label(S): float(np.sum(w * np.abs(f[norm])))
+                                                         for S, f in fields.items()} for norm, w in weights.items()}}
+    d = decompose({S: f["particles"] for S, f in fields.items()}, STAGES)
+    shown = {**d.shapley, GAP: d.gap}
+    step = max(1, points.size // FIELD_POINTS)
+    out["fields"] = {k: [float(f"{v:.6g}") for v in f[::step]] for k, f in {"x": points, **shown}.items()}
+    if problem == "sod":
+        s = sod.SodSettings()
+        regions = sod_regions(riemann.wave_positions(s.T, s.left, s.right), REGION_HALF_WIDTH)
+        out["regions"] = {k: l1_by_region(points, f, weights["particles"], regions).tolist() for k, f in shown.items()}
     return out
-
-
-def _rounded(a) -> list:
-    return [float(f"{v:.6g}") for v in a]
 
 
 def bases_case(case: dict) -> dict:
@@ -165,24 +171,21 @@ def run(options: StudyOptions) -> None:
     folder = options.folder(NAME)
     settings = {"sod": SOD, "burgers": BURGERS, "K": K, "stages": STAGES, "exact_form": EXACT_FORM,
                 "region_half_width": REGION_HALF_WIDTH, "quick": options.quick}
-    ok = {key: r for key, r in sorted(got["budget"].items(), key=lambda kv: (kv[0][0], -kv[0][1], BASES.index(kv[0][2])))
-          if r["ok"]}
+    ok = {key: r for key, r in got["budget"].items() if r["ok"]}  # in the plan's order
     rows = subset_rows(ok)
     write_table(folder, "subsets", rows, settings)
     shapley, interactions = decomposition_rows(rows)
     write_table(folder, "shapley", shapley, settings)
     write_table(folder, "interactions", interactions, settings)
-    write_table(folder, "runs", [{"problem": p, "h": h, "basis": b, **run} for (p, h, b), r in got["budget"].items()
-                                 for run in r["runs"]], settings)
-    regions = region_rows(ok)
-    if regions:
-        write_table(folder, "regions", regions, settings)
+    write_table(folder, "runs", [{"problem": p, "h": h, "basis": b, **x} for (p, h, b), r in got["budget"].items() for x in r["runs"]], settings)
+    if region_rows(ok):
+        write_table(folder, "regions", region_rows(ok), settings)
     for problem in sorted({r["problem"] for r in shapley}):
         shapley_figure(folder / f"shapley_{problem}.png", [r for r in shapley if r["problem"] == problem])
         finest = {b: min(h for p, h, bb in ok if p == problem and bb == b) for p, _, b in ok if p == problem}
         fields_figure(folder / f"fields_{problem}.png", problem, {b: (h, ok[(problem, h, b)]["fields"]) for b, h in finest.items()})
     if got["bases"]:
-        e2 = [{"h": h, "basis": b, **r} for (h, b), r in sorted(got["bases"].items(), key=lambda kv: (-kv[0][0], BASES.index(kv[0][1])))]
+        e2 = [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()]
         write_table(folder, "bases", e2, settings)
         convergence(folder / "bases.png", {f"{b}, {w}": ([r["h"] for r in e2 if r["basis"] == b and r["ok"]],
                     [r[f"{w}_L1"] for r in e2 if r["basis"] == b and r["ok"]], style) for b in BASES
@@ -218,12 +221,8 @@ def decomposition_rows(rows: list[dict]) -> tuple[list, list]:
 def region_rows(got: dict) -> list[dict]:
     """``regions.csv``: L1 of each Shapley error field (particles) and its share in each region of C12."""
     return [{"problem": p, "h": h, "basis": b, "field": name, "L1": sum(parts),
-             **{f"share_{_slug(n)}": x / sum(parts) for n, x in zip(REGION_NAMES, parts)}}
+             **{f"share_{n.replace(' ', '_')}": x / sum(parts) for n, x in zip(REGION_NAMES, parts)}}
             for (p, h, b), r in got.items() for name, parts in r.get("regions", {}).items()]
-
-
-def _slug(name: str) -> str:
-    return name.replace(" ", "_")
 
 
 # ---------------------------------------------------------------- figures
@@ -248,10 +247,8 @@ def shapley_figure(path: Path, rows: list[dict]) -> None:
         ax.axhline(0, color="k", lw=0.5)
         ax.set_xticks(range(len(hs)), [f"{h:g}" for h in hs])
         ax.set(xlabel="h", ylabel=f"{norm} L1 error", title=f"{rows[0]['problem']}, {basis}, {norm}")
-    fig.legend(*axes[0][0].get_legend_handles_labels(), loc="lower center", ncol=6, fontsize=7)
-    fig.tight_layout(rect=(0, 0.06, 1, 1))
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    axes[-1][-1].legend(fontsize=6)
+    save(fig, path)
 
 
 def fields_figure(path: Path, problem: str, fields: dict) -> None:
@@ -271,15 +268,13 @@ def fields_figure(path: Path, problem: str, fields: dict) -> None:
         ax.set_title(f"{problem}, {basis}, h = {h:g}: {'density' if problem == 'sod' else 'velocity'} error by stage",
                      fontsize=9)
     axes[0, 0].legend(fontsize=7, ncol=5)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path)
 
 
 # ---------------------------------------------------------------- the report's section
 
 _SHAPLEY = ("h", "basis", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error")
-_REGIONS = ("h", "basis", "field", "L1", *(f"share_{_slug(n)}" for n in REGION_NAMES))
+_REGIONS = ("h", "basis", "field", "L1", *(f"share_{n.replace(' ', '_')}" for n in REGION_NAMES))
 PAGE = Page(
     NAME, "Error budget (E1) and bases (E2)",
     "Every combination of the four stages in MPM or exact form, on each mesh and basis: the error of each "

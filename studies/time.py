@@ -17,11 +17,10 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from matplotlib.ticker import NullFormatter
 
 from mpm_fem.grid import uniform_grid
 from mpm_fem.models.burgers import ViscousBurgers
-from mpm_fem.plots import plt
+from mpm_fem.plots import plt, save, slope_guides
 from mpm_fem.problems import burgers
 from mpm_fem.solve import Problem
 from mpm_fem.step import Dirichlet
@@ -177,14 +176,6 @@ def crossing_summary(rows: list[dict]) -> list[dict]:
 
 # ---------------------------------------------------------------- figures
 
-def _slope_guide(ax, k: int) -> None:
-    line = ax.get_lines()[0]
-    x, y0 = np.asarray(line.get_xdata(), float), float(line.get_ydata()[0])
-    ax.loglog(x, y0 * (x / x[0]) ** k, ":", color="gray", lw=1)
-    ax.annotate(f"slope {k}", (x[-1], y0 * (x[-1] / x[0]) ** k), fontsize=7, color="gray")
-    ax.xaxis.set_minor_formatter(NullFormatter())
-
-
 def time_figure(path: Path, rows: list[dict], local_rows: list[dict]) -> None:
     """Global error against dt (pulse, Burgers) with slope 1; local error of x_p with slope 2."""
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.0))
@@ -194,7 +185,8 @@ def time_figure(path: Path, rows: list[dict], local_rows: list[dict]) -> None:
             if sub:
                 ax.loglog([r["dt"] for r in sub], [r["error"] for r in sub], "o-", ms=4,
                           label=f"{basis} (order {sub[0]['fitted_order']:.2f})")
-        _slope_guide(ax, 1)
+        shown = [r for r in rows if r["problem"] == problem and r["quantity"] == "velocity"]
+        slope_guides(ax, [r["dt"] for r in shown], max(r["error"] for r in shown), (1,))
         ax.set(xlabel="dt (fixed h, fixed particles)", ylabel="global velocity error at T (mean |v - v_ref|)")
         ax.set_title(f"C1, {problem}: global error", fontsize=9)
         ax.legend(fontsize=7)
@@ -204,13 +196,14 @@ def time_figure(path: Path, rows: list[dict], local_rows: list[dict]) -> None:
             if sub:
                 axes[2].loglog([r["dt"] for r in sub], [r["error"] for r in sub], "o-" if problem == "pulse" else "s--",
                                ms=4, label=f"{problem}, {basis} ({sub[0]['fitted_order']:.2f})")
-    _slope_guide(axes[2], 2)
+    shown = [r for r in local_rows if r["quantity"] == "x"]
+    slope_guides(axes[2], [r["dt"] for r in shown], max(r["error"] for r in shown), (2,))
     axes[2].set(xlabel="dt", ylabel="local error of one step, max |x_p - x_p^ref|")
     axes[2].set_title("C1: local error", fontsize=9)
     axes[2].legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    for ax in axes:
+        ax.xaxis.set_minor_formatter(plt.NullFormatter())
+    save(fig, path)
 
 
 def crossing_figure(path: Path, got: dict, rows: list[dict]) -> None:
@@ -231,9 +224,7 @@ def crossing_figure(path: Path, got: dict, rows: list[dict]) -> None:
         ax.set_title("C2, exact nodal acceleration: P1 jumps at every node crossing (dotted)" if acc == "exact" else
                      "calculated acceleration: a_i jumps when any particle crosses a node", fontsize=8)
         ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path)
 
 
 # ---------------------------------------------------------------- the report's section
