@@ -35,7 +35,7 @@ from baselines import fem_burgers
 from baselines.exact.burgers import make_solution
 from mpm_fem.errors import fitted_order, observed_orders
 from mpm_fem.problems import burgers
-from mpm_fem import source
+from mpm_fem import plots, source
 from mpm_fem.claims import BURGERS_SHOWN
 from mpm_fem.report import Page, View
 from mpm_fem.study import StudyOptions, script_main, write_table
@@ -340,70 +340,61 @@ def _diagnosis(folder: Path, got: dict, settings: dict) -> None:
 
 # ---------------------------------------------------------------- figures
 
-STYLE = {"mpm_calculated": ("o-", "tab:blue"), "mpm_calculated_16": ("o--", "tab:purple"), "mpm_exact": ("s-", "tab:orange"), "mpm_exact_dt_h": ("D-", "tab:red"),
-         "fem_consistent": ("^--", "tab:green"), "fem_lumped": ("v--", "tab:olive")}
+STYLE = {"mpm_calculated": ("o-", "tab:blue"), "mpm_calculated_16": ("o--", "tab:purple"), "mpm_exact": ("s-", "tab:orange"),
+         "mpm_exact_dt_h": ("D-", "tab:red"), "fem_consistent": ("^--", "tab:green"), "fem_lumped": ("v--", "tab:olive")}
 
 
-def _guides(ax, hs, e0):
-    hs = np.array(sorted(hs))
-    for k in (1, 2):
-        ax.loglog(hs, e0 * (hs / hs[-1]) ** k, ":", color="gray", lw=0.8)
-        ax.annotate(f"slope {k}", (hs[0], e0 * (hs[0] / hs[-1]) ** k), fontsize=6, color="gray")
+def _series(points, m, label, norm=NORM, **options):
+    """``{label: (x, error, fmt, options)}`` of method ``m`` from ``points = [(x, result)]``."""
+    where = "nodes" if m.startswith("fem") else WHERE
+    pts = sorted(points)
+    style, color = STYLE[m]
+    return {label: ([x for x, _ in pts], [_value(r, where, norm) for _, r in pts], style, {"color": color, **options})}
 
 
-def _panel(ax, got, sol, eps, title):
-    top = 0.0
-    for m, (label, solver, _, row) in METHODS.items():
-        pts = sorted((h, r) for (s, mm, e, h), r in got["table"].items() if s == sol and mm == m and e == eps)
-        if not pts:
-            continue
-        where = "nodes" if solver == "fem" else WHERE
-        hs, v = [h for h, _ in pts], [_value(r, where, NORM) for _, r in pts]
-        style, color = STYLE[m]
-        ax.loglog(hs, v, style, color=color, ms=3.5, lw=1.1, label=label + (" (nodes)" if solver == "fem" else ""))
-        top = max(top, np.nanmax(v))
+def _convergence_panel(got, sol, eps) -> dict:
+    panel = {}
+    for m, (label, solver, _, _) in METHODS.items():
+        pts = [(h, r) for (s, mm, e, h), r in got["table"].items() if (s, mm, e) == (sol, m, eps)]
+        if pts:
+            panel.update(_series(pts, m, label + (" (nodes)" if solver == "fem" else "")))
     for row, marker in (("exact", "ks"), ("calculated", "ko")):
-        ax.loglog(H, SOURCE[row][eps], marker, mfc="none", ms=6, label=f"source, {row} a")
-    _guides(ax, H, top * 1.3)
-    ax.set_title(title, fontsize=9)
-    ax.set_xlabel("h")
-    ax.set_ylabel(f"velocity error ({NORM}; MPM over {WHERE})")
+        panel[f"source, {row} a"] = (H, SOURCE[row][eps], marker, {"mfc": "none", "ms": 6})
+    return panel
 
 
 def _figures(folder: Path, got: dict) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    ylabel = f"velocity error ({NORM}; MPM over {WHERE})"
     eps_shown = sorted({e for (_, _, e, _) in got["table"]}, reverse=True)
-    fig, axes = plt.subplots(1, len(eps_shown), figsize=(4.2 * len(eps_shown), 4.0), squeeze=False)
-    for ax, eps in zip(axes[0], eps_shown):
-        _panel(ax, got, DEFAULT, eps, f"{DEFAULT}, eps = {eps}")
-    axes[0][0].legend(fontsize=6)
-    fig.suptitle(f"Burgers, T = {burgers.BurgersSettings.T}: velocity error vs h ({DEFAULT} solution); open black: the source's table", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(folder / "convergence.png", dpi=110)
-    plt.close(fig)
-
+    plots.panels(folder / "convergence.png", {f"{DEFAULT}, eps = {e}": _convergence_panel(got, DEFAULT, e) for e in eps_shown},
+                 "h", ylabel, f"Burgers, T = {burgers.BurgersSettings.T}: velocity error vs h ({DEFAULT} solution); "
+                 "open black: the source's table", slopes=(1, 2))
     sols = [s for s in SOLUTIONS if any(k[0] == s for k in got["table"])]
     shown = [e for e in (EPS[0], EPS[-1]) if e in eps_shown]
-    fig, axes = plt.subplots(len(shown), len(sols), figsize=(4.2 * len(sols), 3.8 * len(shown)), squeeze=False)
-    for i, eps in enumerate(shown):
-        for j, sol in enumerate(sols):
-            _panel(axes[i][j], got, sol, eps, f"{sol}, eps = {eps}")
-    axes[0][0].legend(fontsize=6)
-    fig.suptitle("Every candidate exact solution: velocity error vs h", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(folder / "solutions.png", dpi=100)
-    plt.close(fig)
-
+    plots.panels(folder / "solutions.png", {f"{s}, eps = {e}": _convergence_panel(got, s, e) for e in shown for s in sols},
+                 "h", ylabel, "Every candidate exact solution: velocity error vs h", ncols=len(sols), slopes=(1, 2))
     _profile_figure(folder / "profiles.png", got)
-    _ppc_figure(folder / "ppc.png", got)
-    _lumping_figure(folder / "lumping.png", got)
-    _timestep_figure(folder / "timestep.png", got)
+    by = lambda table, keep: {k: r for k, r in got[table].items() if keep(k)}  # noqa: E731
+    plots.panels(folder / "ppc.png", {f"C3, Burgers: error vs N_p ({DEFAULT}, eps = {EPS[0]})": {
+        k: v for m, h in sorted({(m, h) for (m, h, _) in got["ppc"]}) for k, v in _series(
+            [(n, r) for (mm, hh, n), r in got["ppc"].items() if (mm, hh) == (m, h)], m, f"{METHODS[m][0]}, h = {h}",
+            alpha=1.0 if h == max(PPC_H) else 0.6).items()}}, "particles per cell N_p", f"velocity error ({NORM} over {WHERE})")
+    plots.panels(folder / "lumping.png", {f"C15: lumped vs consistent mass ({DEFAULT}, eps = {EPS[0]}; MPM CFL {LUMPING_CFL})": {
+        k: v for m, mass in sorted({(m, mass) for (m, mass, _) in got["lumping"]}) for k, v in _series(
+            [(h, r) for (mm, ms, h), r in by("lumping", lambda k: k[:2] == (m, mass)).items()], m,
+            f"{METHODS[m][0]}, {mass}", "L2", mfc="none" if mass == "lumped" else None).items()}},
+        "h", f"velocity error (L2; MPM over {WHERE}, FEM over nodes)", slopes=(1, 2))
+    plots.panels(folder / "timestep.png", {f"Time error at fixed h: dt / {', '.join(map(str, REFINE))}": {
+        k: v for m, eps in sorted({(m, e) for (m, e, _) in got["timestep"]}) for k, v in _series(
+            [(r["dt"], r) for (mm, e, _), r in got["timestep"].items() if (mm, e) == (m, eps) and r.get("ok")], m,
+            f"{METHODS[m][0]}, eps = {eps}", alpha=1.0 if eps == EPS[0] else 0.6).items()}},
+        "dt (smallest step of the run)", f"velocity error ({NORM} over {WHERE})")
     if got.get("diagnosis"):
-        _diagnosis_figure(folder / "diagnosis.png", got)
+        plots.panels(folder / "diagnosis.png", {
+            f"Why the calculated acceleration stalls ({DEFAULT}, eps = {EPS[0]}): one change at a time": {
+                label: ([h for h, _ in pts], [_value(r, WHERE, "L1") for _, r in pts], "o-") for label in DIAGNOSIS
+                for pts in [sorted((h, r) for (lab, h), r in got["diagnosis"].items() if lab == label)]}},
+            "h", f"velocity error (L1 over {WHERE})", slopes=(1, 2), size=(6.2, 4.6))
 
 
 def _profile_figure(path, got) -> None:
@@ -412,110 +403,29 @@ def _profile_figure(path, got) -> None:
     eps_list = sorted({e for (_, e) in got["profile"]}, reverse=True)
     if not eps_list:
         return
+    T = burgers.BurgersSettings.T
     fig, axes = plt.subplots(2, len(eps_list), figsize=(6.5 * len(eps_list), 6.5), squeeze=False, sharex=True)
     for j, eps in enumerate(eps_list):
-        exact = make_solution(DEFAULT, eps)
-        xe = np.linspace(0, 2, 2001)
-        axes[0][j].plot(xe, exact.v(xe, 0.5), "k-", lw=1, label="exact, T = 0.5")
+        exact, xe = make_solution(DEFAULT, eps), np.linspace(0, 2, 2001)
+        axes[0][j].plot(xe, exact.v(xe, T), "k-", lw=1, label=f"exact, T = {T}")
         axes[0][j].plot(xe, exact.v(xe, 0.0), "k:", lw=0.8, label="exact, t = 0")
         for m, (label, solver, _, _) in METHODS.items():
             r = got["profile"].get((m, eps))
             if not r or not r.get("ok"):
                 continue
-            p = r["profile"]
-            style, color = STYLE[m]
+            p, color = r["profile"], STYLE[m][1]
             if solver == "mpm":
                 x, v = np.array(p["x"]), np.array(p["velocity"])
                 axes[0][j].plot(x, v, ".", ms=1.5, color=color, label=f"{label}, particles")
-                axes[1][j].plot(x, v - exact.v(x, 0.5), ".", ms=1.5, color=color, label=label)
+                axes[1][j].plot(x, v - exact.v(x, T), ".", ms=1.5, color=color, label=label)
             else:
                 x, v = np.array(p["nodes"]), np.array(p["nodal_velocity"])
-                axes[1][j].plot(x, v - exact.v(x, 0.5), "-", lw=0.9, color=color, label=f"{label}, nodes")
-        axes[0][j].set_title(f"{DEFAULT}, eps = {eps}, h = {PROFILE_H}", fontsize=9)
-        axes[0][j].set_ylabel("velocity")
-        axes[1][j].set_ylabel("error v - v_exact at T")
-        axes[1][j].set_xlabel("x")
+                axes[1][j].plot(x, v - exact.v(x, T), "-", lw=0.9, color=color, label=f"{label}, nodes")
+        axes[0][j].set(title=f"{DEFAULT}, eps = {eps}, h = {PROFILE_H}", ylabel="velocity")
+        axes[1][j].set(ylabel="error v - v_exact at T", xlabel="x")
         axes[0][j].legend(fontsize=6, markerscale=4)
         axes[1][j].legend(fontsize=6, markerscale=4)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def _ppc_figure(path, got) -> None:
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(5.5, 4.2))
-    for (m, h) in sorted({(m, h) for (m, h, _) in got["ppc"]}):
-        pts = sorted((n, _value(r, WHERE, NORM)) for (mm, hh, n), r in got["ppc"].items() if mm == m and hh == h)
-        style, color = STYLE[m]
-        ax.loglog([n for n, _ in pts], [v for _, v in pts], style[0], ls="-" if h == max(PPC_H) else "--",
-                  color=color, alpha=1.0 if h == max(PPC_H) else 0.6, label=f"{METHODS[m][0]}, h = {h}")
-    ax.set_xlabel("particles per cell N_p")
-    ax.set_ylabel(f"velocity error ({NORM} over {WHERE})")
-    ax.set_title(f"C3, Burgers: error vs N_p ({DEFAULT}, eps = {EPS[0]})", fontsize=9)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def _lumping_figure(path, got) -> None:
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(5.5, 4.2))
-    for (m, mass) in sorted({(m, mass) for (m, mass, _) in got["lumping"]}):
-        pts = sorted((h, r) for (mm, ms, h), r in got["lumping"].items() if mm == m and ms == mass)
-        where = "nodes" if m.startswith("fem") else WHERE
-        style, color = STYLE[m]
-        ax.loglog([h for h, _ in pts], [_value(r, where, "L2") for _, r in pts], style[0], ls="-" if mass == "consistent" else ":",
-                  color=color, mfc="none" if mass == "lumped" else color, label=f"{METHODS[m][0].split(' a')[0]} a, {mass}" if m.startswith("mpm") else METHODS[m][0])
-    hs = sorted({h for (_, _, h) in got["lumping"]})
-    _guides(ax, hs, ax.get_ylim()[1] * 0.5)
-    ax.set_xlabel("h")
-    ax.set_ylabel(f"velocity error (L2; MPM over {WHERE}, FEM over nodes)")
-    ax.set_title(f"C15: lumped vs consistent mass ({DEFAULT}, eps = {EPS[0]}; MPM CFL {LUMPING_CFL})", fontsize=9)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def _timestep_figure(path, got) -> None:
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(5.5, 4.2))
-    for (m, eps) in sorted({(m, e) for (m, e, _) in got["timestep"]}):
-        pts = sorted((r["dt"], _value(r, WHERE, NORM)) for (mm, e, _), r in got["timestep"].items() if mm == m and e == eps and r.get("ok"))
-        style, color = STYLE[m]
-        ax.loglog([d for d, _ in pts], [v for _, v in pts], style[0], ls="-" if eps == EPS[0] else "--",
-                  color=color, alpha=1.0 if eps == EPS[0] else 0.6, label=f"{METHODS[m][0]}, eps = {eps}")
-    ax.set_xlabel("dt (smallest step of the run)")
-    ax.set_ylabel(f"velocity error ({NORM} over {WHERE})")
-    ax.set_title(f"Time error at fixed h: dt / {', '.join(map(str, REFINE))}", fontsize=9)
-    ax.legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def _diagnosis_figure(path, got) -> None:
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.2, 4.6))
-    cmap = plt.get_cmap("tab10")
-    for k, label in enumerate(DIAGNOSIS):
-        pts = sorted((h, _value(r, WHERE, "L1")) for (lab, h), r in got["diagnosis"].items() if lab == label)
-        ax.loglog([h for h, _ in pts], [v for _, v in pts], "o-", color=cmap(k), ms=3.5, label=label)
-    hs = sorted({h for (_, h) in got["diagnosis"]})
-    _guides(ax, hs, ax.get_ylim()[1] * 0.3)
-    ax.set_xlabel("h")
-    ax.set_ylabel(f"velocity error (L1 over {WHERE})")
-    ax.set_title(f"Why the calculated acceleration stalls ({DEFAULT}, eps = {EPS[0]}): one change at a time", fontsize=9)
-    ax.legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    plots.save(fig, path)
 
 
 # ---------------------------------------------------------------- report
