@@ -37,7 +37,7 @@ from baselines.exact import riemann
 from mpm_fem.decomposition import decompose, label, subsets
 from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
-from mpm_fem.plots import convergence, plt, save
+from mpm_fem.plots import Curve, Plot, draw, plt, save
 from mpm_fem.problems import burgers, sod
 from mpm_fem.regions import REGION_NAMES, l1_by_region, plateau_velocity, sod_regions
 from mpm_fem.report import Page, View
@@ -54,8 +54,7 @@ SOD = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", sch
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025), "burgers": (0.04, 0.02, 0.01)}
-# cost (numpy path, 2 cores): Sod P1 to 0.0025 ~4 min; GIMP and the B-spline stop one mesh earlier (each
-# would add ~7 min at 0.0025; 0.00125 costs ~4x that); Burgers every basis to 0.01 ~1.5 min
+# cost on the numpy path (2 cores): Sod GIMP and B-spline at 0.0025 would add ~7 min; every mesh halving ~4x
 FINEST = {("sod", "gimp"): 0.005, ("sod", "bspline"): 0.005}
 BASES_H = (0.01, 0.005, 0.0025, 0.00125)  # E2: Sod with each basis, MPM stages only
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
@@ -99,8 +98,7 @@ def _run(problem: str, settings, points: np.ndarray) -> tuple[dict, dict]:
     if problem == "sod":
         fields = {"particles": field_on(points, P.x, P.density) - sod.exact(settings, points, result.t)[0],
                   "nodes": result.nodal_density - sod.exact(settings, nodes, result.t)[0]}
-        extra = plateau_velocity(P.x, P.velocity, riemann.wave_positions(result.t, settings.left, settings.right),
-                                 3 * settings.h)
+        extra = plateau_velocity(P.x, P.velocity, _sod_waves(), 3 * settings.h)  # the study's T and states
     else:
         fields, extra = {"particles": field_on(points, P.x, P.velocity) - settings.exact.v(points, result.t)}, {}
     errors = (sod if problem == "sod" else burgers).errors(settings, result)["density" if problem == "sod" else "velocity"]
@@ -147,16 +145,19 @@ def budget_case(case: dict) -> dict:
     step = max(1, points.size // FIELD_POINTS)
     out["fields"] = {k: [float(f"{v:.6g}") for v in f[::step]] for k, f in {"x": points, **shown}.items()}
     if problem == "sod":
-        s = sod.SodSettings()
-        regions = sod_regions(riemann.wave_positions(s.T, s.left, s.right), REGION_HALF_WIDTH)
+        regions = sod_regions(_sod_waves(), REGION_HALF_WIDTH)
         out["regions"] = {k: l1_by_region(points, f, weights["particles"], regions).tolist() for k, f in shown.items()}
     return out
 
 
+def _sod_waves() -> dict:
+    s = sod.SodSettings()
+    return riemann.wave_positions(s.T, s.left, s.right)
+
+
 def bases_case(case: dict) -> dict:
     """E2: Sod with the MPM stages and one basis: density errors and the plateau velocity noise."""
-    row, _ = _run("sod", _settings("sod", case["h"], case["basis"], {}), np.linspace(0, 1, 11))
-    return row
+    return _run("sod", _settings("sod", case["h"], case["basis"], {}), np.linspace(0, 1, 11))[0]
 
 
 def run_case(case: dict) -> dict:
@@ -187,9 +188,7 @@ def run(options: StudyOptions) -> None:
     if got["bases"]:
         e2 = [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()]
         write_table(folder, "bases", e2, settings)
-        convergence(folder / "bases.png", {f"{b}, {w}": ([r["h"] for r in e2 if r["basis"] == b and r["ok"]],
-                    [r[f"{w}_L1"] for r in e2 if r["basis"] == b and r["ok"]], style) for b in BASES
-                    for w, style in (("nodes", "o-"), ("particles", "s--"))}, ylabel="Sod density error (L1)", slopes=(1,))
+        draw(folder, BASES_PLOT, e2)
 
 
 def subset_rows(got: dict) -> list[dict]:
@@ -207,11 +206,9 @@ def decomposition_rows(rows: list[dict]) -> tuple[list, list]:
     shapley, interactions = [], []
     for (p, h, b, norm), values in groups.items():
         v = {S: values[label(S)] for S in subsets(STAGES)}
-        d = decompose(v, STAGES)
-        key = {"problem": p, "h": h, "basis": b, "norm": norm}
-        full, none = frozenset(STAGES), frozenset()
+        d, key, full = decompose(v, STAGES), {"problem": p, "h": h, "basis": b, "norm": norm}, frozenset(STAGES)
         shapley += [{**key, "stage": s, "shapley": d.shapley[s], "share": d.shapley[s] / d.gap,
-                     "removed": v[full] - v[full - {s}], "alone": v[frozenset({s})] - v[none],
+                     "removed": v[full] - v[full - {s}], "alone": d.moebius[frozenset({s})],
                      "mpm_error": d.total, "exact_error": d.floor} for s in STAGES]
         interactions += [{**key, "stages": label(S), "order": len(S), "term": m, "share": m / d.gap}
                          for S, m in d.interactions().items()]
@@ -226,6 +223,11 @@ def region_rows(got: dict) -> list[dict]:
 
 
 # ---------------------------------------------------------------- figures
+
+BASES_PLOT = Plot("bases.png", "E2: Sod density L1 with each basis, MPM stages", "bases", "h", (
+    Curve("{group}, nodes", "nodes_L1", "o-", {"ok": True}, group="basis"),
+    Curve("{group}, particles", "particles_L1", "s--", {"ok": True}, group="basis")), ylabel="density L1", slopes=(1,))
+
 
 def shapley_figure(path: Path, rows: list[dict]) -> None:
     """Per mesh: v(all exact) as a grey bar, beside it each stage's Shapley value stacked from that
@@ -259,14 +261,9 @@ def fields_figure(path: Path, problem: str, fields: dict) -> None:
         for s in STAGES:
             ax.plot(f["x"], f[s], "-", lw=0.8, color=COLORS[s], label=s)
         ax.plot(f["x"], f[GAP], "k-", lw=0.4, label=GAP)
-        if problem == "sod":
-            s = sod.SodSettings()
-            waves = riemann.wave_positions(s.T, s.left, s.right)
-            for w in ("rarefaction_head", "rarefaction_tail", "contact", "shock"):
-                ax.axvline(waves[w], color="gray", ls=":", lw=0.8)
-        ax.set(xlabel="x", ylabel="Shapley error field")
-        ax.set_title(f"{problem}, {basis}, h = {h:g}: {'density' if problem == 'sod' else 'velocity'} error by stage",
-                     fontsize=9)
+        for w in ("rarefaction_head", "rarefaction_tail", "contact", "shock") if problem == "sod" else ():
+            ax.axvline(_sod_waves()[w], color="gray", ls=":", lw=0.8)
+        ax.set(xlabel="x", ylabel="Shapley error field", title=f"{problem}, {basis}, h = {h:g}: error field by stage")
     axes[0, 0].legend(fontsize=7, ncol=5)
     save(fig, path)
 

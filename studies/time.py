@@ -20,7 +20,7 @@ import numpy as np
 
 from mpm_fem.grid import uniform_grid
 from mpm_fem.models.burgers import ViscousBurgers
-from mpm_fem.plots import plt, save, slope_guides
+from mpm_fem.plots import Curve, Plot, draw, plt, save
 from mpm_fem.problems import burgers
 from mpm_fem.solve import Problem
 from mpm_fem.step import Dirichlet
@@ -125,7 +125,7 @@ def run(options: StudyOptions) -> None:
     rows, local_rows = time_rows(got["time"])
     write_table(folder, "time_order", rows, settings)
     write_table(folder, "local_error", local_rows, settings)
-    time_figure(folder / "time_order.png", rows, local_rows)
+    draw(folder, TIME_PLOT, rows + [{**r, "quantity": "local " + r["quantity"]} for r in local_rows])
     rows = crossing_rows(got["crossing"])
     write_table(folder, "crossing", rows, settings)
     write_table(folder, "crossing_summary", crossing_summary(rows), settings)
@@ -176,35 +176,13 @@ def crossing_summary(rows: list[dict]) -> list[dict]:
 
 # ---------------------------------------------------------------- figures
 
-def time_figure(path: Path, rows: list[dict], local_rows: list[dict]) -> None:
-    """Global error against dt (pulse, Burgers) with slope 1; local error of x_p with slope 2."""
-    fig, axes = plt.subplots(1, 3, figsize=(13, 4.0))
-    for ax, problem in zip(axes, ("pulse", "burgers")):
-        for basis in BASES:
-            sub = [r for r in rows if (r["problem"], r["basis"], r["quantity"]) == (problem, basis, "velocity")]
-            if sub:
-                ax.loglog([r["dt"] for r in sub], [r["error"] for r in sub], "o-", ms=4,
-                          label=f"{basis} (order {sub[0]['fitted_order']:.2f})")
-        shown = [r for r in rows if r["problem"] == problem and r["quantity"] == "velocity"]
-        slope_guides(ax, [r["dt"] for r in shown], max(r["error"] for r in shown), (1,))
-        ax.set(xlabel="dt (fixed h, fixed particles)", ylabel="global velocity error at T (mean |v - v_ref|)")
-        ax.set_title(f"C1, {problem}: global error", fontsize=9)
-        ax.legend(fontsize=7)
-    for problem in ("pulse", "burgers"):
-        for basis in BASES:
-            sub = [r for r in local_rows if (r["problem"], r["basis"], r["quantity"]) == (problem, basis, "x")]
-            if sub:
-                axes[2].loglog([r["dt"] for r in sub], [r["error"] for r in sub], "o-" if problem == "pulse" else "s--",
-                               ms=4, label=f"{problem}, {basis} ({sub[0]['fitted_order']:.2f})")
-    shown = [r for r in local_rows if r["quantity"] == "x"]
-    slope_guides(axes[2], [r["dt"] for r in shown], max(r["error"] for r in shown), (2,))
-    axes[2].set(xlabel="dt", ylabel="local error of one step, max |x_p - x_p^ref|")
-    axes[2].set_title("C1: local error", fontsize=9)
-    axes[2].legend(fontsize=6)
-    for ax in axes:
-        ax.xaxis.set_minor_formatter(plt.NullFormatter())
-    save(fig, path)
-
+TIME_PLOT = Plot("time_order.png", "C1: error against dt at fixed h and particles", "time_order", "dt", tuple(
+    Curve(label, "error", fmt, where, panel, "basis") for label, fmt, where, panel in (
+        ("{group}", "o-", {"problem": "pulse", "quantity": "velocity"}, "pulse: global velocity error (slope 1)"),
+        ("{group}", "o-", {"problem": "burgers", "quantity": "velocity"}, "Burgers: global velocity error (slope 1)"),
+        ("pulse, {group}", "o-", {"problem": "pulse", "quantity": "local x"}, "one step: local error of x_p (slope 2)"),
+        ("Burgers, {group}", "s--", {"problem": "burgers", "quantity": "local x"}, "one step: local error of x_p (slope 2)"))),
+    xlabel="dt", ylabel="error", slopes=(1, 2))
 
 def crossing_figure(path: Path, got: dict, rows: list[dict]) -> None:
     """dA/dt along the particle's path (exact acceleration) and A itself (calculated), node crossings dotted."""
