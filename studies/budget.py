@@ -21,9 +21,8 @@ terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) -
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Tables: ``subsets.csv`` (v(S)), ``shapley.csv``, ``interactions.csv`` (Moebius terms of order >= 2),
-``regions.csv`` (Sod: each Shapley field's L1 by the regions of C12), ``runs.csv``; E2, ``bases.csv``:
-Sod with each basis in MPM form down to h = 0.00125 (density L1, plateau velocity scatter).
+Meshes: Sod h = 0.01 ... 0.0025 (GIMP, B-spline to 0.005), Burgers 0.04 ... 0.01: ~8 min on 2 cores on the
+numpy path (Sod to 0.000625 and Burgers to 0.005 with every basis: ~2.7 h). E2: Sod, each basis in MPM form.
 """
 
 from __future__ import annotations
@@ -54,7 +53,6 @@ SOD = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", sch
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025), "burgers": (0.04, 0.02, 0.01)}
-# cost on the numpy path (2 cores): Sod GIMP and B-spline at 0.0025 would add ~7 min; every mesh halving ~4x
 FINEST = {("sod", "gimp"): 0.005, ("sod", "bspline"): 0.005}
 BASES_H = (0.01, 0.005, 0.0025, 0.00125)  # E2: Sod with each basis, MPM stages only
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
