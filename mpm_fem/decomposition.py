@@ -93,7 +93,7 @@ def decompose(v: Mapping, stages: Iterable[str]) -> Decomposition:
         moebius[S] = _sum(terms)
     shapley = {s: _sum([moebius[S] / len(S) for S in all_subsets if s in S]) for s in stages}
     full = frozenset(stages)
-    return Decomposition(stages, _plain(moebius), _plain(shapley), _plain1(value[full]), _plain1(value[frozenset()]))
+    return Decomposition(stages, _unwrap(moebius), _unwrap(shapley), _number_or_array(value[full]), _number_or_array(value[frozenset()]))
 
 
 def shapley_by_orders(v: Mapping, stages: Iterable[str]) -> dict:
@@ -108,7 +108,7 @@ def shapley_by_orders(v: Mapping, stages: Iterable[str]) -> dict:
             out[s] = out[s] + (np.asarray(v[before | {s}], float) - np.asarray(v[before], float))
             before = before | {s}
     n = factorial(len(stages))
-    return {s: _plain1(value / n) for s, value in out.items()}
+    return {s: _number_or_array(value / n) for s, value in out.items()}
 
 
 def _sum(terms: list) -> np.ndarray:
@@ -117,9 +117,9 @@ def _sum(terms: list) -> np.ndarray:
     return reduce(np.add, terms)
 
 
-def _plain1(a: np.ndarray):
+def _number_or_array(a: np.ndarray):
     return float(a) if a.ndim == 0 else a
 
 
-def _plain(d: dict) -> dict:
-    return {k: _plain1(a) for k, a in d.items()}
+def _unwrap(d: dict) -> dict:
+    return {k: _number_or_array(a) for k, a in d.items()}
