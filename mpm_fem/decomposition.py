@@ -92,8 +92,8 @@ def decompose(v: Mapping, stages: Iterable[str]) -> Decomposition:
         terms = [(-1) ** (len(S) - len(T)) * value[T] for T in all_subsets if T <= S]
         moebius[S] = _sum(terms)
     shapley = {s: _sum([moebius[S] / len(S) for S in all_subsets if s in S]) for s in stages}
-    full = frozenset(stages)
-    return Decomposition(stages, _unwrap(moebius), _unwrap(shapley), _number_or_array(value[full]), _number_or_array(value[frozenset()]))
+    total, floor = (_number_or_array(value[S]) for S in (frozenset(stages), frozenset()))
+    return Decomposition(stages, _unwrap(moebius), _unwrap(shapley), total, floor)
 
 
 def shapley_by_orders(v: Mapping, stages: Iterable[str]) -> dict:
