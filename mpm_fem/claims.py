@@ -421,11 +421,12 @@ FIRST_ORDER = (0.8, 1.2)
 C13_METHODS = {"exact a, dt ~ h": "mpm_exact_dt_h", "calculated a": "mpm_calculated"}
 
 
+_C13_RULE = (f"least-squares order in [{FIRST_ORDER[0]}, {FIRST_ORDER[1]}] on every eps, for the exact (dt ~ h) and "
+             "the calculated acceleration -> confirmed; for one of them -> partly; for none -> differs")
+
+
 @claim("C13", source="first order with exact and with calculated acceleration", tables=("burgers/orders",),
-       study="burgers",
-       thresholds=f"least-squares order in [{FIRST_ORDER[0]}, {FIRST_ORDER[1]}] on every eps, for the exact "
-                  "(dt ~ h) and the calculated acceleration -> confirmed; for one of them -> partly; for none -> "
-                  "differs",
+       study="burgers", thresholds=_C13_RULE,
        explanation="With the exact acceleration the O(dt) time error dominates when dt ~ h; with the viscous time "
                    "step it is second order. The calculated acceleration stalls at four particles per cell: the "
                    "weight of each cell in the force quadrature jumps whenever a particle crosses a node.")

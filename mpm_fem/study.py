@@ -8,12 +8,13 @@ finished cases lives in ``figures/<name>/.cache/`` (git-ignored).
 from __future__ import annotations
 
 import csv
-import sys
 import io
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 from .output import versions, write_atomic, write_json
+from .tables import read_table  # noqa: F401  (re-exported: the studies' and tests' reader)
 from .sweep import code_version, run_cases
 
 
@@ -70,10 +71,18 @@ def write_table(folder: Path, table: str, rows: list[dict], settings: dict) -> P
     return path
 
 
-def read_table(path: Path) -> list[dict]:
-    """Rows of a CSV table written by :func:`write_table` (values as strings)."""
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+def publish(folder: Path, tables: dict[str, list[dict]], settings: dict, extra: dict | None = None, figures=()) -> None:
+    """Write every non-empty table of ``tables`` (``{name: rows}``) with ``settings`` (and the
+    ``extra`` settings of that table), then draw the ``figures`` (:class:`mpm_fem.plots.Plot`) whose
+    table was written."""
+    from . import plots
+
+    for name, rows in tables.items():
+        if rows:
+            write_table(folder, name, rows, {**settings, **(extra or {}).get(name, {})})
+    for plot in figures:
+        if tables.get(plot.table):
+            plots.draw(folder, plot, tables[plot.table])
 
 
 def _fmt(value):

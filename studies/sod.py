@@ -21,8 +21,7 @@ from mpm_fem.particles import PositivityError
 from mpm_fem.problems import sod
 from mpm_fem.regions import REGION_NAMES, ExtremaCounter, describe
 from mpm_fem.plots import Curve, Plot
-from mpm_fem.report import Page, View
-from mpm_fem.study import StudyOptions, script_main, write_table
+from mpm_fem.study import StudyOptions, publish, script_main
 
 NAME = "sod"
 H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)
@@ -112,10 +111,10 @@ def run(options: StudyOptions) -> None:
     waves = riemann.wave_positions(T, sod.SodSettings.left, sod.SodSettings.right)
     extra = {"regions": {"regions": describe(REGION_HALF_WIDTH, waves, T)}, "extrema": {
         "rtol": 1e-9, "definition": "new strict local extremum among position-ordered particles"}}
-    for name, rows in tables.items():
-        if rows:
-            write_table(folder, name, rows, {**settings, **extra.get(name, {})})
-    _figures(folder, got, tables)
+    publish(folder, tables, settings, extra, PLOTS)
+    plots.stacked_shares(folder / "regions.png", tables["regions"], REGION_NAMES, f"C12: density L1 error by region of "
+                         f"the exact solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
+    _profiles(folder, got)
 
 
 def _L1(r, where="nodes", norm="L1"):
@@ -235,18 +234,10 @@ PLOTS = (
                                                                ("elsewhere", "other particles", {"alpha": 0.5}))),
          ylabel="new extrema", size=(4.5, 3.6)),
     Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", "ppc", "ppc", tuple(
-        Curve("h = {group}", f"{w}_L1", panel=f"over {name}", group="h", where={"ok": True})
+        Curve("h = {h}", f"{w}_L1", panel=f"over {name}", group=("h",), where={"ok": True})
         for w, name in (("nodes", "grid nodes"), ("particles", "particles"))),
         xlabel="particles per cell N_p", ylabel="density error (L1)", size=(4.5, 3.6)),
 )
-
-
-def _figures(folder, got, t) -> None:
-    for plot in PLOTS:
-        plots.draw(folder, plot, t[plot.table])
-    plots.stacked_shares(folder / "regions.png", t["regions"], REGION_NAMES, f"C12: density L1 error by region of the exact "
-                         f"solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
-    _profiles(folder, got)
 
 
 def _profiles(folder, got) -> None:
@@ -266,33 +257,6 @@ def _profiles(folder, got) -> None:
                                                           ("MPM grid nodes", mp["nodes"], nodal, "x", {"ms": 3, "color": "tab:red"})],
             f"FEM (P1, SSPRK3, CFL {FEM['cfl']})": fem},
             f"Sod at T = {T}, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh")
-
-
-_CONVERGENCE = ("h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1",
-                "mpm_particles_L1", "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1", "order_fv_L1")
-PAGE = Page(
-    NAME, "Sod's shock tube",
-    "Density error at the final time against the exact Riemann solution, with one set of MPM settings for every "
-    "mesh (recorded in the JSON beside each table), over particles and over grid nodes, beside P1 FEM with "
-    "consistent and lumped mass and a finite-volume reference on the same mesh, and beside the source's table.",
-    views=(
-        View("sod/convergence", "Density L1 against h, beside the source", _CONVERGENCE, {}, "convergence.png"),
-        View("sod/convergence", "What sets the floor: volume gained by the particles, signed mean error in the "
-             "smooth region, position error of the rarefaction head", ("h", "mpm_volume_drift",
-             "mpm_particles_mean_error_smooth", "mpm_nodes_mean_error_smooth", "mpm_head_shift", "fem_consistent_head_shift")),
-        View("sod/regions", "Share of the L1 error by region of the exact solution",
-             ("method", "h", "L1") + tuple(f"share_{k}" for k in range(len(REGION_NAMES))), {}, "regions.png"),
-        View("sod/extrema", "New extrema per step, at cell crossings and elsewhere", ("h", "steps", "crossings_per_step",
-             "density_new_per_step", "density_rate_crossing", "density_rate_elsewhere", "density_rate_ratio",
-             "energy_new_per_step", "energy_rate_ratio"), {}, "extrema.png"),
-        View("sod/ppc", "Error against particles per cell", ("h", "ppc", "ok", "nodes_L1", "particles_L1"), {}, "ppc.png"),
-        View("sod/mass", "Lumped against consistent mass, MPM and FEM"),
-        View("sod/plateau", "What moves the floor: one setting changed at a time", ("h", "variant", "ok", "nodes_L1",
-             "nodes_vs_study", "particles_L1", "particles_vs_study", "density_new_extrema_per_step")),
-    ),
-    figures=tuple((f"profiles_h{h:g}.png", "Profiles against the exact solution, MPM above and FEM below, on the "
-                   "mesh named in the file") for h in PROFILE_H),
-)
 
 
 if __name__ == "__main__":
