@@ -36,11 +36,10 @@ from baselines.exact import riemann
 from mpm_fem.decomposition import decompose, label, subsets
 from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
-from mpm_fem.plots import Curve, Plot, draw, plt, save
+from mpm_fem.plots import Curve, Plot, plt, save
 from mpm_fem.problems import burgers, sod
 from mpm_fem.regions import REGION_NAMES, l1_by_region, plateau_velocity, sod_regions
-from mpm_fem.report import Page, View
-from mpm_fem.study import StudyOptions, script_main, write_table
+from mpm_fem.study import StudyOptions, publish, script_main
 from mpm_fem.timing import field_on
 
 NAME = "budget"
@@ -172,21 +171,14 @@ def run(options: StudyOptions) -> None:
                 "region_half_width": REGION_HALF_WIDTH, "quick": options.quick}
     ok = {key: r for key, r in got["budget"].items() if r["ok"]}  # in the plan's order
     rows = subset_rows(ok)
-    write_table(folder, "subsets", rows, settings)
     shapley, interactions = decomposition_rows(rows)
-    write_table(folder, "shapley", shapley, settings)
-    write_table(folder, "interactions", interactions, settings)
-    write_table(folder, "runs", [{"problem": p, "h": h, "basis": b, **x} for (p, h, b), r in got["budget"].items() for x in r["runs"]], settings)
-    if region_rows(ok):
-        write_table(folder, "regions", region_rows(ok), settings)
+    publish(folder, {"subsets": rows, "shapley": shapley, "interactions": interactions, "regions": region_rows(ok),
+                     "runs": [{"problem": p, "h": h, "basis": b, **x} for (p, h, b), r in got["budget"].items() for x in r["runs"]],
+                     "bases": [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()]}, settings, figures=(BASES_PLOT,))
     for problem in sorted({r["problem"] for r in shapley}):
         shapley_figure(folder / f"shapley_{problem}.png", [r for r in shapley if r["problem"] == problem])
         finest = {b: min(h for p, h, bb in ok if p == problem and bb == b) for p, _, b in ok if p == problem}
         fields_figure(folder / f"fields_{problem}.png", problem, {b: (h, ok[(problem, h, b)]["fields"]) for b, h in finest.items()})
-    if got["bases"]:
-        e2 = [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()]
-        write_table(folder, "bases", e2, settings)
-        draw(folder, BASES_PLOT, e2)
 
 
 def subset_rows(got: dict) -> list[dict]:
@@ -223,8 +215,8 @@ def region_rows(got: dict) -> list[dict]:
 # ---------------------------------------------------------------- figures
 
 BASES_PLOT = Plot("bases.png", "E2: Sod density L1 with each basis, MPM stages", "bases", "h", (
-    Curve("{group}, nodes", "nodes_L1", "o-", {"ok": True}, group="basis"),
-    Curve("{group}, particles", "particles_L1", "s--", {"ok": True}, group="basis")), ylabel="density L1", slopes=(1,))
+    Curve("{basis}, nodes", "nodes_L1", "o-", {"ok": True}, group=("basis",)),
+    Curve("{basis}, particles", "particles_L1", "s--", {"ok": True}, group=("basis",))), ylabel="density L1", slopes=(1,))
 
 
 def shapley_figure(path: Path, rows: list[dict]) -> None:
@@ -248,7 +240,8 @@ def shapley_figure(path: Path, rows: list[dict]) -> None:
         ax.set_xticks(range(len(hs)), [f"{h:g}" for h in hs])
         ax.set(xlabel="h", ylabel=f"{norm} L1 error", title=f"{rows[0]['problem']}, {basis}, {norm}")
     axes[-1][-1].legend(fontsize=6)
-    save(fig, path)
+    save(fig, path, caption=f"{rows[0]['problem']}: v(all exact) as the grey floor, each stage's Shapley value stacked on "
+                            "it (signed), ending at v(all MPM) (black mark)")
 
 
 def fields_figure(path: Path, problem: str, fields: dict) -> None:
@@ -263,35 +256,8 @@ def fields_figure(path: Path, problem: str, fields: dict) -> None:
             ax.axvline(_sod_waves()[w], color="gray", ls=":", lw=0.8)
         ax.set(xlabel="x", ylabel="Shapley error field", title=f"{problem}, {basis}, h = {h:g}: error field by stage")
     axes[0, 0].legend(fontsize=7, ncol=5)
-    save(fig, path)
-
-
-# ---------------------------------------------------------------- the report's section
-
-_SHAPLEY = ("h", "basis", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error")
-_REGIONS = ("h", "basis", "field", "L1", *(f"share_{n.replace(' ', '_')}" for n in REGION_NAMES))
-PAGE = Page(
-    NAME, "Error budget (E1) and bases (E2)",
-    "Every combination of the four stages in MPM or exact form, on each mesh and basis: the error of each "
-    "combination, its exact decomposition into each stage's Shapley value (main effect plus an equal share of "
-    "every interaction the stage takes part in) and the interactions; each stage's signed error field and where "
-    "along the tube it sits; and Sod with each basis.",
-    views=(
-        View("budget/shapley", "Sod, particle density L1: each stage's Shapley value and share of v(all MPM) - "
-             "v(all exact); removed and alone are the one-at-a-time views", _SHAPLEY,
-             {"problem": "sod", "norm": "particles"}, "shapley_sod.png"),
-        View("budget/shapley", "Sod, nodal density L1", _SHAPLEY, {"problem": "sod", "norm": "nodes"}),
-        View("budget/shapley", "Burgers, particle velocity L1", _SHAPLEY, {"problem": "burgers"}, "shapley_burgers.png"),
-        View("budget/interactions", "Sod, point-mass P1, particles: the interactions (Moebius terms of two and more "
-             "stages)", ("h", "stages", "term", "share"), {"problem": "sod", "basis": "mpm", "norm": "particles"}),
-        View("budget/regions", "Sod, point-mass P1: share of each Shapley error field's L1 by region of the exact "
-             "solution (C12)", _REGIONS, {"basis": "mpm"}, "fields_sod.png"),
-        View("budget/bases", "E2: Sod with each basis, MPM stages", ("basis", "h", "ok", "particles_L1", "nodes_L1",
-             "plateau_noise", "plateau_offset"), {}, "bases.png"),
-    ),
-    figures=(("fields_burgers.png", "Each stage's Shapley error field of Burgers at the finest mesh; they add up "
-              "to e_MPM - e_exact (black) at every point"),),
-)
+    save(fig, path, caption=f"{problem}: each stage's Shapley error field at the finest mesh of each basis; they add up "
+                            "to e_MPM - e_exact (black) at every point" + (", waves dotted" if problem == "sod" else ""))
 
 
 if __name__ == "__main__":

@@ -24,7 +24,6 @@ from mpm_fem.plots import Curve, Plot, draw, plt, save
 from mpm_fem.problems import burgers
 from mpm_fem.solve import Problem
 from mpm_fem.step import Dirichlet
-from mpm_fem.report import Page, View
 from mpm_fem.study import StudyOptions, script_main, write_table
 from mpm_fem.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, observed_order,
                             pulse_setup, simulate_pulse, state_at)
@@ -179,11 +178,11 @@ def crossing_summary(rows: list[dict]) -> list[dict]:
 GLOBAL_SLOPE, LOCAL_SLOPE = 1, 2  # C1: the orders in dt the guides show
 LOCAL_PANEL = f"one step: local error of x_p (slope {LOCAL_SLOPE})"
 TIME_PLOT = Plot("time_order.png", "C1: error against dt at fixed h and particles", "time_order", "dt", tuple(
-    Curve(label, "error", fmt, where, panel, "basis") for label, fmt, where, panel in (
-        ("{group}", "o-", {"problem": "pulse", "quantity": "velocity"}, f"pulse: global velocity error (slope {GLOBAL_SLOPE})"),
-        ("{group}", "o-", {"problem": "burgers", "quantity": "velocity"}, f"Burgers: global velocity error (slope {GLOBAL_SLOPE})"),
-        ("pulse, {group}", "o-", {"problem": "pulse", "quantity": "local x"}, LOCAL_PANEL),
-        ("Burgers, {group}", "s--", {"problem": "burgers", "quantity": "local x"}, LOCAL_PANEL))),
+    Curve(label, "error", fmt, where, panel, ("basis",)) for label, fmt, where, panel in (
+        ("{basis}", "o-", {"problem": "pulse", "quantity": "velocity"}, f"pulse: global velocity error (slope {GLOBAL_SLOPE})"),
+        ("{basis}", "o-", {"problem": "burgers", "quantity": "velocity"}, f"Burgers: global velocity error (slope {GLOBAL_SLOPE})"),
+        ("pulse, {basis}", "o-", {"problem": "pulse", "quantity": "local x"}, LOCAL_PANEL),
+        ("Burgers, {basis}", "s--", {"problem": "burgers", "quantity": "local x"}, LOCAL_PANEL))),
     xlabel="dt", ylabel="error", slopes=(GLOBAL_SLOPE, LOCAL_SLOPE))
 
 def crossing_figure(path: Path, got: dict, rows: list[dict]) -> None:
@@ -204,27 +203,8 @@ def crossing_figure(path: Path, got: dict, rows: list[dict]) -> None:
         ax.set_title("C2, exact nodal acceleration: P1 jumps at every node crossing (dotted)" if acc == "exact" else
                      "calculated acceleration: a_i jumps when any particle crosses a node", fontsize=8)
         ax.legend(fontsize=7)
-    save(fig, path)
-
-
-# ---------------------------------------------------------------- the report's section
-
-PAGE = Page(
-    NAME, "Time error (C1) and grid crossing (C2)",
-    "At a fixed mesh and fixed particles, the time step alone is refined against a much smaller step: the global "
-    "error at the final time and the local error of one step from a common state; and the third time derivative "
-    "of one particle's position along its path, measured at each node crossing beside the slides' formula.",
-    views=(
-        View("time/time_order", "Global error against dt: fitted order per problem, basis and quantity",
-             ("problem", "basis", "quantity", "fitted_order"), {"order": ""}, "time_order.png"),
-        View("time/local_error", "Local error of one step: fitted order", ("problem", "basis", "quantity", "fitted_order"),
-             {"order": ""}),
-        View("time/crossing_summary", "Jump of dA/dt at node crossings, measured against the slides' formula",
-             ("basis", "acceleration", "crossings", "median_ratio", "max_ratio_error", "max_abs_ratio",
-              "median_abs_measured"), {},
-             "crossing.png"),
-    ),
-)
+    save(fig, path, caption="C2: dA/dt along one particle's path (exact acceleration; P1 jumps at each node crossing, "
+                            "dotted) and A itself (calculated acceleration)")
 
 
 if __name__ == "__main__":
