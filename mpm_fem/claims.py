@@ -387,8 +387,8 @@ def _c15_sod(t: Tables) -> tuple[str, str]:
 def _e3(t: Tables) -> tuple[str, str]:
     rows = t[CONVERGENCE]
     full = [r for r in rows if all(math.isfinite(num(r, c)) for c in SIDE_BY_SIDE.values())]
-    fv = setting(t, CONVERGENCE, "fv.scheme", "FV") + " (" + setting(t, CONVERGENCE, "fv.limiter", "limiter not recorded") + ")"
-    fem = "FEM viscosity " + setting(t, CONVERGENCE, "fem.viscosity", "not recorded")
+    fv = setting(t, CONVERGENCE, "fv.scheme", "FV") + ("" if setting(t, CONVERGENCE, "fv.limiter") else ", limiter not recorded")
+    fem = "FEM: " + setting(t, CONVERGENCE, "fem.viscosity", "viscosity variant not recorded")
     last = rows[-1]
     verdict = count_verdict(len(full), len(rows), "not measured")
     return verdict, (f"density L1 at h = {last['h']}: " + ", ".join(f"{m} {num(last, c):.3g}" for m, c in SIDE_BY_SIDE.items())

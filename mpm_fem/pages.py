@@ -65,10 +65,10 @@ PAGES = (
              View("sod/convergence", "Density L1 against h, beside the source", (
                  "h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1", "mpm_particles_L1",
                  "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1", "order_fv_L1"), {}, "convergence.png"),
-             View("sod/convergence", "What sets the floor: volume gained by the particles, signed mean error in the "
-                  "smooth region, position error of the rarefaction head", (
-                      "h", "mpm_volume_drift", "mpm_particles_mean_error_smooth", "mpm_nodes_mean_error_smooth",
-                      "mpm_head_shift", "fem_consistent_head_shift")),
+             View("sod/convergence", "What sets the floor: volume gained by the particles, relative drift of the "
+                  "total energy, signed mean error in the smooth region, position error of the rarefaction head", (
+                      "h", "mpm_volume_drift", "mpm_energy_drift", "mpm_particles_mean_error_smooth",
+                      "mpm_nodes_mean_error_smooth", "mpm_head_shift", "fem_consistent_head_shift")),
              View("sod/regions", "Share of the L1 error by region of the exact solution",
                   ("method", "h", "L1") + tuple(f"share_{k}" for k in range(len(REGION_NAMES))), {}, "regions.png"),
              View("sod/extrema", "New extrema per step, at cell crossings and elsewhere", (

@@ -11,7 +11,6 @@ committed tables again gives the same bytes: ``python -m mpm_fem.report [--out f
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import math
 import sys
@@ -186,9 +185,10 @@ def write_report(out: Path, pages: list[Page] | None = None) -> Path:
 
 def reproduce(options) -> Path:
     """Run every study with ``options`` (:class:`mpm_fem.study.StudyOptions`), then write the report."""
-    studies = importlib.import_module("studies")
-    for name in studies.STUDIES:
-        importlib.import_module(f"studies.{name}").run(options)
+    from .study import STUDIES, run_study
+
+    for name in STUDIES:
+        run_study(name, options)
     return write_report(options.out)
 
 

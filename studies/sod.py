@@ -29,8 +29,9 @@ SOURCE = source.SOD
 T = sod.SodSettings.T
 # One set of MPM settings for every h (never tuned per mesh); why these: ppc.csv and plateau.csv
 MPM = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", scheme="usl", basis="mpm", layout="regular", seed=0)
-FEM = dict(cfl=0.3, viscosity_linear=0.1, viscosity_quadratic=1.0)  # baselines.fem_euler defaults
-FV_CFL = 0.8  # baselines.fv_euler default
+# E3: FEM with the baselines.fem_euler defaults (viscosity on every cell); FV with the stronger of its limiters
+FEM = dict(cfl=0.3, viscosity_linear=0.1, viscosity_quadratic=1.0, compression_only=False)
+FV = dict(cfl=0.8, limiter="mc")
 REGION_HALF_WIDTH = 0.02  # every wave, every mesh: two cells of the coarsest mesh on each side
 PROFILE_H = (0.01, 0.0025)
 PPC = (1, 2, 4, 8, 16, 32)
@@ -49,11 +50,11 @@ def run_case(case: dict) -> dict:
     :data:`MPM` and ``h``), ``"fem"`` (``h``, ``mass`` and the keys of :data:`FEM`) or ``"fv"``."""
     h, width, profiles = case["h"], case.get("region_half_width"), case.get("profiles", False)
     if case["solver"] == "fv":
-        return shock_tube.fv(fv_euler.solve(h, cfl=case["cfl"]), h)
+        return shock_tube.fv(fv_euler.solve(h, cfl=case["cfl"], limiter=case["limiter"]), h)
     if case["solver"] == "fem":
         try:
             r = fem_euler.solve(h, mass=case["mass"], cfl=case["cfl"],
-                                viscosity=fem_euler.Viscosity(case["viscosity_linear"], case["viscosity_quadratic"]))
+                                viscosity=_viscosity(case))
         except fem_euler.PositivityError as err:
             return {"ok": False, "error": str(err)}
         return shock_tube.fem(r, uniform_grid(0.0, 1.0, h).lumped_mass, width, profiles)
@@ -64,6 +65,10 @@ def run_case(case: dict) -> dict:
     except (PositivityError, FloatingPointError) as err:
         return {"ok": False, "error": str(err), "steps": counter.steps}
     return shock_tube.mpm(settings, result, sod.errors(settings, result), counter.summary(), width, profiles)
+
+
+def _viscosity(fem: dict) -> fem_euler.Viscosity:
+    return fem_euler.Viscosity(fem["viscosity_linear"], fem["viscosity_quadratic"], fem["compression_only"])
 
 
 def mpm_case(h: float, **changes) -> dict:
@@ -93,7 +98,7 @@ def _plan(quick: bool) -> dict:
         "mpm_consistent": {h: mpm_case(h, mass="consistent") for h in consistent_h},
         "fem_consistent": {h: fem_case(h, "consistent") for h in hs},
         "fem_lumped": {h: fem_case(h, "lumped") for h in hs},
-        "fv": {h: {"solver": "fv", "h": h, "cfl": FV_CFL} for h in hs},
+        "fv": {h: {"solver": "fv", "h": h, **FV} for h in hs},
         "ppc": {(h, n): mpm_case(h, ppc=n) if n != MPM["ppc"] else mpm_case(h) for h in ppc_h for n in PPC},
         "plateau": {(h, name): mpm_case(h, **change) if change else mpm_case(h)
                     for h in plateau_h for name, change in PLATEAU_VARIANTS.items()},
@@ -104,7 +109,8 @@ def run(options: StudyOptions) -> None:
     """All cases in one sweep (shared ones run once), then tables and figures."""
     got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
     folder = options.folder(NAME)
-    settings = {"mpm": MPM, "fem": FEM, "fv": {"cfl": FV_CFL, "scheme": "MUSCL-Hancock + HLLC"}, "region_half_width": REGION_HALF_WIDTH, "T": T,
+    settings = {"mpm": MPM, "fem": {**FEM, "viscosity": _viscosity(FEM).name}, "fv": {**FV, "scheme": fv_euler.label(FV["limiter"])},
+                "region_half_width": REGION_HALF_WIDTH, "T": T,
                 "quick": options.quick, "problem": sod.SodSettings().as_dict()}
     tables = {"convergence": _convergence(got), "regions": _regions(got), "extrema": _extrema(got), "ppc": _ppc(got),
               "mass": _mass(got), "plateau": _plateau(got) if got["plateau"] else []}
@@ -145,7 +151,7 @@ def _convergence(got) -> list[dict]:
             "mpm_volume_drift": r.get("volume_drift", ""), "mpm_head_shift": r.get("head_shift", ""),
             "fem_consistent_head_shift": got["fem_consistent"][h].get("head_shift", ""),
             "mpm_steps": r.get("steps"), "mpm_particles": r.get("particles"),
-            "mpm_wall_s": round(r.get("wall_s", float("nan")), 2)})
+            "mpm_wall_s": round(r.get("wall_s", float("nan")), 2), "mpm_energy_drift": r.get("energy_drift", "")})
         rows.append(row)
     return rows
 
@@ -225,7 +231,7 @@ PLOTS = (
     Plot("convergence.png", f"Sod, T = {T}: density L1 error against h, beside the source's table", "convergence", "h", (
         Curve("MPM, grid nodes", "mpm_nodes_L1"), Curve("MPM, particles", "mpm_particles_L1", "s-"),
         Curve("FEM consistent", "fem_consistent_L1", "^--"), Curve("FEM lumped", "fem_lumped_L1", "v--"),
-        Curve("FV (MUSCL-Hancock + HLLC)", "fv_L1", "x-."), Curve("source (slides)", "source_L1", "k*")),
+        Curve(fv_euler.label(FV["limiter"]), "fv_L1", "x-."), Curve("source (slides)", "source_L1", "k*")),
         ylabel="density error (L1)", slopes=(0.5, 1)),
     Plot("extrema.png", "C14: new extrema of particle density and energy, per step and per particle-step", "extrema", "h",
          tuple(Curve(n, f"{n}_new_per_step", f, panel="new extrema per step") for n, f in _STYLES.items())
