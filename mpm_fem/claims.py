@@ -535,9 +535,9 @@ def _trend(shares: list[float]) -> str:
 
 
 def budget_verdicts(rows: list[dict], norm: str) -> tuple[dict, bool]:
-    """Per basis: the dominant stage at the finest mesh (or the two largest when none reaches
-    DOMINANT), its shares from the coarsest mesh to the finest, and whether the shares of every
-    mesh add up to one."""
+    """Per basis, at the finest mesh: the stages ranked by Shapley share, the dominant one (the
+    largest, when it reaches DOMINANT), the shares of the largest from the coarsest mesh to the
+    finest; and whether the shares of every mesh add up to one."""
     out, closes = {}, True
     for basis in dict.fromkeys(r["basis"] for r in rows):
         sub = select(rows, basis=basis, norm=norm)
@@ -545,10 +545,20 @@ def budget_verdicts(rows: list[dict], norm: str) -> tuple[dict, bool]:
         share = {h: {r["stage"]: num(r, "share") for r in sub if num(r, "h") == h} for h in hs}
         closes &= all(abs(sum(s.values()) - 1) <= CLOSURE for s in share.values())
         ranked = sorted(share[hs[-1]].items(), key=lambda kv: -kv[1])
-        top = ranked[0][0] if ranked[0][1] >= DOMINANT else None
-        out[basis] = {"h": hs[-1], "dominant": top, "ranked": ranked[:2],
-                      "shares": [share[h].get(top or ranked[0][0], math.nan) for h in hs]}
+        out[basis] = {"h": hs[-1], "ranked": ranked, "dominant": ranked[0][0] if ranked[0][1] >= DOMINANT else None,
+                      "shares": [share[h].get(ranked[0][0], math.nan) for h in hs]}
     return out, closes
+
+
+def _e1_text(basis: str, f: dict) -> str:
+    """``mpm at h = 0.0025: projection 326% (136% -> 326%, grows as h shrinks); compensated by mass -180%``."""
+    (top, v), second = f["ranked"][0], f["ranked"][1]
+    head = (f"{top} {v:.0%}" if f["dominant"] else f"shared: {top} {v:.0%} and {second[0]} {second[1]:.0%}")
+    also = [f"{s} {x:.0%}" for s, x in f["ranked"][1:] if x >= DOMINANT]
+    low = f["ranked"][-1]
+    return (f"{basis} at h = {f['h']:g}: {head} ({' -> '.join(f'{x:.0%}' for x in f['shares'])}, {_trend(f['shares'])})"
+            + (f", also above half {', '.join(also)}" if also and f["dominant"] else "")
+            + (f"; compensated by {low[0]} {low[1]:.0%}" if low[1] < 0 else ""))
 
 
 def _e1(problem: str) -> Criterion:
@@ -556,20 +566,15 @@ def _e1(problem: str) -> Criterion:
         rows = select(t[SHAPLEY], problem=problem)
         norms = list(dict.fromkeys(r["norm"] for r in rows))
         found, closes = budget_verdicts(rows, norms[0])
-        parts = []
-        for basis, f in found.items():
-            name = f["dominant"] or " and ".join(s for s, _ in f["ranked"])
-            what = (f"{name} dominates" if f["dominant"] else f"shared, largest {name}")
-            parts.append(f"{basis} at h = {f['h']:g}: {what} ({', '.join(f'{s} {v:.0%}' for s, v in f['ranked'])}); "
-                         f"share of {f['dominant'] or f['ranked'][0][0]} {' -> '.join(f'{v:.0%}' for v in f['shares'])}, "
-                         f"{_trend(f['shares'])}")
+        parts = [_e1_text(basis, f) for basis, f in found.items()]
         for norm in norms[1:]:
             other, ok = budget_verdicts(rows, norm)
             closes &= ok
-            parts.append(f"{norm}: " + ", ".join(f"{b} {f['dominant'] or 'shared'}" for b, f in other.items()))
+            parts.append(f"{norm} L1: " + ", ".join(f"{b} {f['ranked'][0][0]} {f['ranked'][0][1]:.0%}" for b, f in other.items()))
         dominated = sum(f["dominant"] is not None for f in found.values())
         verdict = ("refuted" if not closes else "confirmed" if dominated == len(found) else "partly")
-        return verdict, f"{norms[0]} L1: " + "; ".join(parts) + ("" if closes else "; the shares do not add up to one")
+        return verdict, f"{norms[0]} L1, largest Shapley share: " + "; ".join(parts) + (
+            "" if closes else "; the shares do not add up to one")
     return criterion
 
 

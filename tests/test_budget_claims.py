@@ -29,14 +29,15 @@ DOMINATED = {(0.04, "mpm"): (0.55, 0.2, 0.15, 0.1), (0.02, "mpm"): (0.7, 0.1, 0.
 def test_e1_names_the_dominant_stage_and_whether_its_share_grows():
     verdict, evidence = judge("E1 (burgers)", {"budget/shapley": _shapley(DOMINATED)})
     assert verdict == "confirmed"
-    assert "mpm at h = 0.02: projection dominates" in evidence and "55% -> 70%, grows as h shrinks" in evidence
+    assert "mpm at h = 0.02: projection 70% (55% -> 70%, grows as h shrinks)" in evidence
+    assert "gimp at h = 0.02: projection 80% (60% -> 80%, grows as h shrinks); compensated by time -10%" in evidence
 
 
 def test_e1_is_partly_when_no_stage_reaches_half_and_names_the_two_largest():
     shared = {**DOMINATED, (0.02, "gimp"): (0.4, 0.35, 0.2, 0.05)}
     assert_flips("E1 (burgers)", {"budget/shapley": _shapley(shared)}, {"budget/shapley": _shapley(DOMINATED)})
     verdict, evidence = judge("E1 (burgers)", {"budget/shapley": _shapley(shared)})
-    assert verdict == "partly" and "gimp at h = 0.02: shared, largest projection and mass (projection 40%, mass 35%)" in evidence
+    assert verdict == "partly" and "gimp at h = 0.02: shared: projection 40% and mass 35%" in evidence
 
 
 def test_e1_is_refuted_when_the_shares_do_not_add_up():
@@ -48,7 +49,7 @@ def test_e1_is_refuted_when_the_shares_do_not_add_up():
 def test_e1_sod_reads_both_norms_and_is_not_measured_without_its_table():
     tables = {"budget/shapley": _shapley(DOMINATED, "sod") + _shapley(DOMINATED, "sod", "nodes")}
     verdict, evidence = judge("E1 (sod)", tables)
-    assert verdict == "confirmed" and "nodes: mpm projection, gimp projection" in evidence
+    assert verdict == "confirmed" and "nodes L1: mpm projection 70%, gimp projection 80%" in evidence
     assert judge("E1 (sod)", {})[0] == "not measured"
 
 
