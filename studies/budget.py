@@ -239,7 +239,7 @@ def shapley_figure(path: Path, rows: list[dict]) -> None:
         ax.axhline(0, color="k", lw=0.5)
         ax.set_xticks(range(len(hs)), [f"{h:g}" for h in hs])
         ax.set(xlabel="h", ylabel=f"{norm} L1 error", title=f"{rows[0]['problem']}, {basis}, {norm}")
-    axes[-1][-1].legend(fontsize=6)
+    axes[0][-1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     save(fig, path, caption=f"{rows[0]['problem']}: v(all exact) as the grey floor, each stage's Shapley value stacked on "
                             "it (signed), ending at v(all MPM) (black mark)")
 
