@@ -56,7 +56,7 @@ FINEST = {("sod", "gimp"): 0.005, ("sod", "bspline"): 0.005}
 BASES_H = (0.01, 0.005, 0.0025, 0.00125)  # E2: Sod with each basis, MPM stages only
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
-QUICK = {"h": {"sod": (0.01,), "burgers": (0.04, 0.02)}, "bases": ("mpm",), "bases_h": ()}
+QUICK = {"h": {"sod": (0.02,), "burgers": (0.04, 0.02)}, "bases": ("mpm",), "bases_h": ()}
 GAP = "all MPM - all exact"
 COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:green", "time": "tab:red"}
 
