@@ -589,7 +589,7 @@ for _problem in ("sod", "burgers"):
           tables=(SHAPLEY,), study="budget", problem=_problem, thresholds=_E1_RULE, explanation=_E1_WHY)(_e1(_problem))
 
 
-@claim("E2", source="does a smooth basis remove the stagnation of C11?", tables=("budget/bases",), study="budget",
+@claim("E2", source="whether a smooth basis removes the stagnation of C11", tables=("budget/bases",), study="budget",
        thresholds=f"P1's particle density L1 order over the last refinement is below {FLOOR_ORDER} and a C1 basis "
                   f"keeps it above {CONVERGING_ORDER} -> confirmed; a C1 basis above P1 -> partly; none above P1 -> "
                   "refuted; P1 not levelled off -> differs")
