@@ -41,6 +41,7 @@ class Page:
 _SOLUTION, _WHERE, _NORM = BURGERS_SHOWN["solution"], BURGERS_SHOWN["where"], BURGERS_SHOWN["norm"]
 _COMPARED = f"{_WHERE}_{_NORM}"
 _FIRST_EPS = max(BURGERS["exact"])
+_SHAPLEY = ("h", "basis", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error")
 
 PAGES = (
     Page("projection", "Projection and particle quadrature",
@@ -105,5 +106,38 @@ PAGES = (
                   {}, "lumping.png"),
              View("burgers/diagnosis", "Why the calculated acceleration stalls: one change at a time",
                   ("variant", "h", f"{_WHERE}_L1", "order_L1"), {}, "diagnosis.png"),
+         )),
+    Page("budget", "Error budget (E1) and bases (E2)",
+         "Every combination of the four stages in MPM or exact form, on each mesh and basis: the error of each "
+         "combination, its exact decomposition into each stage's Shapley value (main effect plus an equal share of "
+         "every interaction the stage takes part in) and the interactions; each stage's signed error field and where "
+         "along the tube it sits; and Sod with each basis.",
+         views=(
+             View("budget/shapley", "Sod, particle density L1: each stage's Shapley value and share of v(all MPM) - "
+                  "v(all exact); removed and alone are the one-at-a-time views", _SHAPLEY,
+                  {"problem": "sod", "norm": "particles"}, "shapley_sod.png"),
+             View("budget/shapley", "Sod, nodal density L1", _SHAPLEY, {"problem": "sod", "norm": "nodes"}),
+             View("budget/shapley", "Burgers, particle velocity L1", _SHAPLEY, {"problem": "burgers"},
+                  "shapley_burgers.png"),
+             View("budget/interactions", "Sod, point-mass P1, particles: the interactions (Moebius terms of two and "
+                  "more stages)", ("h", "stages", "term", "share"), {"problem": "sod", "basis": "mpm", "norm": "particles"}),
+             View("budget/regions", "Sod, point-mass P1: share of each Shapley error field's L1 by region of the exact "
+                  "solution (C12)", ("h", "basis", "field", "L1") + tuple(f"share_{n.replace(' ', '_')}" for n in REGION_NAMES),
+                  {"basis": "mpm"}, "fields_sod.png"),
+             View("budget/bases", "E2: Sod with each basis, MPM stages", ("basis", "h", "ok", "particles_L1", "nodes_L1",
+                  "plateau_noise", "plateau_offset"), {}, "bases.png"),
+         )),
+    Page("time", "Time error (C1) and grid crossing (C2)",
+         "At a fixed mesh and fixed particles, the time step alone is refined against a much smaller step: the global "
+         "error at the final time and the local error of one step from a common state; and the third time derivative "
+         "of one particle's position along its path, measured at each node crossing beside the slides' formula.",
+         views=(
+             View("time/time_order", "Global error against dt: fitted order per problem, basis and quantity",
+                  ("problem", "basis", "quantity", "fitted_order"), {"order": ""}, "time_order.png"),
+             View("time/local_error", "Local error of one step: fitted order",
+                  ("problem", "basis", "quantity", "fitted_order"), {"order": ""}),
+             View("time/crossing_summary", "Jump of dA/dt at node crossings, measured against the slides' formula",
+                  ("basis", "acceleration", "crossings", "median_ratio", "max_ratio_error", "max_abs_ratio",
+                   "median_abs_measured"), {}, "crossing.png"),
          )),
 )

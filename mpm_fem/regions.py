@@ -212,3 +212,14 @@ class ExtremaCounter:
                 "rate_elsewhere": s / max(staying, 1),
             }
         return out
+
+
+def plateau_velocity(x: np.ndarray, v: np.ndarray, waves: dict, margin: float) -> dict:
+    """Sod's post-shock plateau (contact + margin, shock - margin): the scatter ``std(v_p)`` of the
+    particle velocities there (the force quadrature's velocity noise) and the offset of their mean
+    from the exact ``u*`` (``waves``: :func:`baselines.exact.riemann.wave_positions`); both NaN
+    when no particle lies that far inside the plateau (a mesh too coarse to resolve it)."""
+    inside = v[(x > waves["contact"] + margin) & (x < waves["shock"] - margin)]
+    if inside.size == 0:
+        return {"plateau_noise": float("nan"), "plateau_offset": float("nan")}
+    return {"plateau_noise": float(np.std(inside)), "plateau_offset": float(np.mean(inside) - waves["u_star"])}

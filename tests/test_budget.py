@@ -1,11 +1,13 @@
 """The exact stages of the error budget (E1) and the bases' conservation (E2)."""
 
 from dataclasses import replace
+from functools import lru_cache
 
 import numpy as np
 import pytest
 
 from baselines.exact import riemann
+from mpm_fem.decomposition import decompose, label
 from mpm_fem.exact_stages import RiemannFields, exact_projection, quadrature
 from mpm_fem.grid import uniform_grid
 from mpm_fem.models.euler import IdealGas
@@ -14,6 +16,7 @@ from mpm_fem.shape import make_shape
 from mpm_fem.step import Stages, Walls, explicit_step
 from mpm_fem.timing import field_difference
 from mpm_fem.transfer import nodal_internal_force
+from studies import budget as study
 
 SOD = ((1.0, 0.0, 1.0), (0.125, 0.0, 0.1))
 
@@ -158,3 +161,63 @@ def test_bases_keep_partition_of_unity_and_conservation_in_a_step(basis):
     walls = grid.boundary_nodes
     assert dP == pytest.approx(-dt * F[walls].sum(), rel=1e-10)
     assert new.mass.sum() == moved.mass.sum()
+
+
+# ---------------------------------------------------------------- E1: every subset of the stages
+
+ALL, NONE = frozenset(study.STAGES), frozenset()
+SMALL = {"sod": (0.05, {"ppc": 4, "cfl": 0.1}), "burgers": (0.05, {})}
+
+
+@lru_cache(maxsize=None)
+def _small(problem: str):
+    h, settings = SMALL[problem]
+    return problem, h, study.subset_fields(problem, h, "mpm", settings)
+
+
+@pytest.fixture(params=sorted(SMALL))
+def small(request):
+    """The sixteen subsets of a small real case: Sod (h = 0.05, 4 particles per cell), Burgers (h = 0.05)."""
+    return _small(request.param)
+
+
+def test_small_case_has_every_subset_and_its_shapley_values_add_up(small):
+    """v(S) = L1 of e_S; the four Shapley values sum to v(all MPM) - v(all exact) within 1e-12
+    relative, the Moebius terms to v(all MPM), in the table rows too."""
+    problem, h, (fields, weights, points, runs) = small
+    assert fields is not None and len(fields) == 16 and len(runs) == 16 and all(r["ok"] for r in runs)
+    assert set(weights) == ({"particles", "nodes"} if problem == "sod" else {"particles"})
+    for norm, w in weights.items():
+        v = {S: float(np.sum(w * np.abs(f[norm]))) for S, f in fields.items()}
+        d = decompose(v, study.STAGES)
+        gap = v[ALL] - v[NONE]
+        assert abs(gap) > 0.1 * v[ALL], f"{problem} {norm}: the stages change nothing? {v}"
+        assert abs(sum(d.shapley.values()) - gap) <= 1e-12 * abs(gap)
+        assert abs(sum(d.moebius.values()) - v[ALL]) <= 1e-12 * v[ALL]
+    got = {(problem, h, "mpm"): {"subsets": {norm: {label(S): float(np.sum(w * np.abs(f[norm]))) for S, f in fields.items()}
+                                             for norm, w in weights.items()}}}
+    rows = study.subset_rows(got)
+    assert len(rows) == 16 * len(weights) and {r["mpm_stages"] for r in rows} >= {"none", "interpolation+mass+projection+time"}
+    shapley, interactions = study.decomposition_rows(rows)
+    for norm in weights:
+        group = [r for r in shapley if r["norm"] == norm]
+        assert abs(sum(r["shapley"] for r in group) - (group[0]["mpm_error"] - group[0]["exact_error"])) <= 1e-12 * group[0]["mpm_error"]
+        assert sum(r["share"] for r in group) == pytest.approx(1.0, abs=1e-12)
+        assert len([r for r in interactions if r["norm"] == norm]) == 11
+
+
+def test_small_case_field_decomposition_adds_exactly_at_every_point(small):
+    """The Shapley error fields add up to e_MPM - e_exact point by point (round-off only)."""
+    _, _, (fields, weights, _, _) = small
+    for norm in weights:
+        d = decompose({S: f[norm] for S, f in fields.items()}, study.STAGES)
+        gap = fields[ALL][norm] - fields[NONE][norm]
+        assert np.abs(sum(d.shapley.values()) - gap).max() <= 1e-14 * np.abs(gap).max()
+
+
+def test_time_exact_is_the_dt_to_zero_extrapolation():
+    """Burgers, every stage exact: the run at dt keeps the time error of the step, which the
+    extrapolation from dt and dt/2 removes to below 5% (the remainder is O(dt^2))."""
+    _, _, (fields, weights, _, _) = _small("burgers")
+    l1 = lambda S: float(np.sum(weights["particles"] * np.abs(fields[S]["particles"])))  # noqa: E731
+    assert l1(NONE) < 0.05 * l1(frozenset({"time"})), (l1(NONE), l1(frozenset({"time"})))

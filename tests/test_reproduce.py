@@ -21,7 +21,7 @@ TABLES = {
     "sod/convergence.csv": (("h",), ("mpm_nodes_L1", "mpm_particles_L1", "fem_lumped_L1", "fem_consistent_L1", "fv_L1")),
     "burgers/errors.csv": (("solution", "method", "eps", "h"), ("particles_L1", "particles_max", "nodes_L1")),
     "projection/errors.csv": (("quantity", "layout", "weights", "basis", "N_p", "h", "norm", "seeds"), ("value",)),
-    "budget/runs.csv": (("problem", "h", "basis", "variant"), ("field_L1", "particles_L1", "nodes_L1")),
+    "budget/subsets.csv": (("problem", "h", "basis", "norm", "mpm_stages"), ("error",)),
 }
 RTOL = 1e-5
 
