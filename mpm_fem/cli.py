@@ -22,9 +22,18 @@ from .grid import GridError
 from .particles import LAYOUTS, PositivityError
 from .shape import BASES
 from .step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, SCHEMES, STAGE_MASS
+from .reconstruction import RECONSTRUCTIONS
+from .volume import VOLUMES
 
 CHOICES = {"mass": STAGE_MASS, "basis": BASES, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
            "projection": PROJECTIONS, "interpolation": INTERPOLATIONS}
+# --- remedies (E5): --flip ALPHA, --reconstruct none|taylor, --volume carried|grid, --basis bspline_gimp
+CHOICES.update({"reconstruct": RECONSTRUCTIONS, "volume": VOLUMES})
+REMEDY_HELP = {
+    "flip": "PIC/FLIP blend alpha in [0, 1]: 1 FLIP (standard), 0 PIC",
+    "reconstruct": "stress before the force integral: none (particle sum) or taylor (per-cell least-squares line)",
+    "volume": "particle volumes: carried by the flow, or grid (reset to tile the grid every step)",
+}
 HELP = {
     "h": "cell size (must divide the domain)",
     "ppc": "particles per cell N_p",
@@ -37,7 +46,8 @@ HELP = {
     "projection": "particle-to-grid projection: MPM sums or exact integrals of the exact fields",
     "interpolation": "grid-to-particle interpolation: MPM sums or exact for the exact fields",
     "refine": "time stage: the time step divided by this integer",
-    "basis": "particle basis: point mass (mpm), particle domain (gimp) or quadratic B-spline (bspline)",
+    "basis": "particle basis: point mass (mpm), particle domain (gimp), quadratic B-spline (bspline) or the "
+             "B-spline averaged over the particle domain (bspline_gimp)",
     "scheme": "stress update order",
     "layout": "initial particle layout in each cell",
     "seed": "random seed of jittered/random layouts",
@@ -45,6 +55,7 @@ HELP = {
     "solution": "exact solution giving initial, boundary data and errors",
     "acceleration": "nodal acceleration: calculated F_i/m_i or the exact eps v_xx",
 }
+HELP.update(REMEDY_HELP)
 
 
 class UsageError(Exception):

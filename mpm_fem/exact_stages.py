@@ -50,7 +50,7 @@ from typing import Protocol
 import numpy as np
 
 from .grid import Grid
-from .shape import Shape, make_shape
+from .shape import Shape, grid_functions, make_shape
 from .transfer import nodal_internal_force, nodal_mass, nodal_momentum
 
 GAUSS_POINTS = 5  # exact for polynomials of degree 9 (Sod's fan: rho u S_i has degree 7)
@@ -110,13 +110,13 @@ def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float) -> G
     """``m_i = int rho S_i``, ``P_i = int rho v S_i``, ``F_i = -int sigma S_i'`` of the exact fields.
 
     The grid functions are the P1 hats for the point-mass and GIMP bases (GIMP averages the same
-    hats over the particle domain) and the quadratic B-splines for ``"bspline"``. The quadrature
+    hats over the particle domain) and the quadratic B-splines for ``"bspline"`` and ``"bspline_gimp"``. The quadrature
     points act as particles of mass ``w_q rho_q`` and volume ``w_q``, so the consistent mass of the
     exact projection is ``int rho S_i S_j`` by the same code as the particle mass matrix.
     """
     x, w = quadrature(grid, fields.breakpoints(t))
     rho, v, sigma = fields.integrand(x, t)
-    shape = make_shape(grid, x, w, "bspline" if basis == "bspline" else "mpm")
+    shape = make_shape(grid, x, w, grid_functions(basis))
     mass = w * rho
     m_i = nodal_mass(shape, mass)
     return GridData(shape, mass, m_i, nodal_momentum(shape, mass, v), nodal_internal_force(shape, w, sigma))
