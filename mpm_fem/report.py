@@ -4,7 +4,7 @@ Each study module (``studies/<name>.py``) provides ``report(folder) -> str`` (it
 read from the tables it wrote) and may provide ``claims(folder) -> list[dict]`` with keys ``id``
 (``"C4"``, ``"E1"``, ...), ``verdict`` (``"confirmed"``, ``"differs"``, ``"partly"``,
 ``"refuted"``, ``"not measured"``) and ``evidence`` (one line with the numbers). The index at the
-top lists every claim C1-C15 and E1-E4 of STUDY.md; a claim no study speaks for is listed as not
+top lists every claim C1-C15 and E1-E5 of STUDY.md; a claim no study speaks for is listed as not
 measured, never silently dropped.
 """
 
@@ -38,6 +38,7 @@ CLAIMS = {
     "E2": "bases: point-mass P1 vs GIMP vs C1 B-spline",
     "E3": "MPM, fixed-mesh FEM and exact side by side on the same mesh",
     "E4": "one command regenerates everything",
+    "E5": "a remedy (basis, reconstruction, volume reset, PIC/FLIP) removes the MPM plateau; accuracy per cost",
 }
 
 

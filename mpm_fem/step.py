@@ -177,7 +177,7 @@ def explicit_step(
     m_i = nodal_mass(shape, m)
     v_i = boundary.velocity(grid, grid_values(shape, m, m_i, nodal_momentum(shape, m, particles.velocity), stages.mass), t)
     if stages.volume == "grid":
-        particles = _reset_volume(model, particles, grid_volume_factor(grid, particles.x, V, stages.basis))
+        particles = _reset_volume(model, particles, grid_volume_factor(grid, particles.x, V, stages.basis, shape))
         V = particles.volume
 
     if stages.scheme == "usf":

@@ -23,16 +23,19 @@ from __future__ import annotations
 import numpy as np
 
 from .grid import Grid
-from .shape import basis_integrals, grid_functions, make_shape
+from .shape import Shape, basis_integrals, grid_functions, make_shape
 from .transfer import divide_by_lumped
 
 VOLUMES = ("carried", "grid")
 DOMAIN_BASIS = {"mpm": "gimp", "bspline": "bspline_gimp"}  # grid functions -> their domain averages
 
 
-def grid_volume_factor(grid: Grid, x: np.ndarray, volume: np.ndarray, basis: str = "mpm") -> np.ndarray:
+def grid_volume_factor(grid: Grid, x: np.ndarray, volume: np.ndarray, basis: str = "mpm",
+                       shape: Shape | None = None) -> np.ndarray:
     """``f_p = sum_i Sbar_ip int S_i / V_i`` with ``V_i = sum_p V_p Sbar_ip`` (n_p,), for the grid
-    functions ``S_i`` of ``basis`` (module docstring)."""
+    functions ``S_i`` of ``basis`` (module docstring). ``shape``: the step's own ``Sbar_ip`` when
+    ``basis`` already averages over the particle domains at these volumes (saves computing it again)."""
     functions = grid_functions(basis)
-    shape = make_shape(grid, x, volume, DOMAIN_BASIS[functions])
+    if shape is None or basis != DOMAIN_BASIS[functions]:
+        shape = make_shape(grid, x, volume, DOMAIN_BASIS[functions])
     return shape.gather(divide_by_lumped(basis_integrals(grid, functions), shape.scatter(volume)))

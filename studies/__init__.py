@@ -10,4 +10,4 @@ and ends with ``if __name__ == "__main__": sys.exit(script_main("<name>"))`` so 
 ``python studies/<name>.py [--quick] [--jobs N]`` and ``mpm-fem study <name>`` are the same.
 """
 
-STUDIES = ("projection", "sod", "burgers", "budget")
+STUDIES = ("projection", "sod", "burgers", "budget", "remedies")
