@@ -1,6 +1,6 @@
 """Fixed-mesh Galerkin FEM for the viscous Burgers equation, on scikit-fem.
 
-The baseline that MPM is compared with on the same mesh (STUDY.md, C13, C15 and E3). The equation
+The baseline that MPM is compared with on the same mesh (docs/claims.md, C13, C15 and E3). The equation
 
     v_t + (v^2 / 2)_x = eps v_xx       on [a, b] = solution.domain,  0 < t <= T,
     v(x, 0) = v_exact(x, 0),  v(a, t) = v_exact(a, t),  v(b, t) = v_exact(b, t),

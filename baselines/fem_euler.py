@@ -1,6 +1,6 @@
 """Fixed-mesh Galerkin FEM for the 1D Euler equations (Sod's shock tube), on scikit-fem.
 
-The baseline that MPM is compared with on the same mesh (STUDY.md, C15 and E3). Conservative
+The baseline that MPM is compared with on the same mesh (docs/claims.md, C15 and E3). Conservative
 variables at the nodes, ``U = (rho, rho u, E)``, ideal gas ``p = (gamma - 1)(E - rho u^2 / 2)``,
 flux ``F(U) = (rho u, rho u^2 + p, (E + p) u)``. The equations solved are
 

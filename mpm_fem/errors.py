@@ -32,3 +32,12 @@ def observed_orders(h, errors) -> np.ndarray:
 def fitted_order(h, errors) -> float:
     """Least-squares slope of ``log E`` against ``log h``."""
     return float(np.polyfit(np.log(np.asarray(h, float)), np.log(np.asarray(errors, float)), 1)[0])
+
+
+def orders_column(h, errors) -> list:
+    """The observed order of each entry against the previous one, as a table column: ``""`` in the
+    first row, and in every row when fewer than two errors or a non-positive one make orders undefined."""
+    e = np.asarray(errors, dtype=float)
+    if e.size < 2 or not np.all(e > 0):
+        return [""] * e.size
+    return [""] + [float(o) for o in observed_orders(h, e)]

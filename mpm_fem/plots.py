@@ -1,6 +1,15 @@
-"""Figures: final profiles against the exact solution, and convergence plots with reference slopes."""
+"""Figures, with the studies' conventions: log-log axes, slope guides, the source's points beside the measured.
+
+A study declares most of its figures as data, a :class:`Plot` of :class:`Curve` s drawn from the
+rows of one of its tables (:func:`draw`), so that every figure can be redrawn from the tables alone.
+Figures that need more than a table holds (profiles) use :func:`profile_grid` and :func:`stacked_shares`.
+"""
 
 from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
 
 import matplotlib
 
@@ -29,25 +38,158 @@ def profiles(path, x_exact, exact: dict, x_particles, particles: dict, x_nodes=N
     plt.close(fig)
 
 
-def convergence(path, series: dict, xlabel: str = "h", ylabel: str = "error", slopes=(1, 2), title: str = ""):
-    """Log-log error against ``h``: ``series = {label: (h, error, style)}``, with slope guides."""
-    fig, ax = plt.subplots(figsize=(5.2, 4.0))
-    hs = []
-    for label, (h, err, *style) in series.items():
-        ax.loglog(h, err, style[0] if style else "o-", label=label, ms=4)
-        hs.append(np.asarray(h, float))
-        anchor = (np.asarray(h, float)[0], np.asarray(err, float)[0])
-    if hs:
-        h_all = np.unique(np.concatenate(hs))
-        h0, e0 = anchor
-        for k in slopes:
-            ax.loglog(h_all, e0 * (h_all / h0) ** k, ":", color="gray", lw=0.9)
-            ax.annotate(f"slope {k}", (h_all[0], e0 * (h_all[0] / h0) ** k), fontsize=7, color="gray")
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.legend(fontsize=7)
-    if title:
-        ax.set_title(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
+# ----------------------------------------------------------------------------- the studies' conventions
+
+def slope_guides(ax, h, e0: float, slopes=(1, 2)) -> None:
+    """Dotted grey lines ``e0 (h / h_max)^k`` over the range of ``h``, one per slope ``k``, labelled."""
+    h = np.sort(np.asarray(h, float))
+    for k in slopes:
+        ax.loglog(h, e0 * (h / h[-1]) ** k, ":", color="gray", lw=0.8)
+        ax.annotate(f"slope {k:g}", (h[0], e0 * (h[0] / h[-1]) ** k), fontsize=6, color="gray")
+
+
+def panels(path, content: dict, xlabel: str, ylabel: str, title: str = "", ncols: int | None = None,
+           slopes=(), size=(4.2, 3.8), log: bool = True, legends: bool = False) -> None:
+    """One panel per entry of ``content = {panel title: {label: (x, y, fmt, options)}}`` (``options``
+    optional: matplotlib keywords), log-log unless ``log`` is false, with slope guides through the
+    largest value of each panel and the legend in the first one. The source's points are a series
+    like any other, drawn black and open (fmt ``"ks"``/``"ko"``/``"k*"``, ``mfc="none"``). With
+    ``legends`` every panel gets its own legend (panels that show different series)."""
+    names = list(content)
+    ncols = ncols or len(names)
+    nrows = -(-len(names) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(size[0] * ncols, size[1] * nrows), squeeze=False)
+    for ax, name in zip(axes.ravel(), names):
+        xs, top = [], 0.0
+        for label, (x, y, fmt, *options) in content[name].items():
+            y = np.asarray(y, float)
+            (ax.loglog if log else ax.plot)(x, y, fmt, label=label, **{"ms": 3.5, "lw": 1.1, **(options[0] if options else {})})
+            xs += list(x)
+            top = max(top, np.nanmax(y, initial=0.0))
+        if slopes and top > 0:
+            slope_guides(ax, xs, top * 1.3, slopes)
+        ax.set_title(name, fontsize=9)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        if legends:
+            ax.legend(fontsize=6, markerscale=1.5)
+    for ax in axes.ravel()[len(names):]:
+        ax.set_visible(False)
+    axes[0][0].legend(fontsize=6, markerscale=1.5)
+    save(fig, path, title)
+
+
+def stacked_shares(path, rows: list[dict], names, title: str = "", ylabel: str = "share", group: str = "method",
+                   bar: str = "h", total: str = "L1") -> None:
+    """One panel per value of column ``group``, one stacked bar per row (labelled by ``bar``) of the
+    columns ``share_0 ... share_k`` (one per entry of ``names``; each bar sums to 1), ``total`` above it."""
+    groups = list(dict.fromkeys(r[group] for r in rows))
+    fig, axes = plt.subplots(1, len(groups), figsize=(3.6 * len(groups), 4.0), sharey=True, squeeze=False)
+    colors = plt.cm.tab10(np.arange(len(names)))
+    for ax, g in zip(axes[0], groups):
+        bars = [r for r in rows if r[group] == g]
+        labels, bottom = [f"{_value(r[bar]):g}" for r in bars], np.zeros(len(bars))
+        for k, name in enumerate(names):
+            values = np.array([_value(r[f"share_{k}"]) for r in bars])
+            ax.bar(labels, values, bottom=bottom, color=colors[k], label=f"{k} {name}")
+            bottom += values
+        for j, r in enumerate(bars):
+            ax.annotate(f"{_value(r[total]):.2g}", (j, 1.01), ha="center", fontsize=6)
+        ax.set_ylim(0, 1.08)
+        ax.set_title(g, fontsize=9)
+        ax.tick_params(axis="x", labelrotation=45, labelsize=7)
+    axes[0][0].set_ylabel(ylabel)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles[::-1], labels[::-1], fontsize=7, loc="center right")
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout(rect=(0, 0, 0.89, 1))
+    fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def save(fig, path, title: str = "") -> None:
+    """Title, tight layout, PNG at the studies' resolution, and the figure closed."""
+    if title:
+        fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def profile_grid(path, exact: dict, rows: dict, title: str = "") -> None:
+    """One column per field of ``exact = {field: (x, values)}`` (drawn as a black line in every row)
+    and one row per entry of ``rows = {row label: [(label, x, {field: values}, fmt, options)]}``; a
+    series draws only the fields it has."""
+    fig, axes = plt.subplots(len(rows), len(exact), figsize=(4 * len(exact), 3.2 * len(rows)), sharex=True,
+                             squeeze=False)
+    for axes_row, (row_label, series) in zip(axes, rows.items()):
+        for ax, (field, (xe, ye)) in zip(axes_row, exact.items()):
+            ax.plot(xe, ye, "k-", lw=1.0, label="exact")
+            ax.set_title(field, fontsize=9)
+            for label, x, values, fmt, options in series:
+                if field in values:
+                    ax.plot(x, values[field], fmt, label=label, **options)
+        axes_row[0].set_ylabel(row_label)
+        axes_row[0].legend(fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("x")
+    save(fig, path, title)
+
+
+# ----------------------------------------------------------------------------- figures as data
+
+@dataclass(frozen=True)
+class Curve:
+    """Column ``y`` against the plot's ``x`` over the rows matching ``where``, in ``panel``; with
+    ``group`` (a column) one line per value of it, ``label`` formatted with ``{group}``. The
+    source's points are a curve of the source's column, drawn black and open (``fmt="k*"``)."""
+
+    label: str
+    y: str
+    fmt: str = "o-"
+    where: dict = field(default_factory=dict)
+    panel: str = ""
+    group: str = ""
+    options: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Plot:
+    """A figure ``file`` with its one-line ``caption`` (also its title), drawn from ``table``."""
+
+    file: str
+    caption: str
+    table: str
+    x: str
+    curves: tuple[Curve, ...]
+    xlabel: str = "h"
+    ylabel: str = "error"
+    slopes: tuple = ()
+    size: tuple = (5.2, 4.0)
+
+
+def _value(v) -> float:
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def _matches(row: dict, where: dict) -> bool:
+    return all(str(row.get(k)) == str(v) or _value(row.get(k)) == _value(v) for k, v in where.items())
+
+
+def draw(folder, plot: Plot, rows: list[dict]) -> None:
+    """Draw ``plot`` from ``rows`` (as written or as read back: numbers or strings) into ``folder``."""
+    content: dict = {}
+    for c in plot.curves:
+        sel = [r for r in rows if _matches(r, c.where)]
+        for g in dict.fromkeys(r.get(c.group) for r in sel) if c.group else (None,):
+            pts = sorted((_value(r[plot.x]), _value(r.get(c.y))) for r in sel if not c.group or r.get(c.group) == g)
+            pts = [(x, y) for x, y in pts if math.isfinite(x) and math.isfinite(y) and y > 0]
+            if pts:
+                label = c.label.format(group=g)
+                content.setdefault(c.panel or plot.caption, {})[label] = (
+                    [x for x, _ in pts], [y for _, y in pts], c.fmt, {"mfc": "none", **c.options} if c.fmt[0] == "k" else c.options)
+    panels(Path(folder) / plot.file, content, plot.xlabel, plot.ylabel, plot.caption if len(content) > 1 else "",
+           slopes=plot.slopes, size=plot.size, legends=len(content) > 1)

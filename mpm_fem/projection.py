@@ -71,7 +71,7 @@ class Fields:
 
 
 def smooth_fields(gamma: float = 1.4, rho_amplitude: float = 0.5, v_amplitude: float = 1.0) -> Fields:
-    """STUDY.md's fields on [0, 1]: ``rho = 1 + a sin(2 pi x)``, ``v = b sin(2 pi x)``, ``p = rho^gamma``."""
+    """docs/claims.md's fields on [0, 1]: ``rho = 1 + a sin(2 pi x)``, ``v = b sin(2 pi x)``, ``p = rho^gamma``."""
     k = 2 * np.pi
     rho = lambda x: 1.0 + rho_amplitude * np.sin(k * x)  # noqa: E731
     drho = lambda x: rho_amplitude * k * np.cos(k * x)  # noqa: E731

@@ -93,6 +93,38 @@ def mean_by_region(x: np.ndarray, error: np.ndarray, weights: np.ndarray, region
     return np.divide(signed, total, out=np.zeros(n), where=total > 0)
 
 
+def describe(half_width: float, waves: dict, t: float) -> dict:
+    """The partition of :func:`sod_regions` in words, for a table's settings."""
+    w = half_width
+    x = {k: round(waves[k], 5) for k in ("rarefaction_head", "rarefaction_tail", "contact", "shock")}
+    return {
+        "0 undisturbed": f"[0, x_H - {w}) and [x_S + {w}, 1]", "1 rarefaction head": f"[x_H - {w}, x_H + {w})",
+        "2 smooth": f"[x_H + {w}, x_T - {w}) (fan) and [x_T + {w}, x_C - {w}) (plateau)",
+        "3 rarefaction tail": f"[x_T - {w}, x_T + {w})", "4 contact": f"[x_C - {w}, x_C + {w})",
+        "5 behind shock": f"[x_C + {w}, x_S - {w})", "6 shock front": f"[x_S - {w}, x_S + {w})",
+        f"waves at T={t}": ", ".join(f"x_{n} = {v}" for n, v in zip("HTCS", x.values())),
+    }
+
+
+def by_region(x: np.ndarray, error: np.ndarray, weights: np.ndarray, regions: Regions) -> dict[str, list]:
+    """``{"L1": l1_by_region, "mean": mean_by_region}`` of one error, as lists (JSON-able)."""
+    return {"L1": l1_by_region(x, error, weights, regions).tolist(),
+            "mean": mean_by_region(x, error, weights, regions).tolist()}
+
+
+def first_below(x: np.ndarray, q: np.ndarray, level: float) -> float:
+    """First ``x`` (linear between points) where ``q`` drops below ``level``, from the left."""
+    k = int(np.argmax(q < level))
+    return float(x[k - 1] + (x[k] - x[k - 1]) * (q[k - 1] - level) / (q[k - 1] - q[k]))
+
+
+def head_shift(x: np.ndarray, rho: np.ndarray, exact, level: float = 0.99, window=(0.2, 0.4)) -> float:
+    """Where the computed density first drops below ``level`` minus where the exact one (``exact(x)``,
+    sampled finely over ``window``) does: the position error of the rarefaction head (> 0: it lags)."""
+    xe = np.linspace(*window, 20001)
+    return first_below(x, rho, level) - first_below(xe, exact(xe), level)
+
+
 def strict_extrema(q: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
     """Boolean mask of strict local extrema of ``q`` (ordered) beyond ``tol`` (module docstring)."""
     q = np.asarray(q, dtype=float)

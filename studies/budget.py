@@ -104,7 +104,7 @@ def _error_field(problem: str, settings, result, points: np.ndarray) -> np.ndarr
 
 def _plateau(settings, result) -> dict:
     """Particle velocities on the post-shock plateau (contact + 3h, shock - 3h): their scatter
-    (standard deviation, the velocity noise of the force quadrature, STUDY.md pitfalls) and the
+    (standard deviation, the velocity noise of the force quadrature, docs/claims.md pitfalls) and the
     offset of their mean from the exact ``u*``."""
     w = sod.riemann.wave_positions(result.t, settings.left, settings.right)
     P = result.particles

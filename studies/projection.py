@@ -29,7 +29,10 @@ from mpm_fem.errors import fitted_order, observed_orders
 from mpm_fem.grid import uniform_grid
 from mpm_fem.projection import QUANTITIES, Advection, cell_weights, layout, projection_errors, quadrature_checks, smooth_fields
 from mpm_fem.quadrature import cell_points, discrepancy_d2, estimate_c, expected_offset, offset_term
-from mpm_fem.study import StudyOptions, read_table, script_main, write_table
+from mpm_fem.claims import BAND_TOLERANCE, ORDERS
+from mpm_fem.report import Page, View
+from mpm_fem.source import D2_C, PROJECTION_BANDS, band_text
+from mpm_fem.study import StudyOptions, script_main, write_table
 
 NAME = "projection"
 CELLS = [10 * 2**k for k in range(9)]  # h = 1/10 ... 1/2560
@@ -39,17 +42,11 @@ SEEDS = 5
 QUICK = {"cells": CELLS[:6], "ppc": [1, 4, 16], "seeds": 3}
 GAMMA = 1.4
 ADVECTION = Advection()
-#: The source's claimed order bands ("Conclusions" slide); E_v1 "is first order in space".
-BANDS = {"E_m": (1, 2), "E_P": (1, 2), "E_F": (1, 2), "E_a": (0, 1), "E_a_pred": (0, 1), "E_v": (0, 1),
-         "E_v1": (1, 1), "E_VG": "E_v", "E_VG_proj": "E_v"}
-#: Least-squares orders within this distance of a band count as inside (sampling noise of the fit).
-TOLERANCE = 0.1
-SLIDES_C = (0.25, 1 / 3)
+BANDS, TOLERANCE, SLIDES_C = PROJECTION_BANDS, BAND_TOLERANCE, D2_C
 #: (weights, basis) of the projections: the slides' point-mass sums with h/N_p^i; with the volumes
 #: V_p a run carries (differs from h/N_p^i only once particles moved); GIMP with V_p (E2).
 VARIANTS = (("cell", "mpm"), ("volume", "mpm"), ("volume", "gimp"))
 SAMPLE = 12  # (bound, error) pairs kept per check and case for the figure
-CLAIM_OF = {"E_m": "C5", "E_P": "C6", "E_F": "C7", "E_a": "C8", "E_v": "C9", "E_VG_proj": "C10"}
 
 
 def case(c: dict) -> dict:
@@ -86,13 +83,6 @@ def cases(options: StudyOptions) -> list[dict]:
     return [{"layout": lay, "ppc": n, "cells": k, "seed": s}
             for lay in LAYOUT_NAMES for n in ppc for k in cells
             for s in (range(seeds) if lay in ("jittered", "random") else (0,))]
-
-
-def _band_text(quantity: str) -> str:
-    band = BANDS[quantity]
-    if isinstance(band, str):
-        return f"order of {band}"
-    return f"{band[0]}" if band[0] == band[1] else f"[{band[0]}, {band[1]}]"
 
 
 def _inside(quantity: str, order: float, reference: dict) -> bool:
@@ -138,7 +128,7 @@ def tables(results: list[tuple[dict, dict]]) -> dict[str, list[dict]]:
             order_rows.append({"quantity": q, "layout": lay, "weights": weights, "basis": basis, "N_p": n, "norm": norm,
                                "order": fitted[q], "order_coarse": float(steps[0]), "order_fine": float(steps[-1]),
                                "successive": " ".join(f"{p:.2f}" for p in steps),
-                               "band": _band_text(q), "inside": "yes" if _inside(q, fitted[q], fitted) else "no"})
+                               "band": band_text(q), "inside": "yes" if _inside(q, fitted[q], fitted) else "no"})
 
     d2_rows = []
     for (lay, n, k), ds in sorted(d2s.items()):
@@ -179,13 +169,13 @@ def settings(options: StudyOptions) -> dict:
         "h": [1.0 / k for k in cells], "N_p": ppc, "layouts": list(LAYOUT_NAMES), "seeds": seeds,
         "jitter": 1.0,
         "advection": {"velocity": f"{ADVECTION.amplitude} sin(2 pi x)", "T": ADVECTION.T, "cfl": ADVECTION.cfl,
-                      "start": "regular", "update": "kinematic MPM (USL positions, V_p *= 1 + dt dv/dx)"},
+                      "start": "regular", "update": "kinematic MPM (USL positions, V_p *= 1+dt dv/dx)"},
         "weights": {"cell": "h / N_p^i (slides)", "volume": "V_p carried by the run (= h/N_p for seeded layouts)"},
         "variants": [f"{w}:{b}" for w, b in VARIANTS],
         "bases": {"mpm": "point mass S_i(x_p)", "gimp": "hats averaged over [x_p - V_p/2, x_p + V_p/2]"},
         "nodes": "interior nodes (whole hats); norms weighted by h (nodes, cells) or w_p (particles)",
         "exact_integrals": "Gauss-Legendre, 20 points per cell",
-        "bands": {q: _band_text(q) for q in QUANTITIES}, "tolerance": TOLERANCE, "slides_C": list(SLIDES_C),
+        "bands": {q: band_text(q) for q in QUANTITIES}, "tolerance": TOLERANCE, "slides_C": list(SLIDES_C),
     }
 
 
@@ -292,7 +282,7 @@ def figures(folder: Path, t: dict, results: list) -> None:
     a1.loglog(n, 1 / (np.sqrt(12) * n), "k-", lw=0.8, label="1/(sqrt(12) N) (regular midpoints)")
     a1.set_xlabel("particles per cell N_p")
     a1.set_ylabel(f"root mean square D2 over cells (h = 1/{round(1 / finest)})")
-    a1.set_title("D2 vs N_p; lines: closed forms (3) with the expected offsets", fontsize=9)
+    a1.set_title("D2 vs N_p; lines: the closed forms with the expected offsets", fontsize=9)
     a1.legend(fontsize=7)
     hh = np.array(sorted({r["h"] for r in d2}))
     for c, ls in zip(SLIDES_C, ("--", "-.")):
@@ -330,137 +320,26 @@ def figures(folder: Path, t: dict, results: list) -> None:
     plt.close(fig)
 
 
-# ----------------------------------------------------------------------------- report
+# ----------------------------------------------------------------------------- report page
 
-def _orders(folder: Path) -> list[dict]:
-    return read_table(folder / "orders.csv")
-
-
-def _pick(rows, **kw):
-    return [r for r in rows if all(str(r[k]) == str(v) for k, v in kw.items())]
-
-
-def _range(rows, quantity, lay, norm="L1", weights="cell", basis="mpm"):
-    vals = [float(r["order"]) for r in _pick(rows, quantity=quantity, layout=lay, norm=norm, weights=weights, basis=basis)]
-    return (min(vals), max(vals)) if vals else (float("nan"), float("nan"))
-
-
-COLUMNS = (("regular", "cell", "mpm", "regular"), ("jittered", "cell", "mpm", "jittered"),
-           ("random", "cell", "mpm", "random"), ("advected", "cell", "mpm", "advected, h/N_p^i"),
-           ("advected", "volume", "mpm", "advected, V_p"), ("advected", "volume", "gimp", "advected, GIMP V_p"),
-           ("random", "volume", "gimp", "random, GIMP V_p"))
-
-
-def _fmt(rows, q, lay, weights="cell", basis="mpm"):
-    a, b = _range(rows, q, lay, weights=weights, basis=basis)
-    lo, hi = f"{a:.2f}", f"{b:.2f}"
-    return lo if lo == hi else f"{lo}..{hi}"
-
-
-def _coarse(rows, q, layouts):
-    """Largest order between the two coarsest meshes (L1, point mass, h/N_p^i) over N_p and ``layouts``."""
-    vals = [float(r["order_coarse"]) for r in rows if r["quantity"] == q and r["layout"] in layouts
-            and r["norm"] == "L1" and r["weights"] == "cell" and r["basis"] == "mpm"]
-    return max(vals) if vals else float("nan")
-
-
-def claims(folder: Path) -> list[dict]:
-    """Verdicts on C4-C10 from the written tables (least-squares L1 orders, range over N_p)."""
-    folder = Path(folder)
-    if not (folder / "orders.csv").exists():
-        return []
-    o = _orders(folder)
-    bounds = read_table(folder / "bounds.csv")
-    c_vals = [float(r["C"]) for r in read_table(folder / "d2_constant.csv")]
-    f = lambda q, lay, w="cell", b="mpm": _fmt(o, q, lay, w, b)  # noqa: E731
-    ratio = min(float(r["min_ratio"]) for r in bounds)
-    out = [{"id": "C4", "verdict": "partly",
-            "evidence": f"the bound holds on every cell and node of every layout (smallest bound/error {ratio:.3g}); "
-                        f"but D2 ~ [1/(12N^2) + C h^2]^1/2 mixes units: measured C in [{min(c_vals):.3g}, "
-                        f"{max(c_vals):.3g}], not [1/4, 1/3], and the scale-free D2 does not depend on h"}]
-    seeded = ("jittered", "random")
-    for q in ("E_m", "E_P", "E_F"):
-        text = (f"first order: random {f(q, 'random')}, jittered {f(q, 'jittered')}, advected {f(q, 'advected')}; "
-                f"second order only between the two coarsest meshes of the advected layout (up to "
-                f"{_coarse(o, q, ('advected',)):.2f}; seeded layouts at most {_coarse(o, q, seeded):.2f}); "
-                f"regular midpoints {f(q, 'regular')}, better than claimed")
-        if q == "E_F":
-            text += (f"; but with the volumes V_p a run carries the force does not converge "
-                     f"({f(q, 'advected', 'volume')}); GIMP with V_p: {f(q, 'advected', 'volume', 'gimp')}")
-        out.append({"id": CLAIM_OF[q], "verdict": "partly" if q == "E_F" else "confirmed", "evidence": text})
-    out.append({"id": "C8", "verdict": "partly",
-                "evidence": f"one order below E_F as claimed: random {f('E_a', 'random')}, jittered {f('E_a', 'jittered')}, "
-                            f"regular {f('E_a', 'regular')}; with V_p weights still one below E_F but outside the band: "
-                            f"E_a grows like 1/h ({f('E_a', 'advected', 'volume')}); GIMP with V_p: "
-                            f"{f('E_a', 'advected', 'volume', 'gimp')}"})
-    out.append({"id": "C9", "verdict": "confirmed",
-                "evidence": f"E_v: random {f('E_v', 'random')}, jittered {f('E_v', 'jittered')}, advected "
-                            f"{f('E_v', 'advected')}; regular {f('E_v', 'regular')} (better); E_v1 is second order at "
-                            f"interior nodes ({f('E_v1', 'regular')}), not first as the slides say (first order only "
-                            f"at a wall's cut hat)"})
-    out.append({"id": "C10", "verdict": "refuted",
-                "evidence": f"(E_v^(i+1) - E_v^i)/h: random {f('E_VG_proj', 'random')}, jittered "
-                            f"{f('E_VG_proj', 'jittered')}, advected {f('E_VG_proj', 'advected')}: one order below E_v, "
-                            f"because E_v^i is not smooth in i; the same order only for regular midpoints "
-                            f"({f('E_VG_proj', 'regular')})"})
-    return out
-
-
-WHY = """Why:
-
-- Regular midpoints have the smallest discrepancy, D2 = 1/(sqrt(12) N_p) exactly (every cell, every h; `d2.csv`),
-  yet Hickernell's bound gives them only first order: D2 bounds the worst integrand with a given ||f'||.
-  They do better because the midpoint rule integrates linear functions exactly and the errors of the
-  two halves of a whole hat cancel at leading order: E_m, E_P, E_F are O(h^3) and a_i, v_i O(h^2).
-- For the other layouts D2 is scale-free: it depends on the pattern of the points in the cell, not on h,
-  so E_m <= D2 h (|rho(xi_1)| + |rho(xi_2)|) is exactly first order and the bound is nearly sharp
-  (`hickernell.png`). In the slides' (3) the offsets are in physical units while 1/(12N^2) is not: the
-  "C h^2" term is then h^2 times the mean squared offset in cell units, and the measured C (closed forms:
-  jittered 1/(12 N^2), random 1/(6(N+1)) + (N-1)/(12N^2(N+1))) stays below 0.09, far from [1/4, 1/3].
-  The only h-dependence of D2 seen is on the advected layout between h = 1/10 and 1/20, where the coarse
-  cells do not resolve the deformation; that is where the only second-order steps appear.
-- Acceleration and velocity are ratios with m_i = O(h): E_F/m_i is O(1) for a first-order E_F, hence
-  order 0. The velocity does better, order 1: P_i/m_i is a weighted mean of v_p near x_i, and the
-  quadrature error of S_i rho (v - v_i) is one order smaller than that of S_i rho.
-- E_v^i is O(h) but, for jittered, random and advected particles, uncorrelated from node to node, so
-  (E_v^(i+1) - E_v^i)/h is O(1): the slides' argument for C10 assumes E_v^i = C h^p with C smooth in i,
-  which only the regular layout satisfies. Through dv/dx this O(1) error enters the density and energy
-  updates of every step (the Sod study's stagnation).
-- With the volumes V_p that a run carries instead of h/N_p^i, a particle whose volume straddles a node
-  puts all of p_p V_p into one cell: the force quadrature is off by O(p V_p/h) = O(p/N_p) and E_a grows
-  like 1/h. GIMP, whose G_ip is continuous in x_p, restores a converging force with V_p once N_p >= 8,
-  where the particle domains tile the line; with fewer particles the volumes the run updates drift from
-  a tiling (gaps and overlaps that do not shrink with h) and GIMP stalls too, as it does on seeded random
-  layouts, whose domains overlap. Each basis needs its own consistency: equal weights per cell for the
-  point-mass sums, particle domains that tile the line for GIMP.
-"""
-
-
-def report(folder: Path) -> str:
-    folder = Path(folder)
-    lines = ['## Projection and particle quadrature (C4-C10)', ""]
-    if not (folder / "orders.csv").exists():
-        return "\n".join(lines + ["Not run yet: `mpm-fem study projection`.", ""])
-    o = _orders(folder)
-    hs = sorted({float(r["h"]) for r in read_table(folder / "d2.csv")})
-    lines += [f"Smooth fields on [0, 1] (`rho = 1 + 0.5 sin 2 pi x`, `v = sin 2 pi x`, `p = rho^1.4`), h = 1/{round(1 / hs[-1])} "
-              f"... 1/{round(1 / hs[0])}, errors at interior nodes, L1 norms; least-squares orders over all meshes, "
-              "range over N_p. Point-mass sums with the slides' weights h/N_p^i unless marked; `V_p`: the volumes "
-              "a run carries; GIMP: hats averaged over the particle domains. Tables and figures in "
-              "`figures/projection/` (`errors_vs_h.png`, `errors_vs_h_random.png`, `d2.png`, `hickernell.png`).", "",
-              "| quantity | source's band | " + " | ".join(c[3] for c in COLUMNS) + " |",
-              "|---|---|" + "---|" * len(COLUMNS)]
-    for q in QUANTITIES:
-        lines.append(f"| {q} | {_band_text(q)} | " + " | ".join(_fmt(o, q, *c[:3]) for c in COLUMNS) + " |")
-    c_rows = read_table(folder / "d2_constant.csv")
-    lines += ["", "The C of `D2 ~ [1/(12 N^2) + C h^2]^1/2` (slides: 1/4 <= C <= 1/3), fitted per layout:", "",
-              "| layout | " + " | ".join(f"N_p={r['N_p']}" for r in c_rows if r["layout"] == "random") + " |",
-              "|---|" + "---|" * sum(r["layout"] == "random" for r in c_rows)]
-    for lay in LAYOUT_NAMES:
-        lines.append(f"| {lay} | " + " | ".join(f"{float(r['C']):.3g}" for r in c_rows if r["layout"] == lay) + " |")
-    lines += ["", WHY, "Verdicts:", ""]
-    lines += [f"- **{c['id']}** {c['verdict']}: {c['evidence']}" for c in claims(folder)]
-    return "\n".join(lines + [""])
+_SHOWN = {"norm": "L1", "weights": "cell", "basis": "mpm"}
+PAGE = Page(
+    NAME, "Projection and particle quadrature",
+    "Smooth fields on the unit interval are sampled by regular, jittered, random and advected particles; each "
+    "nodal projection of the slides is compared with the exact integral it stands in for, and Hickernell's "
+    "discrepancy and bound are measured on every cell. Orders are least-squares slopes over all meshes.",
+    views=(
+        View(ORDERS, "Least-squares L1 orders per layout at the middle particle count, point mass with the slides' "
+             "weights", ("quantity", "layout", "N_p", "order", "order_coarse", "order_fine", "band"),
+             {**_SHOWN, "N_p": 4}, "errors_vs_h.png"),
+        View(ORDERS, "The same with the volumes a run carries and with GIMP, advected particles",
+             ("quantity", "weights", "basis", "N_p", "order", "band"), {"layout": "advected", "norm": "L1", "N_p": 4,
+                                                                          "weights": "volume"}),
+        View("projection/d2_constant", "The C of the slides' D2 formula fitted per layout and N_p", (), {}, "d2.png"),
+    ),
+    figures=(("errors_vs_h_random.png", "Projection errors of random layouts against h, one line per N_p"),
+             ("hickernell.png", "Measured quadrature error against Hickernell's bound on every cell and node")),
+)
 
 
 if __name__ == "__main__":

@@ -1,46 +1,33 @@
-"""Sod's shock tube: MPM beside fixed-mesh FEM and the exact solution (claims C11, C12, C14, C3, C15).
+"""Sod's shock tube: MPM beside fixed-mesh FEM, a finite-volume reference and the exact solution.
 
-Density error at T = 0.2 against the exact Riemann solution, for h = 0.01 ... 0.0003125, with one
-set of MPM settings for every mesh (``MPM``: 16 particles per cell, CFL 0.05, von Neumann-Richtmyer
-viscosity 0.5 / 2.0 in the energy equation, USL, point-mass basis, lumped mass), measured over
-particles and over grid nodes (``m_i / int S_i``), beside P1 FEM with consistent and lumped mass
-on the same mesh, and the source's table (slides, "Final Error Combination(cont.)").
-
-- ``convergence.csv``: C11, the source's L1/L2 in their own columns, measured/source, orders.
-- ``regions.csv``: C12, each region's share of the L1 error (regions of :mod:`mpm_fem.regions`).
-- ``extrema.csv``: C14, new density/energy extrema per step, at cell crossings and elsewhere.
-- ``ppc.csv``: C3, error against particles per cell (1 ... 32) on three meshes.
-- ``mass.csv``: C15, MPM and FEM with lumped and consistent mass on the same meshes.
-- ``plateau.csv``: what moves the floor: one setting changed at a time, on two fine meshes.
+Density error at T against the exact Riemann solution on every mesh of the source's table, with one
+set of MPM settings for every mesh (``MPM``), over particles and over grid nodes (``m_i / int S_i``).
+Tables: ``convergence`` (C11, E3), ``regions`` (C12), ``extrema`` (C14), ``ppc`` (C3), ``mass``
+(C15), ``plateau`` (what moves the floor: one setting changed at a time).
 """
 
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 
 from baselines import fem_euler, fv_euler
 from baselines.exact import riemann
-from mpm_fem.errors import norms, observed_orders
+from mpm_fem import plots, shock_tube, source
+from mpm_fem.errors import orders_column
 from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
 from mpm_fem.problems import sod
-from mpm_fem.regions import REGION_NAMES, ExtremaCounter, l1_by_region, mean_by_region, sod_regions
-from mpm_fem.study import StudyOptions, read_table, script_main, write_table
+from mpm_fem.regions import REGION_NAMES, ExtremaCounter, describe
+from mpm_fem.plots import Curve, Plot
+from mpm_fem.report import Page, View
+from mpm_fem.study import StudyOptions, script_main, write_table
 
 NAME = "sod"
 H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)
-# The source's density error table (slides, "Final Error Combination(cont.)")
-SOURCE = {
-    0.01: (0.00830833, 0.0158701),
-    0.005: (0.00433578, 0.0104553),
-    0.0025: (0.00230507, 0.0075895),
-    0.00125: (0.00126351, 0.0057596),
-    0.000625: (0.00109963, 0.0061870),
-    0.0003125: (0.00101256, 0.0062115),
-}
+SOURCE = source.SOD
+T = sod.SodSettings.T
 # One set of MPM settings for every h (never tuned per mesh); why these: ppc.csv and plateau.csv
 MPM = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", scheme="usl", basis="mpm", layout="regular", seed=0)
 FEM = dict(cfl=0.3, viscosity_linear=0.1, viscosity_quadratic=1.0)  # baselines.fem_euler defaults
@@ -51,128 +38,34 @@ PPC = (1, 2, 4, 8, 16, 32)
 PPC_H = (0.01, 0.0025, 0.000625)
 CONSISTENT_H = H[:4]  # the consistent particle mass costs ~2x: the two finest meshes are left out
 PLATEAU_H = (0.0025, 0.00125)
-PLATEAU_VARIANTS = {
-    "study settings": {},
-    "CFL 0.025": {"cfl": 0.025},
-    "CFL 0.1": {"cfl": 0.1},
-    "8 ppc": {"ppc": 8},
-    "32 ppc": {"ppc": 32},
-    "viscosity x0.5": {"av_linear": 0.25, "av_quadratic": 1.0},
-    "viscosity x2": {"av_linear": 1.0, "av_quadratic": 4.0},
-    "USF": {"scheme": "usf"},
-    "MUSL": {"scheme": "musl"},
-    "GIMP": {"basis": "gimp"},
-    "consistent mass": {"mass": "consistent"},
-}
+PLATEAU_VARIANTS = {"study settings": {}, "CFL 0.025": {"cfl": 0.025}, "CFL 0.1": {"cfl": 0.1}, "8 ppc": {"ppc": 8},
+                    "32 ppc": {"ppc": 32}, "viscosity x0.5": {"av_linear": 0.25, "av_quadratic": 1.0},
+                    "viscosity x2": {"av_linear": 1.0, "av_quadratic": 4.0}, "USF": {"scheme": "usf"}, "MUSL": {"scheme": "musl"},
+                    "GIMP": {"basis": "gimp"}, "consistent mass": {"mass": "consistent"}}
 QUICK = dict(H=H[:3], PPC_H=(0.01,), CONSISTENT_H=H[:2], PLATEAU_H=())
 
 
-# ---------------------------------------------------------------- one case (runs in a worker)
-
-def _exact_density(x, t):
-    return riemann.sample(x, t, sod.SodSettings.left, sod.SodSettings.right, x0=0.5, gamma=1.4)[0]
-
-
-def _first_below(x, rho, level):
-    """First ``x`` (linear between points) where ``rho`` drops below ``level``, from the left."""
-    k = int(np.argmax(rho < level))
-    return float(x[k - 1] + (x[k] - x[k - 1]) * (rho[k - 1] - level) / (rho[k - 1] - rho[k]))
-
-
-def _head_shift(x, rho, t, level=0.99):
-    """Where the computed density first drops below 0.99 minus where the exact one does: the
-    position error of the rarefaction head (> 0: the computed head lags behind)."""
-    xe = np.linspace(0.2, 0.4, 20001)
-    return _first_below(x, rho, level) - _first_below(xe, _exact_density(xe, t), level)
-
-
-def _profile(values: dict) -> dict:
-    return {k: [float(f"{v:.7g}") for v in np.asarray(a)] for k, a in values.items()}
-
-
 def run_case(case: dict) -> dict:
-    """One run: ``case["solver"]`` is ``"mpm"`` (keys of :data:`MPM` and ``h``) or ``"fem"``
-    (``h``, ``mass`` and the keys of :data:`FEM`). Returns density errors over particles and
-    nodes, the regional L1 split, new-extrema counts (MPM), and profiles when asked for."""
-    h = case["h"]
-    if case["solver"] == "fem":
-        return _run_fem(case)
+    """One run, measured (:mod:`mpm_fem.shock_tube`): ``case["solver"]`` is ``"mpm"`` (keys of
+    :data:`MPM` and ``h``), ``"fem"`` (``h``, ``mass`` and the keys of :data:`FEM`) or ``"fv"``."""
+    h, width, profiles = case["h"], case.get("region_half_width"), case.get("profiles", False)
     if case["solver"] == "fv":
-        return _run_fv(case)
+        return shock_tube.fv(fv_euler.solve(h, cfl=case["cfl"]), h)
+    if case["solver"] == "fem":
+        try:
+            r = fem_euler.solve(h, mass=case["mass"], cfl=case["cfl"],
+                                viscosity=fem_euler.Viscosity(case["viscosity_linear"], case["viscosity_quadratic"]))
+        except fem_euler.PositivityError as err:
+            return {"ok": False, "error": str(err)}
+        return shock_tube.fem(r, uniform_grid(0.0, 1.0, h).lumped_mass, width, profiles)
     settings = sod.SodSettings(h=h, **{k: case[k] for k in MPM})
     counter = ExtremaCounter(uniform_grid(0.0, 1.0, h))
     try:
         result = sod.simulate(settings, progress=False, observer=counter)
     except (PositivityError, FloatingPointError) as err:
         return {"ok": False, "error": str(err), "steps": counter.steps}
-    errors = sod.errors(settings, result)
-    P, g = result.particles, result.grid
-    regions = sod_regions(riemann.wave_positions(result.t, settings.left, settings.right), case["region_half_width"])
-    e_p = P.density - _exact_density(P.x, result.t)
-    e_i = result.nodal_density - _exact_density(g.nodes, result.t)
-    out = {
-        "ok": True,
-        "steps": result.steps,
-        "wall_s": result.wall_s,
-        "particles": int(P.n),
-        "density": errors["density"],
-        "velocity": errors["velocity"],
-        "pressure": errors["pressure"],
-        "regions": {
-            "particles": l1_by_region(P.x, e_p, P.volume, regions).tolist(),
-            "nodes": l1_by_region(g.nodes, e_i, g.lumped_mass, regions).tolist(),
-        },
-        "mean_error": {
-            "particles": mean_by_region(P.x, e_p, P.volume, regions).tolist(),
-            "nodes": mean_by_region(g.nodes, e_i, g.lumped_mass, regions).tolist(),
-        },
-        "extrema": counter.summary(),
-        "volume_drift": float(P.volume.sum() - 1.0),
-        "head_shift": _head_shift(g.nodes, result.nodal_density, result.t),
-    }
-    if case.get("profiles"):
-        thermal = (settings.gamma - 1.0) * P.density * P.energy
-        out["profile"] = _profile(dict(x=P.x, density=P.density, velocity=P.velocity, pressure=thermal,
-                                       energy=P.energy, nodes=g.nodes, nodal_density=result.nodal_density,
-                                       nodal_velocity=result.nodal_velocity))
-    return out
+    return shock_tube.mpm(settings, result, sod.errors(settings, result), counter.summary(), width, profiles)
 
-
-def _run_fem(case: dict) -> dict:
-    visc = fem_euler.Viscosity(case["viscosity_linear"], case["viscosity_quadratic"])
-    try:
-        r = fem_euler.solve(case["h"], mass=case["mass"], cfl=case["cfl"], viscosity=visc)
-    except fem_euler.PositivityError as err:
-        return {"ok": False, "error": str(err)}
-    w = uniform_grid(0.0, 1.0, case["h"]).lumped_mass
-    e = r.rho - _exact_density(r.nodes, r.t)
-    regions = sod_regions(riemann.wave_positions(r.t, sod.SodSettings.left, sod.SodSettings.right),
-                          case["region_half_width"])
-    out = {
-        "ok": True,
-        "steps": r.steps,
-        "density": {"nodes": norms(e, w)},
-        "regions": {"nodes": l1_by_region(r.nodes, e, w, regions).tolist()},
-        "mean_error": {"nodes": mean_by_region(r.nodes, e, w, regions).tolist()},
-        "mass": float(np.sum(w * r.rho)),
-        "head_shift": _head_shift(r.nodes, r.rho, r.t),
-        "settings": r.settings,
-    }
-    if case.get("profiles"):
-        out["profile"] = _profile(dict(x=r.nodes, density=r.rho, velocity=r.u, pressure=r.p, energy=r.e))
-    return out
-
-
-def _run_fv(case: dict) -> dict:
-    """The finite-volume reference (MUSCL-Hancock + HLLC) on the cells of the same mesh: cell
-    averages against the exact density at the cell centres, weights h."""
-    r = fv_euler.solve(case["h"], cfl=case["cfl"])
-    e = r.rho - _exact_density(r.centres, r.t)
-    return {"ok": True, "steps": r.steps, "density": {"cells": norms(e, np.full(e.size, case["h"]))},
-            "mass": float(np.sum(r.rho) * case["h"])}
-
-
-# ---------------------------------------------------------------- the cases
 
 def mpm_case(h: float, **changes) -> dict:
     """The MPM case at ``h`` with the study settings, ``changes`` applied."""
@@ -183,10 +76,6 @@ def mpm_case(h: float, **changes) -> dict:
 def fem_case(h: float, mass: str) -> dict:
     return {"solver": "fem", "h": h, "mass": mass, **FEM, "region_half_width": REGION_HALF_WIDTH,
             "profiles": h in PROFILE_H}
-
-
-def fv_case(h: float) -> dict:
-    return {"solver": "fv", "h": h, "cfl": FV_CFL}
 
 
 def _cost(case: dict) -> float:
@@ -205,525 +94,205 @@ def _plan(quick: bool) -> dict:
         "mpm_consistent": {h: mpm_case(h, mass="consistent") for h in consistent_h},
         "fem_consistent": {h: fem_case(h, "consistent") for h in hs},
         "fem_lumped": {h: fem_case(h, "lumped") for h in hs},
-        "fv": {h: fv_case(h) for h in hs},
+        "fv": {h: {"solver": "fv", "h": h, "cfl": FV_CFL} for h in hs},
         "ppc": {(h, n): mpm_case(h, ppc=n) if n != MPM["ppc"] else mpm_case(h) for h in ppc_h for n in PPC},
         "plateau": {(h, name): mpm_case(h, **change) if change else mpm_case(h)
                     for h in plateau_h for name, change in PLATEAU_VARIANTS.items()},
     }
 
 
-# ---------------------------------------------------------------- the study
-
 def run(options: StudyOptions) -> None:
     """All cases in one sweep (shared ones run once), then tables and figures."""
-    plan = _plan(options.quick)
-    got = options.sweep_plan(NAME, run_case, plan, cost=_cost)
+    got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
     folder = options.folder(NAME)
-    settings = {"mpm": MPM, "fem": FEM, "fv": {"cfl": FV_CFL, "scheme": "MUSCL-Hancock + HLLC"}, "region_half_width": REGION_HALF_WIDTH, "T": 0.2,
+    settings = {"mpm": MPM, "fem": FEM, "fv": {"cfl": FV_CFL, "scheme": "MUSCL-Hancock + HLLC"}, "region_half_width": REGION_HALF_WIDTH, "T": T,
                 "quick": options.quick, "problem": sod.SodSettings().as_dict()}
-    _convergence(folder, got, settings)
-    _regions(folder, got, settings)
-    _extrema(folder, got, settings)
-    _ppc(folder, got, settings)
-    _mass(folder, got, settings)
-    if got["plateau"]:
-        _plateau(folder, got, settings)
-    _profiles(folder, got)
+    tables = {"convergence": _convergence(got), "regions": _regions(got), "extrema": _extrema(got), "ppc": _ppc(got),
+              "mass": _mass(got), "plateau": _plateau(got) if got["plateau"] else []}
+    waves = riemann.wave_positions(T, sod.SodSettings.left, sod.SodSettings.right)
+    extra = {"regions": {"regions": describe(REGION_HALF_WIDTH, waves, T)}, "extrema": {
+        "rtol": 1e-9, "definition": "new strict local extremum among position-ordered particles"}}
+    for name, rows in tables.items():
+        if rows:
+            write_table(folder, name, rows, {**settings, **extra.get(name, {})})
+    _figures(folder, got, tables)
 
 
-def _orders(hs, values) -> list:
-    """Observed order between each row and the previous one ('' in the first row)."""
-    v = np.asarray(values, float)
-    if len(v) < 2 or not np.all(v > 0):
-        return [""] * len(v)
-    return [""] + [float(o) for o in observed_orders(hs, v)]
+def _L1(r, where="nodes", norm="L1"):
+    return r["density"][where][norm] if r["ok"] else float("nan")
 
 
-def _convergence(folder, got, settings) -> None:
+def _convergence(got) -> list[dict]:
     hs = sorted(got["mpm"], reverse=True)
     mpm = [got["mpm"][h] for h in hs]
-    d = lambda r, where, norm: r["density"][where][norm] if r["ok"] else float("nan")  # noqa: E731
-    cols = {
-        "nodes_L1": [d(r, "nodes", "L1") for r in mpm],
-        "nodes_L2": [d(r, "nodes", "L2") for r in mpm],
-        "particles_L1": [d(r, "particles", "L1") for r in mpm],
-        "particles_L2": [d(r, "particles", "L2") for r in mpm],
-        "fem_consistent_L1": [d(got["fem_consistent"][h], "nodes", "L1") for h in hs],
-        "fem_lumped_L1": [d(got["fem_lumped"][h], "nodes", "L1") for h in hs],
-        "fv_L1": [d(got["fv"][h], "cells", "L1") for h in hs],
-    }
-    orders = {k: _orders(hs, v) for k, v in cols.items()}
-    src_orders = {n: _orders(hs, [SOURCE[h][i] for h in hs]) for i, n in enumerate(("L1", "L2"))}
+    cols = {f"{w}_{n}": [_L1(r, w, n) for r in mpm] for w in ("nodes", "particles") for n in ("L1", "L2")}
+    cols.update({f"{m}_L1": [_L1(got[m][h], where) for h in hs]
+                 for m, where in (("fem_consistent", "nodes"), ("fem_lumped", "nodes"), ("fv", "cells"))})
+    orders = {k: orders_column(hs, v) for k, v in cols.items()}
+    src_orders = orders_column(hs, [SOURCE[h][0] for h in hs])
     rows = []
-    for k, h in enumerate(hs):
-        s1, s2 = SOURCE[h]
-        rows.append({
-            "h": h,
-            "source_L1": s1, "source_L2": s2, "source_order_L1": src_orders["L1"][k],
-            "mpm_nodes_L1": cols["nodes_L1"][k], "ratio_nodes_L1": cols["nodes_L1"][k] / s1,
-            "order_nodes_L1": orders["nodes_L1"][k],
-            "mpm_nodes_L2": cols["nodes_L2"][k], "ratio_nodes_L2": cols["nodes_L2"][k] / s2,
-            "order_nodes_L2": orders["nodes_L2"][k],
-            "mpm_particles_L1": cols["particles_L1"][k], "ratio_particles_L1": cols["particles_L1"][k] / s1,
-            "order_particles_L1": orders["particles_L1"][k],
-            "mpm_particles_L2": cols["particles_L2"][k], "ratio_particles_L2": cols["particles_L2"][k] / s2,
-            "fem_consistent_L1": cols["fem_consistent_L1"][k], "order_fem_consistent_L1": orders["fem_consistent_L1"][k],
-            "fem_lumped_L1": cols["fem_lumped_L1"][k], "order_fem_lumped_L1": orders["fem_lumped_L1"][k],
-            "fv_L1": cols["fv_L1"][k], "order_fv_L1": orders["fv_L1"][k],
-            "mpm_particles_mean_error_smooth": mpm[k]["mean_error"]["particles"][2] if mpm[k]["ok"] else "",
-            "mpm_nodes_mean_error_smooth": mpm[k]["mean_error"]["nodes"][2] if mpm[k]["ok"] else "",
-            "mpm_volume_drift": mpm[k].get("volume_drift", ""), "mpm_head_shift": mpm[k].get("head_shift", ""),
+    for k, (h, r) in enumerate(zip(hs, mpm)):
+        s = dict(zip(("L1", "L2"), SOURCE[h]))
+        row = {"h": h, "source_L1": s["L1"], "source_L2": s["L2"], "source_order_L1": src_orders[k]}
+        for key in ("nodes_L1", "nodes_L2", "particles_L1", "particles_L2"):
+            row.update({f"mpm_{key}": cols[key][k], f"ratio_{key}": cols[key][k] / s[key[-2:]]})
+            if key != "particles_L2":
+                row[f"order_{key}"] = orders[key][k]
+        for m in ("fem_consistent", "fem_lumped", "fv"):
+            row.update({f"{m}_L1": cols[f"{m}_L1"][k], f"order_{m}_L1": orders[f"{m}_L1"][k]})
+        row.update({
+            "mpm_particles_mean_error_smooth": r["mean_error"]["particles"][2] if r["ok"] else "",
+            "mpm_nodes_mean_error_smooth": r["mean_error"]["nodes"][2] if r["ok"] else "",
+            "mpm_volume_drift": r.get("volume_drift", ""), "mpm_head_shift": r.get("head_shift", ""),
             "fem_consistent_head_shift": got["fem_consistent"][h].get("head_shift", ""),
-            "mpm_steps": mpm[k].get("steps"), "mpm_particles": mpm[k].get("particles"),
-            "mpm_wall_s": round(mpm[k].get("wall_s", float("nan")), 2),
-        })
-    write_table(folder, "convergence", rows, settings)
-    from mpm_fem import plots
-
-    hs_src = list(SOURCE)
-    series = {
-        "MPM, grid nodes": (hs, cols["nodes_L1"], "o-"),
-        "MPM, particles": (hs, cols["particles_L1"], "s-"),
-        "FEM consistent": (hs, cols["fem_consistent_L1"], "^--"),
-        "FEM lumped": (hs, cols["fem_lumped_L1"], "v--"),
-        "FV (MUSCL-Hancock + HLLC)": (hs, cols["fv_L1"], "x-."),
-    }
-    cons = sorted(got["mpm_consistent"], reverse=True)
-    if cons:
-        series["MPM consistent mass, nodes"] = (cons, [d(got["mpm_consistent"][h], "nodes", "L1") for h in cons], "d:")
-    series["source (slides)"] = (hs_src, [SOURCE[h][0] for h in hs_src], "k*")
-    plots.convergence(folder / "convergence.png", series, ylabel="density error (L1)", slopes=(0.5, 1),
-                      title="Sod, T=0.2: density L1 error vs h (MPM 16 ppc, CFL 0.05)")
-
-
-def _regions(folder, got, settings) -> None:
-    rows = []
-    methods = [("MPM nodes", got["mpm"], "nodes"), ("MPM particles", got["mpm"], "particles"),
-               ("FEM consistent", got["fem_consistent"], "nodes"), ("FEM lumped", got["fem_lumped"], "nodes")]
-    for label, group, where in methods:
-        for h in sorted(group, reverse=True):
-            r = group[h]
-            if not r["ok"]:
-                continue
-            parts = np.asarray(r["regions"][where])
-            total = r["density"][where]["L1"]
-            row = {"method": label, "h": h, "L1": total, "sum_of_regions": float(parts.sum())}
-            row.update({f"L1_{k}_{_slug(n)}": float(p) for k, (n, p) in enumerate(zip(REGION_NAMES, parts))})
-            row.update({f"share_{k}": float(p / total) for k, p in enumerate(parts)})
-            rows.append(row)
-    write_table(folder, "regions", rows, {**settings, "regions": _region_text()})
-    _region_figure(folder / "regions.png", rows)
-
-
-def _slug(name: str) -> str:
-    return name.replace(" ", "_")
-
-
-def _region_text() -> dict:
-    w = REGION_HALF_WIDTH
-    return {
-        "0 undisturbed": f"[0, x_H - {w}) and [x_S + {w}, 1]",
-        "1 rarefaction head": f"[x_H - {w}, x_H + {w})",
-        "2 smooth": f"[x_H + {w}, x_T - {w}) (fan) and [x_T + {w}, x_C - {w}) (plateau)",
-        "3 rarefaction tail": f"[x_T - {w}, x_T + {w})",
-        "4 contact": f"[x_C - {w}, x_C + {w})",
-        "5 behind shock": f"[x_C + {w}, x_S - {w})",
-        "6 shock front": f"[x_S - {w}, x_S + {w})",
-        "waves at T=0.2": "x_H = 0.26336, x_T = 0.48595, x_C = 0.68549, x_S = 0.85043",
-    }
-
-
-def _region_figure(path, rows) -> None:
-    """Stacked shares of the L1 error by region (each bar sums to 1), total L1 above each bar."""
-    import matplotlib.pyplot as plt
-
-    methods = list(dict.fromkeys(r["method"] for r in rows))
-    fig, axes = plt.subplots(1, len(methods), figsize=(3.6 * len(methods), 4.0), sharey=True, squeeze=False)
-    colors = plt.cm.tab10(np.arange(len(REGION_NAMES)))
-    for ax, method in zip(axes[0], methods):
-        sub = [r for r in rows if r["method"] == method]
-        labels = [f"{r['h']:g}" for r in sub]
-        bottom = np.zeros(len(sub))
-        for k, name in enumerate(REGION_NAMES):
-            vals = np.array([r[f"share_{k}"] for r in sub])
-            ax.bar(labels, vals, bottom=bottom, color=colors[k], label=f"{k} {name}")
-            bottom += vals
-        for j, r in enumerate(sub):
-            ax.annotate(f"{r['L1']:.2g}", (j, 1.01), ha="center", fontsize=6)
-        ax.set_ylim(0, 1.08)
-        ax.set_title(method, fontsize=9)
-        ax.set_xlabel("h")
-        ax.tick_params(axis="x", labelrotation=45, labelsize=7)
-    axes[0][0].set_ylabel("share of the density L1 error (total above)")
-    handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles[::-1], labels[::-1], fontsize=7, loc="center right")
-    fig.suptitle(f"C12: density L1 error by region of the exact solution at T = 0.2 (half-width {REGION_HALF_WIDTH})",
-                 fontsize=9)
-    fig.tight_layout(rect=(0, 0, 0.89, 1))
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def _extrema(folder, got, settings) -> None:
-    rows = []
-    for h in sorted(got["mpm"], reverse=True):
-        r = got["mpm"][h]
-        if not r["ok"]:
-            continue
-        x = r["extrema"]
-        row = {"h": h, "steps": x["steps"], "crossings": x["crossings"],
-               "crossings_per_step": x["crossings"] / x["steps"]}
-        for name in ("density", "energy"):
-            f = x[name]
-            row.update({
-                f"{name}_new_at_crossing": f["new_at_crossing"], f"{name}_new_elsewhere": f["new_elsewhere"],
-                f"{name}_new_per_step": f["new_per_step"], f"{name}_max_per_step": f["max_per_step"],
-                f"{name}_rate_crossing": f["rate_crossing"], f"{name}_rate_elsewhere": f["rate_elsewhere"],
-                f"{name}_rate_ratio": f["rate_crossing"] / f["rate_elsewhere"] if f["rate_elsewhere"] else float("inf"),
-            })
+            "mpm_steps": r.get("steps"), "mpm_particles": r.get("particles"),
+            "mpm_wall_s": round(r.get("wall_s", float("nan")), 2)})
         rows.append(row)
-    write_table(folder, "extrema", rows, {**settings, "rtol": 1e-9,
-                                          "definition": "new strict local extremum among position-ordered particles"})
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
-    hs = [r["h"] for r in rows]
-    for name, style in (("density", "o-"), ("energy", "s--")):
-        axes[0].loglog(hs, [r[f"{name}_new_per_step"] for r in rows], style, label=name)
-        axes[1].loglog(hs, [r[f"{name}_rate_crossing"] for r in rows], style, label=f"{name}: particles crossing a node")
-        axes[1].loglog(hs, [r[f"{name}_rate_elsewhere"] for r in rows], style, alpha=0.5, label=f"{name}: other particles")
-    axes[0].set(xlabel="h", ylabel="new extrema per step")
-    axes[1].set(xlabel="h", ylabel="new extrema per particle-step")
-    for ax in axes:
-        ax.legend(fontsize=7)
-    fig.suptitle("C14: new extrema of particle density / energy (MPM, 16 ppc, CFL 0.05)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(folder / "extrema.png", dpi=120)
-    plt.close(fig)
+    return rows
 
 
-def _ppc(folder, got, settings) -> None:
+def _regions(got) -> list[dict]:
+    rows = []
+    for label, group, where in (("MPM nodes", "mpm", "nodes"), ("MPM particles", "mpm", "particles"),
+                                ("FEM consistent", "fem_consistent", "nodes"), ("FEM lumped", "fem_lumped", "nodes")):
+        for h, r in sorted(got[group].items(), reverse=True):
+            if r["ok"]:
+                parts, total = np.asarray(r["regions"][where]), r["density"][where]["L1"]
+                rows.append({"method": label, "h": h, "L1": total, "sum_of_regions": float(parts.sum()),
+                             **{f"L1_{k}_{n.replace(' ', '_')}": float(p) for k, (n, p) in enumerate(zip(REGION_NAMES, parts))},
+                             **{f"share_{k}": float(p / total) for k, p in enumerate(parts)}})
+    return rows
+
+
+def _extrema(got) -> list[dict]:
+    rows = []
+    for h, r in sorted(got["mpm"].items(), reverse=True):
+        if r["ok"]:
+            x = r["extrema"]
+            row = {"h": h, "steps": x["steps"], "crossings": x["crossings"], "crossings_per_step": x["crossings"] / x["steps"]}
+            for name in ("density", "energy"):
+                f = x[name]
+                row.update({f"{name}_{k}": f[k] for k in ("new_at_crossing", "new_elsewhere", "new_per_step", "max_per_step",
+                                                          "rate_crossing", "rate_elsewhere")})
+                row[f"{name}_rate_ratio"] = f["rate_crossing"] / f["rate_elsewhere"] if f["rate_elsewhere"] else float("inf")
+            rows.append(row)
+    return rows
+
+
+def _ppc(got) -> list[dict]:
     rows = []
     for (h, n), r in sorted(got["ppc"].items(), key=lambda kv: (-kv[0][0], kv[0][1])):
-        row = {"h": h, "ppc": n, "ok": r["ok"]}
-        if r["ok"]:
-            row.update({"nodes_L1": r["density"]["nodes"]["L1"], "nodes_L2": r["density"]["nodes"]["L2"],
-                        "particles_L1": r["density"]["particles"]["L1"], "particles_L2": r["density"]["particles"]["L2"],
-                        "steps": r["steps"], "wall_s": round(r["wall_s"], 2), "error": ""})
-        else:
-            row.update({"nodes_L1": "", "nodes_L2": "", "particles_L1": "", "particles_L2": "", "steps": r.get("steps"),
-                        "wall_s": "", "error": r["error"]})
-        rows.append(row)
-    write_table(folder, "ppc", rows, settings)
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
-    for ax, where in zip(axes, ("nodes", "particles")):
-        for h in sorted({r["h"] for r in rows}, reverse=True):
-            sub = [r for r in rows if r["h"] == h and r["ok"]]
-            ax.loglog([r["ppc"] for r in sub], [r[f"{where}_L1"] for r in sub], "o-", label=f"h = {h:g}")
-            if h in SOURCE:
-                ax.axhline(SOURCE[h][0], color=ax.lines[-1].get_color(), ls=":", lw=0.8)
-        ax.axvspan(4, 8, color="0.9", zorder=0)
-        ax.set(xlabel="particles per cell N_p", title=f"over {'grid nodes' if where == 'nodes' else 'particles'}")
-        ax.set_xticks(PPC, [str(n) for n in PPC])
-    axes[0].set_ylabel("density error (L1)")
-    axes[0].legend(fontsize=7)
-    fig.suptitle("C3: error vs particles per cell (shaded: 4-8, the source's optimum; dotted: source at that h)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(folder / "ppc.png", dpi=120)
-    plt.close(fig)
+        ok = r["ok"]
+        rows.append({"h": h, "ppc": n, "ok": ok, **{f"{w}_{k}": _L1(r, w, k) if ok else "" for w in ("nodes", "particles")
+                                                    for k in ("L1", "L2")},
+                     "steps": r.get("steps"), "wall_s": round(r["wall_s"], 2) if ok else "", "error": "" if ok else r["error"]})
+    return rows
 
 
-def _mass(folder, got, settings) -> None:
+def _mass(got) -> list[dict]:
     rows = []
     for h in sorted(got["mpm_consistent"], reverse=True):
-        lump, cons = got["mpm"][h], got["mpm_consistent"][h]
-        fl, fc = got["fem_lumped"][h], got["fem_consistent"][h]
-        L1 = lambda r, where="nodes": r["density"][where]["L1"] if r["ok"] else float("nan")  # noqa: E731
+        lump, cons, fl, fc = got["mpm"][h], got["mpm_consistent"][h], got["fem_lumped"][h], got["fem_consistent"][h]
         rows.append({
-            "h": h,
-            "mpm_lumped_nodes_L1": L1(lump), "mpm_consistent_nodes_L1": L1(cons),
-            "mpm_consistent_over_lumped_nodes": L1(cons) / L1(lump),
-            "mpm_lumped_particles_L1": L1(lump, "particles"), "mpm_consistent_particles_L1": L1(cons, "particles"),
-            "mpm_consistent_over_lumped_particles": L1(cons, "particles") / L1(lump, "particles"),
-            "fem_lumped_L1": L1(fl), "fem_consistent_L1": L1(fc), "fem_consistent_over_lumped": L1(fc) / L1(fl),
-            "mpm_consistent_error": "" if cons["ok"] else cons["error"],
-        })
-    write_table(folder, "mass", rows, settings)
+            "h": h, "mpm_lumped_nodes_L1": _L1(lump), "mpm_consistent_nodes_L1": _L1(cons),
+            "mpm_consistent_over_lumped_nodes": _L1(cons) / _L1(lump),
+            "mpm_lumped_particles_L1": _L1(lump, "particles"), "mpm_consistent_particles_L1": _L1(cons, "particles"),
+            "mpm_consistent_over_lumped_particles": _L1(cons, "particles") / _L1(lump, "particles"),
+            "fem_lumped_L1": _L1(fl), "fem_consistent_L1": _L1(fc), "fem_consistent_over_lumped": _L1(fc) / _L1(fl),
+            "mpm_consistent_error": "" if cons["ok"] else cons["error"]})
+    return rows
 
 
-def _plateau(folder, got, settings) -> None:
+def _plateau(got) -> list[dict]:
     rows = []
     for (h, name), r in got["plateau"].items():
         base = got["plateau"][(h, "study settings")]
         row = {"h": h, "variant": name, "change": str(PLATEAU_VARIANTS[name]) or "none", "ok": r["ok"]}
         if r["ok"]:
-            e = r["density"]
-            row.update({"nodes_L1": e["nodes"]["L1"], "particles_L1": e["particles"]["L1"],
-                        "nodes_vs_study": e["nodes"]["L1"] / base["density"]["nodes"]["L1"],
-                        "particles_vs_study": e["particles"]["L1"] / base["density"]["particles"]["L1"],
+            row.update({"nodes_L1": _L1(r), "particles_L1": _L1(r, "particles"), "nodes_vs_study": _L1(r) / _L1(base),
+                        "particles_vs_study": _L1(r, "particles") / _L1(base, "particles"),
                         "nodes_smooth_L1": r["regions"]["nodes"][2], "nodes_behind_shock_L1": r["regions"]["nodes"][5],
                         "particles_behind_shock_L1": r["regions"]["particles"][5],
                         "density_new_extrema_per_step": r["extrema"]["density"]["new_per_step"],
-                        "volume_drift": r["volume_drift"], "head_shift": r["head_shift"],
-                        "steps": r["steps"], "error": ""})
+                        "volume_drift": r["volume_drift"], "head_shift": r["head_shift"], "steps": r["steps"], "error": ""})
         else:
             row["error"] = r["error"]
         rows.append(row)
-    write_table(folder, "plateau", rows, settings)
+    return rows
+
+
+_STYLES = {"density": "o-", "energy": "s--"}
+PLOTS = (
+    Plot("convergence.png", f"Sod, T = {T}: density L1 error against h, beside the source's table", "convergence", "h", (
+        Curve("MPM, grid nodes", "mpm_nodes_L1"), Curve("MPM, particles", "mpm_particles_L1", "s-"),
+        Curve("FEM consistent", "fem_consistent_L1", "^--"), Curve("FEM lumped", "fem_lumped_L1", "v--"),
+        Curve("FV (MUSCL-Hancock + HLLC)", "fv_L1", "x-."), Curve("source (slides)", "source_L1", "k*")),
+        ylabel="density error (L1)", slopes=(0.5, 1)),
+    Plot("extrema.png", "C14: new extrema of particle density and energy, per step and per particle-step", "extrema", "h",
+         tuple(Curve(n, f"{n}_new_per_step", f, panel="new extrema per step") for n, f in _STYLES.items())
+         + tuple(Curve(f"{n}: {who}", f"{n}_rate_{k}", f, panel="new extrema per particle-step", options=o)
+                 for n, f in _STYLES.items() for k, who, o in (("crossing", "particles crossing a node", {}),
+                                                               ("elsewhere", "other particles", {"alpha": 0.5}))),
+         ylabel="new extrema", size=(4.5, 3.6)),
+    Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", "ppc", "ppc", tuple(
+        Curve("h = {group}", f"{w}_L1", panel=f"over {name}", group="h", where={"ok": True})
+        for w, name in (("nodes", "grid nodes"), ("particles", "particles"))),
+        xlabel="particles per cell N_p", ylabel="density error (L1)", size=(4.5, 3.6)),
+)
+
+
+def _figures(folder, got, t) -> None:
+    for plot in PLOTS:
+        plots.draw(folder, plot, t[plot.table])
+    plots.stacked_shares(folder / "regions.png", t["regions"], REGION_NAMES, f"C12: density L1 error by region of the exact "
+                         f"solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
+    _profiles(folder, got)
 
 
 def _profiles(folder, got) -> None:
-    import matplotlib.pyplot as plt
-
-    t = 0.2
     xe = np.linspace(0, 1, 2001)
-    rho, u, p = riemann.sample(xe, t, sod.SodSettings.left, sod.SodSettings.right, x0=0.5, gamma=1.4)
-    exact = {"density": rho, "velocity": u, "pressure": p, "energy": p / (0.4 * rho)}
+    rho, u, p = riemann.sample(xe, T, sod.SodSettings.left, sod.SodSettings.right, x0=0.5, gamma=1.4)
+    exact = {k: (xe, v) for k, v in (("density", rho), ("velocity", u), ("pressure", p), ("energy", p / (0.4 * rho)))}
     for h in PROFILE_H:
         m, fc, fl = (got[k].get(h) for k in ("mpm", "fem_consistent", "fem_lumped"))
         if m is None or not m.get("ok") or "profile" not in m:
             continue
-        fig, axes = plt.subplots(2, 4, figsize=(16, 6.4), sharex=True)
-        for col, name in enumerate(exact):
-            for row in range(2):
-                axes[row][col].plot(xe, exact[name], "k-", lw=1.0, label="exact")
-                axes[row][col].set_title(f"{name}", fontsize=9)
-            mp = m["profile"]
-            axes[0][col].plot(mp["x"], mp[name], ".", ms=1.5, color="tab:blue", label="MPM particles")
-            if name in ("density", "velocity"):
-                axes[0][col].plot(mp["nodes"], mp[f"nodal_{name}"], "x", ms=3, color="tab:red", label="MPM grid nodes")
-            for r, style, label in ((fc, "^-", "FEM consistent"), (fl, "v-", "FEM lumped")):
-                if r is not None and r.get("ok") and "profile" in r:
-                    axes[1][col].plot(r["profile"]["x"], r["profile"][name], style, ms=2.5, lw=0.7, label=label)
-        axes[0][0].set_ylabel("MPM (16 ppc, CFL 0.05)")
-        axes[1][0].set_ylabel("FEM (P1, SSPRK3, CFL 0.3)")
-        for ax in axes[1]:
-            ax.set_xlabel("x")
-        axes[0][0].legend(fontsize=7)
-        axes[1][0].legend(fontsize=7)
-        fig.suptitle(f"Sod at T = 0.2, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh", fontsize=10)
-        fig.tight_layout()
-        fig.savefig(folder / f"profiles_h{h:g}.png", dpi=110)
-        plt.close(fig)
+        mp = m["profile"]
+        nodal = {"density": mp["nodal_density"], "velocity": mp["nodal_velocity"]}
+        fem = [(label, r["profile"]["x"], r["profile"], fmt, {"ms": 2.5, "lw": 0.7}) for r, fmt, label in
+               ((fc, "^-", "FEM consistent"), (fl, "v-", "FEM lumped")) if r is not None and r.get("ok") and "profile" in r]
+        plots.profile_grid(folder / f"profiles_h{h:g}.png", exact, {
+            f"MPM ({MPM['ppc']} ppc, CFL {MPM['cfl']})": [("MPM particles", mp["x"], mp, ".", {"ms": 1.5, "color": "tab:blue"}),
+                                                          ("MPM grid nodes", mp["nodes"], nodal, "x", {"ms": 3, "color": "tab:red"})],
+            f"FEM (P1, SSPRK3, CFL {FEM['cfl']})": fem},
+            f"Sod at T = {T}, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh")
 
 
-# ---------------------------------------------------------------- the report
-
-def report(folder: Path) -> str:
-    """Markdown section: C11, C12, C14, C3, C15 with verdicts read from the tables."""
-    folder = Path(folder)
-    path = folder / "convergence.csv"
-    if not path.exists():
-        return "## Sod's shock tube (C11, C12, C14, C3, C15)\n\nNot run.\n"
-    return "\n".join(_report_lines(folder)) + "\n"
-
-
-def _f(row, key):
-    v = row.get(key, "")
-    return float(v) if v not in ("", None) else float("nan")
-
-
-def claims(folder: Path) -> list[dict]:
-    """Verdicts on C11, C12, C14, C3, C15 from the written tables."""
-    folder = Path(folder)
-    if not (folder / "convergence.csv").exists():
-        return []
-    conv = read_table(folder / "convergence.csv")
-    out = [_c11(conv)]
-    regions = read_table(folder / "regions.csv")
-    nodes = [r for r in regions if r["method"] == "MPM nodes"]
-    if nodes:
-        b = nodes[-1]
-        top = sorted(range(len(REGION_NAMES)), key=lambda k: -_f(b, f"share_{k}"))[:3]
-        out.append({"id": "C12", "verdict": "measured",
-                    "evidence": f"at h = {b['h']} the nodal L1 splits " + ", ".join(
-                        f"{k} {REGION_NAMES[k]} {_f(b, f'share_{k}'):.0%}" for k in top)
-                    + f"; the shock front carries {_f(nodes[0], 'share_6'):.0%} at h = {nodes[0]['h']}"})
-    ext = read_table(folder / "extrema.csv")
-    rr = [_f(r, "density_rate_ratio") for r in ext]
-    out.append({"id": "C14", "verdict": "confirmed" if min(rr) > 2 else "differs",
-                "evidence": f"a particle crossing a node becomes a new density extremum {min(rr):.0f}-{max(rr):.0f}x more "
-                            f"often than one that does not; new extrema per step grow from "
-                            f"{_f(ext[0], 'density_new_per_step'):.2g} (h = {ext[0]['h']}) to "
-                            f"{_f(ext[-1], 'density_new_per_step'):.2g} (h = {ext[-1]['h']})"})
-    out.append(_c3_claim(read_table(folder / "ppc.csv")))
-    if "fv_L1" in conv[0]:
-        first, last = conv[0], conv[-1]
-        out.append({"id": "E3", "verdict": "measured", "evidence": (
-            "density L1 on the same meshes (convergence.csv, profiles_h*.png): "
-            + "; ".join(f"h = {r['h']}: MPM nodes {_f(r, 'mpm_nodes_L1'):.3g}, FEM lumped {_f(r, 'fem_lumped_L1'):.3g}, "
-                        f"FEM consistent {_f(r, 'fem_consistent_L1'):.3g}, FV {_f(r, 'fv_L1'):.3g}" for r in (first, last))
-            + ". The fixed-mesh methods keep converging where MPM's nodal error levels off")})
-    mass = read_table(folder / "mass.csv")
-    cm = [_f(r, "mpm_consistent_over_lumped_nodes") for r in mass]
-    cf = [_f(r, "fem_consistent_over_lumped") for r in mass]
-    out.append({"id": "C15", "verdict": "partly",
-                "evidence": f"lumping is not where this error comes from: MPM with the consistent particle mass has "
-                            f"x{min(cm):.2f}-{max(cm):.2f} the nodal L1 of the lumped one (h = {mass[0]['h']} ... "
-                            f"{mass[-1]['h']}); fixed-mesh FEM consistent/lumped x{min(cf):.2f}-{max(cf):.2f}"})
-    return out
-
-
-def _c3_claim(rows) -> dict:
-    """Per mesh: the N_p of the smallest error, and the smallest N_p within 5% of it (saturation)."""
-    parts, saturated = [], []
-    for h in dict.fromkeys(r["h"] for r in rows):
-        ok = [r for r in rows if r["h"] == h and r["ok"] == "True"]
-        text = []
-        for where in ("nodes", "particles"):
-            best = min(_f(r, f"{where}_L1") for r in ok)
-            argmin = min(ok, key=lambda r: _f(r, f"{where}_L1"))["ppc"]
-            enough = min(int(r["ppc"]) for r in ok if _f(r, f"{where}_L1") <= 1.05 * best)
-            saturated.append(enough)
-            text.append(f"{where} smallest at N_p = {argmin}, within 5% from N_p = {enough}")
-        parts.append(f"h = {h}: " + ", ".join(text))
-    in_band = [n for n in saturated if 4 <= n <= 8]
-    verdict = "confirmed" if len(in_band) == len(saturated) else ("partly" if in_band else "refuted")
-    return {"id": "C3", "verdict": verdict, "evidence": "; ".join(parts)}
-
-
-def _report_lines(folder: Path) -> list[str]:
-    conv = read_table(folder / "convergence.csv")
-    out = ["## Sod's shock tube (C11, C12, C14, C3, C15)", "",
-           f"MPM with one set of settings for every mesh: {MPM}. FEM: P1, SSPRK3, {FEM}. "
-           "Density error at T = 0.2 against the exact Riemann solution.", "",
-           "### C11: density error vs h, beside the source", "",
-           "| h | source L1 | MPM nodes L1 | ratio | order | source order | source L2 | MPM nodes L2 | ratio | MPM particles L1 | order | FEM cons. L1 | FEM lumped L1 | FV L1 |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in conv:
-        out.append("| " + " | ".join([r["h"], r["source_L1"], f"{_f(r, 'mpm_nodes_L1'):.4g}", f"{_f(r, 'ratio_nodes_L1'):.3f}",
-                                      _o(r, "order_nodes_L1"), _o(r, "source_order_L1"), r["source_L2"],
-                                      f"{_f(r, 'mpm_nodes_L2'):.4g}", f"{_f(r, 'ratio_nodes_L2'):.3f}",
-                                      f"{_f(r, 'mpm_particles_L1'):.4g}", _o(r, "order_particles_L1"),
-                                      f"{_f(r, 'fem_consistent_L1'):.4g}", f"{_f(r, 'fem_lumped_L1'):.4g}",
-                                      f"{_f(r, 'fv_L1'):.4g}" if "fv_L1" in r else ""]) + " |")
-    c = _c11(conv)
-    out += ["", f"**C11** (the density error stops converging): {c['verdict']}; {c['evidence']}.", ""]
-    out += _floor_report(conv) + _regions_report(folder) + _extrema_report(folder) + _ppc_report(folder) + _mass_report(folder)
-    if (folder / "plateau.csv").exists():
-        out += _plateau_report(folder)
-    return out
-
-
-def _o(row, key) -> str:
-    v = row.get(key, "")
-    return f"{float(v):.2f}" if v not in ("", None) else ""
-
-
-def _c11(conv) -> dict:
-    """Verdict on C11: first order on the coarse meshes, then orders below 1/2 (a floor)."""
-    orders = [_f(r, "order_nodes_L1") for r in conv[1:]]
-    ratios = [_f(r, "ratio_nodes_L1") for r in conv]
-    last = conv[-1]
-    full = len(conv) >= 5
-    floor = full and max(orders[-2:]) < 0.5 and min(orders[:3]) > 0.7
-    text = (f"nodal density L1 / source {', '.join(f'{q:.2f}' for q in ratios)} for h = {conv[0]['h']} ... {last['h']}; "
-            f"orders {', '.join(f'{o:.2f}' for o in orders)} (source {', '.join(_o(r, 'source_order_L1') for r in conv[1:])}); "
-            f"over particles {_f(last, 'mpm_particles_L1'):.2g} at h = {last['h']} "
-            f"({_f(last, 'ratio_particles_L1'):.1f}x the source), orders "
-            f"{', '.join(_o(r, 'order_particles_L1') for r in conv[1:])}; nodal L2 / source {_f(last, 'ratio_nodes_L2'):.2f} "
-            "at the finest mesh")
-    if not full:
-        text += " (quick run: the floor lies on the finer meshes of the full run)"
-    return {"id": "C11", "verdict": "confirmed" if floor else "partly", "evidence": text}
-
-
-def _floor_report(conv) -> list[str]:
-    """The diagnostics that explain the floor, per mesh."""
-    out = ["What sets the floor: the particle volume gained by grid-crossing noise (sum V_p - 1: 0 at t = 0, and "
-           "the walls keep the true length 1), the signed mean density error in the smooth region (2), and the position error of the "
-           "rarefaction head (where the density first drops below 0.99; > 0: behind the exact head).", "",
-           "| h | sum V_p - 1 | mean error, region 2, particles | mean error, region 2, nodes | head shift MPM | head shift FEM |",
-           "|---|---|---|---|---|---|"]
-    for r in conv:
-        out.append(f"| {r['h']} | {_f(r, 'mpm_volume_drift'):.2e} | {_f(r, 'mpm_particles_mean_error_smooth'):+.4f} | "
-                   f"{_f(r, 'mpm_nodes_mean_error_smooth'):+.4f} | {_f(r, 'mpm_head_shift'):+.4f} | "
-                   f"{_f(r, 'fem_consistent_head_shift'):+.4f} |")
-    return out + [""]
-
-
-def _regions_report(folder) -> list[str]:
-    rows = read_table(folder / "regions.csv")
-    out = ["### C12: share of the L1 error by region of the exact solution", "",
-           f"Regions of half-width {REGION_HALF_WIDTH} around each wave ({_region_text()['waves at T=0.2']}); "
-           "0 undisturbed, 1 rarefaction head, 2 smooth (fan and plateau), 3 rarefaction tail, 4 contact, "
-           "5 behind the shock, 6 shock front. The shares add up to 1 (column 'sum').", "",
-           "| method | h | L1 | 0 | 1 | 2 | 3 | 4 | 5 | 6 | sum |", "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        if r["method"] not in ("MPM nodes", "MPM particles", "FEM lumped"):
-            continue
-        shares = [_f(r, f"share_{k}") for k in range(len(REGION_NAMES))]
-        out.append(f"| {r['method']} | {r['h']} | {_f(r, 'L1'):.3g} | " + " | ".join(f"{s:.2f}" for s in shares)
-                   + f" | {sum(shares):.3f} |")
-    by = {m: [r for r in rows if r["method"] == m] for m in ("MPM nodes", "MPM particles", "FEM lumped")}
-    if all(by.values()):
-        (n0, n1), (p0, p1), (f0, f1) = ((v[0], v[-1]) for v in by.values())
-        s = lambda r, k: f"{_f(r, f'share_{k}'):.0%}"  # noqa: E731
-        out += ["", f"**C12**: over nodes the smooth region (2) carries {s(n0, 2)} of the MPM error at h = {n0['h']} and "
-                f"{s(n1, 2)} at h = {n1['h']}; the rarefaction head (1) {s(n0, 1)} -> {s(n1, 1)}; the shock front (6) "
-                f"{s(n0, 6)} -> {s(n1, 6)}; the contact (4) {s(n0, 4)} -> {s(n1, 4)}. Over particles region 2 grows "
-                f"{s(p0, 2)} -> {s(p1, 2)} (the density bias of the volume gain above) and region 5 carries "
-                f"{s(p1, 5)} (noise behind the shock, which the nodal average removes). The fixed-mesh FEM's error "
-                f"moves to the contact ({s(f0, 4)} -> {s(f1, 4)}), which MPM, moving with the material, keeps sharp.", ""]
-    return out
-
-
-def _extrema_report(folder) -> list[str]:
-    rows = read_table(folder / "extrema.csv")
-    out = ["### C14: new extrema when particles cross cells", "",
-           "| h | steps | crossings/step | new density extrema/step | rate at crossing | rate elsewhere | ratio | new energy extrema/step | ratio |",
-           "|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        out.append(f"| {r['h']} | {r['steps']} | {_f(r, 'crossings_per_step'):.1f} | {_f(r, 'density_new_per_step'):.2f} | "
-                   f"{_f(r, 'density_rate_crossing'):.2e} | {_f(r, 'density_rate_elsewhere'):.2e} | "
-                   f"{_f(r, 'density_rate_ratio'):.0f} | {_f(r, 'energy_new_per_step'):.2f} | {_f(r, 'energy_rate_ratio'):.0f} |")
-    ratios = [_f(r, "density_rate_ratio") for r in rows]
-    out += ["", f"**C14**: confirmed if a particle that crosses a node is more likely to become a new extremum than one "
-            f"that does not: the ratio of the two rates is {min(ratios):.0f}-{max(ratios):.0f} for density "
-            "(the exact density is monotone, so every extremum is spurious).", ""]
-    return out
-
-
-def _ppc_report(folder) -> list[str]:
-    rows = read_table(folder / "ppc.csv")
-    out = ["### C3: particles per cell", "", "| h | N_p | nodes L1 | particles L1 |", "|---|---|---|---|"]
-    for r in rows:
-        if r["ok"] == "True":
-            out.append(f"| {r['h']} | {r['ppc']} | {_f(r, 'nodes_L1'):.4g} | {_f(r, 'particles_L1'):.4g} |")
-        else:
-            out.append(f"| {r['h']} | {r['ppc']} | failed: {r['error'][:80]} | |")
-    c = _c3_claim(rows)
-    out += ["", f"**C3** (4-8 particles per cell optimal): {c['verdict']}; {c['evidence']}.", ""]
-    return out
-
-
-def _mass_report(folder) -> list[str]:
-    rows = read_table(folder / "mass.csv")
-    out = ["### C15: lumped vs consistent mass", "",
-           "| h | MPM lumped (nodes) | MPM consistent (nodes) | ratio | MPM lumped (particles) | MPM consistent (particles) | FEM lumped | FEM consistent | ratio |",
-           "|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        out.append(f"| {r['h']} | {_f(r, 'mpm_lumped_nodes_L1'):.4g} | {_f(r, 'mpm_consistent_nodes_L1'):.4g} | "
-                   f"{_f(r, 'mpm_consistent_over_lumped_nodes'):.2f} | {_f(r, 'mpm_lumped_particles_L1'):.4g} | "
-                   f"{_f(r, 'mpm_consistent_particles_L1'):.4g} | {_f(r, 'fem_lumped_L1'):.4g} | "
-                   f"{_f(r, 'fem_consistent_L1'):.4g} | {_f(r, 'fem_consistent_over_lumped'):.2f} |")
-    out += [""]
-    return out
-
-
-def _plateau_report(folder) -> list[str]:
-    rows = read_table(folder / "plateau.csv")
-    out = ["### What moves the floor (one setting changed at a time)", "",
-           "| h | variant | nodes L1 | vs study | particles L1 | vs study | new extrema/step |", "|---|---|---|---|---|---|---|"]
-    for r in rows:
-        if r["ok"] == "True":
-            out.append(f"| {r['h']} | {r['variant']} | {_f(r, 'nodes_L1'):.4g} | {_f(r, 'nodes_vs_study'):.2f} | "
-                       f"{_f(r, 'particles_L1'):.4g} | {_f(r, 'particles_vs_study'):.2f} | {_f(r, 'density_new_extrema_per_step'):.2f} |")
-        else:
-            out.append(f"| {r['h']} | {r['variant']} | failed: {r['error'][:60]} | | | | |")
-    return out + [""]
+_CONVERGENCE = ("h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1",
+                "mpm_particles_L1", "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1", "order_fv_L1")
+PAGE = Page(
+    NAME, "Sod's shock tube",
+    "Density error at the final time against the exact Riemann solution, with one set of MPM settings for every "
+    "mesh (recorded in the JSON beside each table), over particles and over grid nodes, beside P1 FEM with "
+    "consistent and lumped mass and a finite-volume reference on the same mesh, and beside the source's table.",
+    views=(
+        View("sod/convergence", "Density L1 against h, beside the source", _CONVERGENCE, {}, "convergence.png"),
+        View("sod/convergence", "What sets the floor: volume gained by the particles, signed mean error in the "
+             "smooth region, position error of the rarefaction head", ("h", "mpm_volume_drift",
+             "mpm_particles_mean_error_smooth", "mpm_nodes_mean_error_smooth", "mpm_head_shift", "fem_consistent_head_shift")),
+        View("sod/regions", "Share of the L1 error by region of the exact solution",
+             ("method", "h", "L1") + tuple(f"share_{k}" for k in range(len(REGION_NAMES))), {}, "regions.png"),
+        View("sod/extrema", "New extrema per step, at cell crossings and elsewhere", ("h", "steps", "crossings_per_step",
+             "density_new_per_step", "density_rate_crossing", "density_rate_elsewhere", "density_rate_ratio",
+             "energy_new_per_step", "energy_rate_ratio"), {}, "extrema.png"),
+        View("sod/ppc", "Error against particles per cell", ("h", "ppc", "ok", "nodes_L1", "particles_L1"), {}, "ppc.png"),
+        View("sod/mass", "Lumped against consistent mass, MPM and FEM"),
+        View("sod/plateau", "What moves the floor: one setting changed at a time", ("h", "variant", "ok", "nodes_L1",
+             "nodes_vs_study", "particles_L1", "particles_vs_study", "density_new_extrema_per_step")),
+    ),
+    figures=tuple((f"profiles_h{h:g}.png", "Profiles against the exact solution, MPM above and FEM below, on the "
+                   "mesh named in the file") for h in PROFILE_H),
+)
 
 
 if __name__ == "__main__":

@@ -134,7 +134,7 @@ def test_fem_p1_consistent_is_second_order_in_l2_and_lumped_is_larger():
 
 
 def test_source_table_with_corrections_falls_monotonically():
-    """STUDY.md's exponent corrections (*) put every row of the source's table in decreasing order."""
+    """docs/claims.md's exponent corrections (*) put every row of the source's table in decreasing order."""
     for row, table in study.SOURCE.items():
         for eps, values in table.items():
             assert all(a > b for a, b in zip(values, values[1:])), f"{row} eps={eps}: {values}"

@@ -1,30 +1,75 @@
-"""The report lists every claim of STUDY.md, measured or not."""
+"""The report is only ever generated: rendering the committed tables gives the committed REPORT.md
+byte for byte; every claim is listed; anchors and links resolve inside the figures folder; every
+table row has as many cells as its header."""
 
-from mpm_fem.report import CLAIMS, claims_index, write_report
-from mpm_fem.study import StudyOptions
+from __future__ import annotations
 
+import re
+from pathlib import Path
 
-class _FakeStudy:
-    @staticmethod
-    def report(folder):
-        return "## fake\n\nA section.\n"
+import pytest
 
-    @staticmethod
-    def claims(folder):
-        return [{"id": "C5", "verdict": "confirmed", "evidence": "order 1.02"},
-                {"id": "E1 (sod)", "verdict": "partly", "evidence": "does not add up"}]
+from mpm_fem.claims import STATEMENTS
+from mpm_fem.report import Page, View, cell, markdown_table, render, study_pages, write_report
+from mpm_fem.tables import load_tables
 
-
-def test_every_claim_appears_in_the_index_with_a_verdict():
-    lines = claims_index({"fake": _FakeStudy.claims(None)})
-    table = [line for line in lines if line.startswith("| C") or line.startswith("| E")]
-    assert [row.split("|")[1].strip().split()[0] for row in table] == list(CLAIMS)
-    assert "| C5 |" in lines[4 + 4] and "confirmed" in lines[4 + 4] and "order 1.02" in lines[4 + 4]
-    assert any(row.startswith("| E1 (sod) |") and "partly" in row for row in table)
-    assert sum("not measured" in row for row in table) == len(CLAIMS) - 2
+FIGURES = Path(__file__).resolve().parent.parent / "figures"
 
 
-def test_report_is_written_with_index_and_sections(tmp_path):
-    path = write_report(StudyOptions(quick=True, out=tmp_path), studies=[("fake", _FakeStudy)])
-    text = path.read_text()
-    assert "QUICK" in text and "## fake" in text and "| E4 |" in text and "confirmed" in text
+@pytest.fixture(scope="module")
+def committed():
+    return (FIGURES / "REPORT.md").read_text()
+
+
+def test_the_committed_report_is_the_rendering_of_the_committed_tables(committed):
+    rendered = render(load_tables(FIGURES), study_pages(FIGURES)) + "\n"
+    assert rendered == committed, "figures/REPORT.md differs from `python -m mpm_fem.report --out figures`"
+
+
+def test_the_header_names_the_code_version_of_the_tables(committed):
+    codes = {r["code"] for r in load_tables(FIGURES)["versions"]}
+    assert any(f"code version {c}" in committed.splitlines()[2] for c in codes)
+
+
+def test_every_claim_is_in_the_summary(committed):
+    summary = committed.split("## Summary")[1].split("<a id=")[0]
+    for cid in STATEMENTS:
+        assert re.search(rf"^\| \[?{cid}[\] (|]", summary, re.M), cid
+
+
+def test_every_anchor_and_link_resolves_inside_the_folder(committed):
+    anchors = set(re.findall(r'<a id="([^"]+)"></a>', committed))
+    for target in re.findall(r"\]\(([^)]+)\)", committed):
+        assert not target.startswith(("/", "..", "http", "figures/")), target
+        if target.startswith("#"):
+            assert target[1:] in anchors, target
+        else:
+            assert (FIGURES / target).exists(), target
+
+
+def test_no_garbled_cells(committed):
+    lines = committed.splitlines()
+    for k, line in enumerate(lines):
+        if line.startswith("|---"):
+            width = lines[k - 1].count("|")
+            for row in lines[k + 1:]:
+                if not row.startswith("|"):
+                    break
+                assert len(re.findall(r"(?<!\\)\|", row)) == width, row
+
+
+def test_a_quick_report_links_only_to_its_own_folder(tmp_path):
+    (tmp_path / "toy").mkdir()
+    (tmp_path / "toy" / "t.csv").write_text("h,quick_value\n0.5,1.25\n0.25,|x|\n")
+    (tmp_path / "toy" / "t.json").write_text('{"settings": {"quick": true}, "code": "abc"}')
+    page = Page("toy", "Toy", "A toy study.", views=(View("toy/t", "The toy table", (), {}, "t.png"),))
+    text = write_report(tmp_path, [page]).read_text()
+    assert "reproduce --quick" in text and "code version abc" in text
+    assert "![The toy table](toy/t.png)" in text and "[t.csv](toy/t.csv)" in text
+    assert "| 0.25 | \\|x\\| |" in text
+    assert "not measured" in text
+
+
+def test_cells_keep_four_significant_digits_and_escape_pipes():
+    assert [cell("0.0083452"), cell("16"), cell("nan"), cell("a|b")] == ["0.008345", "16", "", "a\\|b"]
+    assert markdown_table([{"a": "1", "b": "x"}]) == ["| a | b |", "|---|---|", "| 1 | x |"]

@@ -1,6 +1,6 @@
 """Exact solutions of the viscous Burgers equation ``v_t + v v_x = eps v_xx``.
 
-Source: the candidates (a)-(d) of STUDY.md, "Problem settings" (the slides of Tran & Berzins do
+Source: the candidates (a)-(d) of docs/claims.md, "Problem settings" (the slides of Tran & Berzins do
 not say which exact solution their Burgers table used). All four are Cole-Hopf solutions
 
     v = -2 eps phi_x / phi,        phi_t = eps phi_xx                                   (CH)
@@ -98,7 +98,7 @@ def _exponential_mixture(x, t, eps, kappa, tau, c):
 
 @dataclass(frozen=True)
 class Front(_BurgersSolution):
-    """(a) Travelling front ``v = 0.5 - 0.5 tanh((x - x0 - t/2) / (4 eps))``, STUDY.md (a).
+    """(a) Travelling front ``v = 0.5 - 0.5 tanh((x - x0 - t/2) / (4 eps))``, docs/claims.md (a).
 
     The viscous shock from 1 (left) to 0 (right) moving at the Rankine-Hugoniot speed 1/2, width
     ~ 4 eps. It is the two-term mixture ``phi = exp(-(x - x0 - t/2)/(2 eps)) + 1`` (values 1, 0),
@@ -121,7 +121,7 @@ class Front(_BurgersSolution):
 
 @dataclass(frozen=True)
 class ThreeExponential(_BurgersSolution):
-    """(b) Berzins' three-exponential solution, STUDY.md (b):
+    """(b) Berzins' three-exponential solution, docs/claims.md (b):
 
         v = (0.1 e^-a + 0.5 e^-b + e^-c) / (e^-a + e^-b + e^-c),
         a = 0.05/eps (x - 0.5 + 4.95 t),  b = 0.25/eps (x - 0.5 + 0.75 t),  c = 0.5/eps (x - 0.375).
@@ -145,7 +145,7 @@ class ThreeExponential(_BurgersSolution):
 
 @dataclass(frozen=True)
 class ColeHopfWave(_BurgersSolution):
-    """(c) Decaying Cole-Hopf wave, STUDY.md (c), from ``phi = A + E cos(pi x)``,
+    """(c) Decaying Cole-Hopf wave, docs/claims.md (c), from ``phi = A + E cos(pi x)``,
     ``E = exp(-pi^2 eps t)``:
 
         v    = 2 eps pi E sin(pi x) / D,                     D = A + E cos(pi x),
@@ -189,7 +189,7 @@ def _log_erfcx(z):
 
 @dataclass(frozen=True)
 class Rarefaction(_BurgersSolution):
-    """(d) Viscous rarefaction, STUDY.md (d): the Cole-Hopf solution of the step ``v = u_left``
+    """(d) Viscous rarefaction, docs/claims.md (d): the Cole-Hopf solution of the step ``v = u_left``
     for ``x < x_step``, ``u_right`` for ``x > x_step``, at time ``s = t0 + t`` (``t0 > 0`` makes the
     data at ``t = 0`` smooth).
 

@@ -8,7 +8,7 @@ from an exact solution (``baselines.exact.burgers``), so the error at T is exact
 with the grid velocity ``v_i = P_i / m_i`` taking the Dirichlet data at the two end nodes, as it
 does in every step. Particles leave through the ends; a reservoir outside each end feeds new
 particles in, spaced ``h / N_p`` like the initial layout, so that the domain never empties (the
-pitfall of STUDY.md).
+pitfall of docs/claims.md).
 
 Besides the stage switches, three settings reach the slides' own forms (:mod:`.burgers_fast`,
 which runs point mass with USL; the general loop the rest): ``weights`` ``"volume"`` (the

@@ -1,0 +1,136 @@
+"""Every claim's verdict follows its numbers: a table perturbed to fail and one perturbed to pass
+give different verdicts (mutation tests, one pair per claim), and missing tables are not measured."""
+
+from __future__ import annotations
+
+import pytest
+from claim_mutations import TABLES, assert_flips, claim_named, judge, mutate
+
+from mpm_fem.claims import CLAIMS, STATEMENTS, VERDICTS
+
+ORDERS = "projection/orders"
+
+
+def test_every_registered_claim_gives_a_verdict_of_the_vocabulary_from_the_committed_tables():
+    for c in CLAIMS:
+        verdict, evidence = c.verdict(TABLES)
+        assert verdict in VERDICTS and evidence, c.label
+
+
+def test_every_statement_is_listed_once():
+    assert [k for k in STATEMENTS if k.startswith("C")] == [f"C{k}" for k in range(1, 16)]
+    assert {"E1", "E2", "E3", "E4"} <= set(STATEMENTS)
+    assert len({c.label for c in CLAIMS}) == len(CLAIMS)
+
+
+def test_a_claim_whose_table_is_missing_is_not_measured():
+    tables = {k: v for k, v in TABLES.items() if k != "sod/extrema"}
+    assert judge("C14", tables) == ("not measured", "no table `sod/extrema.csv`")
+
+
+def test_a_verdict_outside_the_vocabulary_is_an_error():
+    c = claim_named("C14")
+    broken = type(c)(**{**c.__dict__, "criterion": lambda t: ("measured", "x")})
+    with pytest.raises(ValueError, match="measured"):
+        broken.verdict(TABLES)
+
+
+@pytest.mark.parametrize("label, quantity, good, bad", [
+    ("C5", "E_m", 1.0, -5.0), ("C6", "E_P", 1.5, 0.2), ("C7", "E_F", 1.0, 3.5),
+    ("C8", "E_a", 0.5, -1.0), ("C9", "E_v", 0.9, -0.5)])
+def test_band_claims_follow_the_orders(label, quantity, good, bad):
+    passing = mutate(TABLES, ORDERS, {"quantity": quantity}, order=good)
+    failing = mutate(TABLES, ORDERS, {"quantity": quantity}, order=bad)
+    assert_flips(label, failing, passing)
+    assert judge(label, failing)[0] == "refuted"
+    assert f"{bad:.2f}" in judge(label, failing)[1]
+
+
+def test_c10_compares_the_gradient_order_with_the_velocity_order():
+    passing = mutate(TABLES, ORDERS, {"quantity": "E_VG_proj"}, order=lambda r: _order(r, "E_v"))
+    assert_flips("C10", TABLES, passing)
+
+
+def _order(row, quantity):
+    match = [r for r in TABLES[ORDERS] if r["quantity"] == quantity and all(
+        r[k] == row[k] for k in ("layout", "weights", "basis", "N_p", "norm"))]
+    return float(match[0]["order"])
+
+
+def test_c4_needs_the_bound_to_hold_and_the_constant_in_the_band():
+    passing = mutate(TABLES, "projection/d2_constant", C=0.3)
+    assert_flips("C4", TABLES, passing)
+    assert judge("C4", mutate(passing, "projection/bounds", {"check": "node_F"}, min_ratio=0.5))[0] == "refuted"
+
+
+def _orders_column(rows, orders):
+    return {r["h"]: o for r, o in zip(rows, orders)}
+
+
+def test_c11_is_confirmed_by_a_floor_and_refuted_by_steady_convergence():
+    rows = TABLES["sod/convergence"]
+    floor = dict(zip((r["h"] for r in rows), ("", 0.9, 0.9, 0.8, 0.2, 0.1)))
+    steady = dict(zip((r["h"] for r in rows), ("", 0.9, 0.9, 0.9, 0.9, 0.9)))
+    passing = mutate(TABLES, "sod/convergence", order_nodes_L1=lambda r: str(floor[r["h"]]))
+    failing = mutate(TABLES, "sod/convergence", order_nodes_L1=lambda r: str(steady[r["h"]]))
+    assert_flips("C11", failing, passing)
+    assert judge("C11", failing)[0] == "refuted"
+    quick = {**TABLES, "sod/convergence": rows[:3]}
+    assert judge("C11", quick)[0] == "not measured"
+
+
+def test_c12_follows_the_share_of_the_waves():
+    passing = mutate(TABLES, "sod/regions", share_6=0.6)
+    failing = mutate(TABLES, "sod/regions", share_1=0.0, share_3=0.0, share_4=0.0, share_6=0.1)
+    assert_flips("C12", failing, passing)
+
+
+def test_c14_follows_the_rate_ratio():
+    assert_flips("C14", mutate(TABLES, "sod/extrema", density_rate_ratio=1.0),
+                 mutate(TABLES, "sod/extrema", density_rate_ratio=30.0))
+
+
+def _best_at(n_best):
+    return lambda r: 1.0 if int(r["ppc"]) == n_best else 2.0 + int(r["ppc"])
+
+
+@pytest.mark.parametrize("label, table, keys", [("C3 (sod)", "sod/ppc", ("nodes_L1", "particles_L1")),
+                                                ("C3 (burgers)", "burgers/ppc", ("particles_max",))])
+def test_c3_follows_where_the_error_saturates(label, table, keys):
+    passing = mutate(TABLES, table, **{k: _best_at(4) for k in keys})
+    failing = mutate(TABLES, table, **{k: _best_at(32) for k in keys})
+    assert_flips(label, failing, passing)
+    assert judge(label, failing)[0] == "differs"
+
+
+def test_c15_sod_follows_the_mass_ratios():
+    passing = mutate(TABLES, "sod/mass", mpm_consistent_over_lumped_nodes=0.5, fem_consistent_over_lumped=0.5)
+    assert_flips("C15 (sod)", TABLES, passing)
+
+
+def test_c15_burgers_follows_the_mass_ratios():
+    passing = mutate(TABLES, "burgers/lumping", {"mass": "consistent"}, L2=1e-9)
+    failing = mutate(TABLES, "burgers/lumping", {"mass": "consistent"}, L2=1.0)
+    assert_flips("C15 (burgers)", failing, passing)
+
+
+def test_c13_needs_both_accelerations_first_order():
+    passing = mutate(TABLES, "burgers/orders", {"method": "mpm_calculated"}, fitted=1.0)
+    assert_flips("C13", TABLES, passing)
+    failing = mutate(passing, "burgers/orders", {"method": "mpm_exact_dt_h"}, fitted=2.0)
+    failing = mutate(failing, "burgers/orders", {"method": "mpm_calculated"}, fitted=0.0)
+    assert judge("C13", failing)[0] == "differs"
+
+
+def test_e3_needs_every_method_on_every_mesh():
+    failing = mutate(TABLES, "sod/convergence", {"h": 0.01}, fv_L1="")
+    assert_flips("E3", failing, TABLES)
+    assert "5 of 6 meshes" in judge("E3", failing)[1]
+
+
+def test_e4_refutes_a_table_from_another_code_version():
+    failing = mutate(TABLES, "versions", {"table": "sod/mass"}, code="0123456789ab")
+    assert_flips("E4", failing, TABLES)
+    assert "sod/mass" in judge("E4", failing)[1]
+    missing = {**TABLES, "versions": [r for r in TABLES["versions"] if r["table"] != "sod/mass"]}
+    assert judge("E4", missing)[0] == "partly"
