@@ -8,7 +8,7 @@ combinations that promise most, errors over grid nodes and over particles:
 - ``errors.csv``: every problem, remedy and mesh; observed orders against the previous mesh; on
   Sod the finite-volume reference (MUSCL-Hancock + HLLC) on the same mesh and the ratio to it.
 - ``orders.csv``: per problem and remedy, the lowest successive and the fitted orders, the errors
-  at the finest mesh, and whether the plateau is removed (E5 criterion, :mod:`mpm_fem.remedies_claim`).
+  at the finest mesh, and whether the plateau is removed (E5 criterion, in :mod:`mpm_fem.claims`).
 - ``cost.csv`` / ``cost.png``: Sod density L1 against particle- (or cell-) steps and against wall
   time, for MPM with each remedy, fixed-mesh P1 FEM (lumped mass) and FV. Wall time is the last
   column: it varies from run to run and no verdict uses it.
@@ -29,13 +29,15 @@ from pathlib import Path
 import numpy as np
 
 from baselines import fem_euler, fv_euler
+from mpm_fem.claims import PLATEAU_ORDER, remedy_assessment, successive_orders
 from mpm_fem.errors import norms
 from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
 from mpm_fem.problems import burgers, sod
-from mpm_fem.remedies_claim import PLATEAU_ORDER, assess, orders, verdict
-from mpm_fem.study import StudyOptions, read_table, script_main, write_table
-from studies.sod import FEM, FV_CFL, H, MPM as SOD_MPM, _exact_density
+from mpm_fem.report import Page, View
+from mpm_fem.shock_tube import exact_density
+from mpm_fem.study import StudyOptions, script_main, write_table
+from studies.sod import FEM, FV_CFL, H, MPM as SOD_MPM
 
 NAME = "remedies"
 SOD_H = H[:5]
@@ -70,7 +72,7 @@ def run_case(case: dict) -> dict:
         else:
             r = fv_euler.solve(h, cfl=FV_CFL, **({"limiter": FV_LIMITER} if FV_LIMITER else {}))
             x, w = r.centres, np.full(r.centres.size, h)
-        e = norms(r.rho - _exact_density(x, r.t), w)
+        e = norms(r.rho - exact_density(x, r.t), w)
         return {"ok": True, "nodes": e, "steps": r.steps, "work": r.steps * x.size, "wall_s": time.perf_counter() - start}
     changes = {k: v for k, v in case.items() if k not in ("solver", "h")}
     try:
@@ -153,7 +155,7 @@ def _errors(got) -> list[dict]:
                            error=r.get("error", ""))
                 series.append(row)
             for m in ("nodes_L1", "particles_L1"):
-                o = orders(series, m) if len(series) > 1 else []
+                o = successive_orders(series, m)
                 for k, row in enumerate(series):
                     row[f"order_{m}"] = float(o[k - 1]) if k else ""
             rows += series
@@ -167,7 +169,7 @@ def _summary(rows) -> list[dict]:
             series = [r for r in rows if r["problem"] == problem and r["remedy"] == name]
             if len(series) < 2:
                 continue
-            s, last = assess(series), series[-1]
+            s, last = remedy_assessment(series), series[-1]
             out.append({"problem": problem, "remedy": name, "h_finest": last["h"],
                         "finest_nodes_L1": last["nodes_L1"], "finest_particles_L1": last["particles_L1"],
                         **{k: s[k] for k in s if k != "meshes" and not (problem == "burgers" and k.startswith("max_fv"))},
@@ -221,39 +223,23 @@ def _figures(folder: Path, rows, cost) -> None:
 
 # ---------------------------------------------------------------- report
 
-def claims(folder: Path) -> list[dict]:
-    path = Path(folder) / "errors.csv"
-    if not path.exists():
-        return []
-    v, evidence = verdict({"errors": read_table(path)})
-    return [{"id": "E5", "verdict": v, "evidence": evidence}]
-
-
-def report(folder: Path) -> str:
-    folder = Path(folder)
-    if not (folder / "orders.csv").exists():
-        return "## Remedies for the plateau (E5)\n\nNot run.\n"
-    summary = read_table(folder / "orders.csv")
-    (v, evidence), = [(c["verdict"], c["evidence"]) for c in claims(folder)]
-    lines = ["## Remedies for the plateau (E5)", "",
-             "Each remedy alone and in combination; a remedy removes the plateau when the observed order over nodes "
-             f"and over particles stays >= {PLATEAU_ORDER} between every pair of successive meshes.", "",
-             f"**E5: {v}.** {evidence}.", "",
-             "| problem | remedy | lowest order nodes / particles | fitted order nodes / particles | finest h | L1 nodes / particles at finest h | max ratio to FV nodes / particles | plateau removed |",
-             "|---|---|---|---|---|---|---|---|"]
-    f = lambda r, k: f"{float(r[k]):.3g}" if r.get(k, "") not in ("", "nan") else "-"  # noqa: E731
-    for r in summary:
-        lines.append(f"| {r['problem']} | {r['remedy']} | {f(r, 'min_order_nodes_L1')} / {f(r, 'min_order_particles_L1')} | "
-                     f"{f(r, 'fitted_order_nodes_L1')} / {f(r, 'fitted_order_particles_L1')} | {r['h_finest']} | "
-                     f"{f(r, 'finest_nodes_L1')} / {f(r, 'finest_particles_L1')} | "
-                     f"{f(r, 'max_fv_ratio_nodes_L1')} / {f(r, 'max_fv_ratio_particles_L1')} | {r['removes_plateau']} |")
-    lines += ["", "![errors](remedies/errors.png)", "",
-              "*errors.png: L1 error against h for each remedy (Sod density over nodes and over particles, with the FV "
-              "reference; Burgers velocity over particles, 4 particles per cell).*", "",
-              "![cost](remedies/cost.png)", "",
-              "*cost.png: Sod density L1 against work (particle-, node- or cell-steps) and wall time, one point per mesh; "
-              "the wall times are one run each on a shared machine and enter no verdict.*", ""]
-    return "\n".join(lines)
+_ORDERS = ("problem", "remedy", "min_order_nodes_L1", "min_order_particles_L1", "fitted_order_nodes_L1",
+           "fitted_order_particles_L1", "h_finest", "finest_nodes_L1", "finest_particles_L1", "max_fv_ratio_nodes_L1",
+           "max_fv_ratio_particles_L1", "removes_plateau")
+PAGE = Page(
+    NAME, "Remedies for the plateau (E5)",
+    "Sod (the Sod study's MPM settings) and Burgers (4 particles per cell, calculated acceleration) with each remedy "
+    "alone and in combination: the B-spline averaged over the particle domain, the Taylor least-squares stress "
+    "reconstruction, the volume reset against the grid and a PIC/FLIP blend. Errors over grid nodes and over "
+    "particles; the accuracy per cost beside fixed-mesh FEM and a finite-volume reference.",
+    views=(
+        View("remedies/orders", "Each remedy by its lowest successive order and its error at the finest mesh",
+             _ORDERS, {}, "errors.png"),
+        View("remedies/cost", "Accuracy per cost: Sod density L1 against work (particle-, node- or cell-steps) and "
+             "wall time (one run each on a shared machine; no verdict uses it)",
+             ("method", "h", "density_L1", "particles_L1", "work", "wall_s"), {}, "cost.png"),
+    ),
+)
 
 
 if __name__ == "__main__":
