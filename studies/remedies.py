@@ -229,7 +229,8 @@ _ORDERS = ("problem", "remedy", "min_order_nodes_L1", "min_order_particles_L1", 
            "max_fv_ratio_particles_L1", "removes_plateau")
 PAGE = Page(
     NAME, "Remedies for the plateau (E5)",
-    "Sod (the Sod study's MPM settings) and Burgers (4 particles per cell, calculated acceleration) with each remedy "
+    "Sod (the Sod study's MPM settings) and Burgers (the few particles per cell at which its calculated acceleration "
+    "stalls; every setting in the JSON beside each table) with each remedy "
     "alone and in combination: the B-spline averaged over the particle domain, the Taylor least-squares stress "
     "reconstruction, the volume reset against the grid and a PIC/FLIP blend. Errors over grid nodes and over "
     "particles; the accuracy per cost beside fixed-mesh FEM and a finite-volume reference.",
