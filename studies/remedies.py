@@ -181,7 +181,7 @@ def _summary(rows) -> list[dict]:
 def _cost_rows(got) -> list[dict]:
     rows = []
     for (name, h), r in got["sod"].items():
-        rows.append({"method": f"MPM {name}", "h": h, "density_L1": _l(r, "nodes", "L1"),
+        rows.append({"method": "MPM" if name == "MPM" else f"MPM + {name}", "h": h, "density_L1": _l(r, "nodes", "L1"),
                      "particles_L1": _l(r, "particles", "L1"), "work": r.get("work", ""), "steps": r.get("steps", ""),
                      "wall_s": round(r.get("wall_s", float("nan")), 2)})
     for method, label in (("fem", "FEM P1 lumped"), ("fv", "FV MUSCL-Hancock" + (" MC" if FV_LIMITER else ""))):
