@@ -194,8 +194,9 @@ def _cost_rows(got) -> list[dict]:
 def _figures(folder: Path, rows, cost) -> None:
     from mpm_fem import plots  # noqa: F401  (selects the Agg backend)
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
 
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
     for ax, (problem, where) in zip(axes, (("sod", "nodes"), ("sod", "particles"), ("burgers", "particles"))):
         for name in dict.fromkeys(r["remedy"] for r in rows if r["problem"] == problem):
             s = [r for r in rows if r["problem"] == problem and r["remedy"] == name]
@@ -204,11 +205,13 @@ def _figures(folder: Path, rows, cost) -> None:
             s = [r for r in rows if r["problem"] == "sod" and r["remedy"] == rows[0]["remedy"]]
             ax.loglog([r["h"] for r in s], [r["fv_L1"] for r in s], "k--", label="FV reference")
         ax.set(xlabel="h", ylabel=f"{'density' if problem == 'sod' else 'velocity'} L1 over {where}", title=f"{problem}, {where}")
-    axes[0].legend(fontsize=7)
-    fig.tight_layout()
+        ax.xaxis.set_minor_formatter(NullFormatter())
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="center right", fontsize=7)
+    fig.tight_layout(rect=(0, 0, 0.84, 1))
     fig.savefig(folder / "errors.png", dpi=120)
     plt.close(fig)
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4))
+    fig, axes = plt.subplots(1, 2, figsize=(13, 4.4))
     for method in dict.fromkeys(r["method"] for r in cost):
         s = sorted((r for r in cost if r["method"] == method), key=lambda r: -r["h"])
         style = "k*--" if method.startswith("FV") else "ks:" if method.startswith("FEM") else "o-"
@@ -216,8 +219,9 @@ def _figures(folder: Path, rows, cost) -> None:
             ax.loglog([r[x] for r in s], [r["density_L1"] for r in s], style, ms=3, label=method)
     axes[0].set(xlabel="particle-steps (MPM) or node/cell-steps", ylabel="Sod density L1 (nodes / cells)")
     axes[1].set(xlabel="wall time [s] (one run, shared machine)", ylabel="Sod density L1 (nodes / cells)")
-    axes[1].legend(fontsize=7)
-    fig.tight_layout()
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="center right", fontsize=7)
+    fig.tight_layout(rect=(0, 0, 0.78, 1))
     fig.savefig(folder / "cost.png", dpi=120)
     plt.close(fig)
 
