@@ -39,9 +39,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.sparse.linalg import splu
 
-from mpm_fem.grid import Grid, GridError, uniform_grid
+from mpm_fem.grid import Grid
 
-MASS_KINDS = ("consistent", "lumped")
+from baselines.galerkin import P1Cells, check_settings, mesh, p1_cells
 
 
 @dataclass(frozen=True)
@@ -57,32 +57,21 @@ class BurgersFEMResult:
 
 
 @dataclass(frozen=True, eq=False)
-class _Operators:
-    """Cell connectivity, cell sizes, lumped mass, and the solve with ``M_II``."""
+class _Operators(P1Cells):
+    """The P1 cells, the interior and boundary nodes, and the solve with ``M_II``."""
 
-    a: np.ndarray
-    b: np.ndarray
-    h: np.ndarray
-    n_nodes: int
     interior: np.ndarray
     boundary: np.ndarray
-    mass: str
-    lumped: np.ndarray
     M_IB: object = None
     solve_II: object = None
 
 
 def _operators(grid: Grid, mass: str) -> _Operators:
-    a, b = grid.mesh.t
-    x = grid.mesh.p[0]
     boundary = grid.boundary_nodes
-    interior = np.setdiff1d(np.arange(grid.n_nodes), boundary)
-    ops = dict(
-        a=a, b=b, h=x[b] - x[a], n_nodes=grid.n_nodes, interior=interior, boundary=boundary,
-        mass=mass, lumped=grid.lumped_mass,
-    )
+    ops = dict(p1_cells(grid, mass), interior=np.setdiff1d(np.arange(grid.n_nodes), boundary), boundary=boundary)
     if mass == "consistent":
         M = grid.consistent_mass.tocsr()
+        interior = ops["interior"]
         ops.update(
             M_IB=M[interior][:, boundary],
             solve_II=splu(M[interior][:, interior].tocsc()).solve,
@@ -113,16 +102,6 @@ def time_derivative(v: np.ndarray, g_t: np.ndarray, ops: _Operators, eps: float)
     return out
 
 
-def _validate(h, T, mass, cfl, cfl_visc) -> None:
-    if mass not in MASS_KINDS:
-        raise ValueError(f"unknown mass {mass!r}: expected one of {MASS_KINDS}")
-    for name, value in (("cfl", cfl), ("cfl_visc", cfl_visc)):
-        if not (np.isfinite(value) and 0.0 < value <= 1.0):
-            raise ValueError(f"{name} must lie in (0, 1], got {name}={value}")
-    if not (np.isfinite(T) and T > 0):
-        raise ValueError(f"final time T must be positive and finite, got T={T}")
-
-
 def solve(
     solution,
     h: float,
@@ -139,13 +118,10 @@ def solve(
     Raises ValueError for bad input (``h`` not dividing the domain, ``cfl`` or ``cfl_visc``
     outside (0, 1], unknown ``mass``) and ArithmeticError if the solution becomes non-finite.
     """
-    _validate(h, T, mass, cfl, cfl_visc)
+    check_settings(mass, T, cfl=cfl, cfl_visc=cfl_visc)
     eps = float(solution.eps)
     lo, hi = solution.domain
-    try:
-        grid = uniform_grid(lo, hi, h)
-    except GridError as err:
-        raise ValueError(str(err)) from err
+    grid = mesh(lo, hi, h)
     ops = _operators(grid, mass)
     x = grid.nodes
     x_b = x[ops.boundary]

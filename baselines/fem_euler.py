@@ -30,7 +30,13 @@ Artificial viscosity (a von Neumann-Richtmyer / Lapidus form, constants fixed fo
 linear in the signal speed and quadratic (``h |du|`` ~ ``h^2 |u_x|``) in the compressive
 velocity jump across the cell. Defaults ``c_lin = 0.1``, ``c_quad = 1``, the same for every mesh
 and both mass matrices; the artificial viscosity acts on all three conserved variables, so it
-enters the energy equation too.
+enters the energy equation too. Two variants (:attr:`Viscosity.name`):
+
+    everywhere (the default)   nu_e as above on every cell;
+    compression only           nu_e as above where ``u_b < u_a`` (``du/dx < 0``), 0 elsewhere,
+
+the second as MPM's von Neumann-Richtmyer viscosity, which acts only in compression: it leaves
+rarefactions and contacts to the Galerkin scheme alone.
 
 Time: SSP-RK3 (Shu-Osher) with ``dt = cfl h / max_i (|u_i| + c_i)`` recomputed every step, the
 last step shortened to land on ``T``. Default ``cfl = 0.3``: with the consistent mass the first
@@ -46,12 +52,14 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from mpm_fem.grid import Grid, GridError, uniform_grid
+from mpm_fem.grid import Grid
+
+from baselines.galerkin import MASS_KINDS  # noqa: F401 (the choices of ``mass``, for callers)
+from baselines.galerkin import P1Cells, check_mass, check_settings, mesh, p1_cells
 
 SOD_LEFT = (1.0, 0.0, 1.0)
 SOD_RIGHT = (0.125, 0.0, 0.1)
 SOD_DIAPHRAGM = 0.5
-MASS_KINDS = ("consistent", "lumped")
 
 
 class PositivityError(ArithmeticError):
@@ -60,16 +68,30 @@ class PositivityError(ArithmeticError):
 
 @dataclass(frozen=True)
 class Viscosity:
-    """Constants of ``nu_e = h_e (linear s_e + quadratic max(0, -du_e))`` (module docstring)."""
+    """Constants of ``nu_e = h_e (linear s_e + quadratic max(0, -du_e))`` (module docstring), on
+    every cell or, with ``compression_only``, only where ``du_e < 0``."""
 
     linear: float = 0.1
     quadratic: float = 1.0
+    compression_only: bool = False
 
     def __post_init__(self):
         for name in ("linear", "quadratic"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"viscosity constant {name} must be finite and >= 0, got {value}")
+        if not isinstance(self.compression_only, (bool, np.bool_)):
+            raise ValueError(f"compression_only must be True or False, got {self.compression_only!r}")
+
+    @property
+    def name(self) -> str:
+        """Which variant: ``"viscosity everywhere"`` or ``"compression-only viscosity"``."""
+        return "compression-only viscosity" if self.compression_only else "viscosity everywhere"
+
+    def coefficient(self, h: np.ndarray, speed: np.ndarray, du: np.ndarray) -> np.ndarray:
+        """``nu_e`` from the cell sizes, the signal speed ``s_e`` and the velocity jump ``du_e``."""
+        nu = h * (self.linear * speed + self.quadratic * np.maximum(0.0, -du))
+        return np.where(du < 0, nu, 0.0) if self.compression_only else nu
 
 
 @dataclass(frozen=True)
@@ -88,24 +110,15 @@ class EulerFEMResult:
 
 
 @dataclass(frozen=True, eq=False)
-class _Operators:
-    """Cell connectivity (``a``, ``b`` node of each cell), cell sizes, and the mass solves."""
+class _Operators(P1Cells):
+    """The P1 cells and the solves with the consistent mass."""
 
-    a: np.ndarray
-    b: np.ndarray
-    h: np.ndarray
-    n_nodes: int
-    mass: str
-    lumped: np.ndarray
     solve_free: object = None  # consistent M, for rho and E
     solve_wall: object = None  # consistent M with wall rows replaced by identity, for rho u
 
 
 def _operators(grid: Grid, mass: str) -> _Operators:
-    t = grid.mesh.t
-    x = grid.mesh.p[0]
-    a, b = t[0], t[1]
-    ops = dict(a=a, b=b, h=x[b] - x[a], n_nodes=grid.n_nodes, mass=mass, lumped=grid.lumped_mass)
+    ops = p1_cells(grid, mass)
     if mass == "consistent":
         M = grid.consistent_mass.tocsc()
         keep = np.ones(grid.n_nodes)
@@ -144,8 +157,7 @@ def residual(U: np.ndarray, ops: _Operators, gamma: float, visc: Viscosity) -> n
     c = np.sqrt(gamma * p / rho)
     speed = np.abs(u) + c
     a, b = ops.a, ops.b
-    s_e = np.maximum(speed[a], speed[b])
-    nu = ops.h * (visc.linear * s_e + visc.quadratic * np.maximum(0.0, u[a] - u[b]))
+    nu = visc.coefficient(ops.h, np.maximum(speed[a], speed[b]), u[b] - u[a])
     half_dF = 0.5 * (F[:, b] - F[:, a])
     diffusive = nu / ops.h * (U[:, b] - U[:, a])
     n = ops.n_nodes
@@ -180,15 +192,10 @@ def sod_initial_state(nodes: np.ndarray, gamma: float) -> np.ndarray:
     return UL[:, None] * weight + UR[:, None] * (1.0 - weight)
 
 
-def _validate(h, T, mass, cfl, gamma) -> None:
-    if mass not in MASS_KINDS:
-        raise ValueError(f"unknown mass {mass!r}: expected one of {MASS_KINDS}")
-    if not (np.isfinite(cfl) and 0.0 < cfl <= 1.0):
-        raise ValueError(f"cfl must lie in (0, 1], got cfl={cfl}")
-    if not (np.isfinite(T) and T > 0):
-        raise ValueError(f"final time T must be positive and finite, got T={T}")
-    if not (np.isfinite(gamma) and gamma > 1):
-        raise ValueError(f"gamma must be > 1, got gamma={gamma}")
+def label(mass: str = "lumped", viscosity: Viscosity = Viscosity()) -> str:
+    """The baseline's name with its variant, e.g. ``"FEM P1 lumped (compression-only viscosity)"``."""
+    check_mass(mass)
+    return f"FEM P1 {mass} ({viscosity.name})"
 
 
 def solve(
@@ -206,11 +213,10 @@ def solve(
     ``mass``) and :class:`PositivityError` naming the step and node if density or pressure
     stops being positive.
     """
-    _validate(h, T, mass, cfl, gamma)
-    try:
-        grid = uniform_grid(0.0, 1.0, h)
-    except GridError as err:
-        raise ValueError(str(err)) from err
+    check_settings(mass, T, cfl=cfl)
+    if not (np.isfinite(gamma) and gamma > 1):
+        raise ValueError(f"gamma must be > 1, got gamma={gamma}")
+    grid = mesh(0.0, 1.0, h)
     ops = _operators(grid, mass)
     U = sod_initial_state(grid.nodes, gamma)
     h_min = float(grid.h.min())
@@ -242,7 +248,9 @@ def solve(
         cfl=cfl,
         gamma=gamma,
         viscosity=asdict(viscosity),
-        viscosity_form="nu_e = h_e (linear max(|u|+c) + quadratic max(0, u_a - u_b)) on all of U",
+        viscosity_form="nu_e = h_e (linear max(|u|+c) + quadratic max(0, u_a - u_b)) on all of U"
+        + (", where u_b < u_a only" if viscosity.compression_only else ""),
+        viscosity_variant=viscosity.name,
         time_integrator="SSPRK3",
         dt_rule="cfl * h / max(|u| + c)",
         elements="P1",

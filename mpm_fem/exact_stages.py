@@ -13,6 +13,8 @@ error budget (E1) additive. With ``f*`` the exact field a stage should deliver:
                                         round-off for piecewise-polynomial fields)
     mass (FE + lumping, grid solve)     u_i = u*(x_i) + [solve(MPM data) - solve(exact data)]:
                                         the solve makes no error of its own on exact data
+                                        (exact data: the FE mass matrices of the exact density,
+                                        assembled by scikit-fem, :func:`fe_mass`)
     interpolation (grid -> particles)   f_p = f*(x_p) + sum_i S_ip (f_i - f*_i): the interpolant is
                                         exact for the exact field; the nodal error still reaches
                                         the particle
@@ -48,10 +50,13 @@ from functools import cached_property
 from typing import Protocol
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
+from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
 
 from .grid import Grid
 from .shape import Shape, grid_functions, make_shape
-from .transfer import nodal_internal_force, nodal_mass, nodal_momentum
+from .transfer import divide_by_lumped, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
 
 GAUSS_POINTS = 5  # exact for polynomials of degree 9 (Sod's fan: rho u S_i has degree 7)
 _XI, _W = np.polynomial.legendre.leggauss(GAUSS_POINTS)
@@ -79,47 +84,100 @@ class ExactFields(Protocol):
 
 @dataclass(frozen=True, eq=False)
 class GridData:
-    """What the projection hands the grid: the kernel and weights that define the mass matrix
-    ``M_ij = sum_q w_q S_iq S_jq`` (particles, or quadrature points), and ``m_i``, ``P_i``, ``F_i``."""
+    """What the projection hands the grid: the kernel and weights of the particles (or quadrature
+    points), and ``m_i``, ``P_i``, ``F_i``. The mass matrix is ``matrix`` where given (the FE mass
+    of exact data, :func:`fe_mass`), else the particle matrix ``M_ij = sum_q w_q S_iq S_jq``."""
 
     shape: Shape
     mass: np.ndarray
     m_i: np.ndarray
     P_i: np.ndarray
     F_i: np.ndarray | None = field(default=None)
+    matrix: sp.csr_matrix | None = field(default=None)
 
 
-def quadrature(grid: Grid, breakpoints=()) -> tuple[np.ndarray, np.ndarray]:
-    """Points and weights of the composite Gauss-Legendre rule on the grid's domain.
+def nodal_values(data: GridData, rhs: np.ndarray, kind: str) -> np.ndarray:
+    """Grid values from a projected right-hand side: ``rhs_i / m_i`` (``kind="lumped"``) or
+    ``M^{-1} rhs`` (``"consistent"``), with ``data``'s FE mass if it has one, else its particles'."""
+    if data.matrix is None:
+        return grid_values(data.shape, data.mass, data.m_i, rhs, kind)
+    if kind == "lumped":
+        return divide_by_lumped(rhs, data.m_i)
+    if kind == "consistent":
+        return spsolve(data.matrix.tocsc(), rhs)
+    raise ValueError(f"unknown mass kind {kind!r}; choose one of lumped, consistent")
 
-    The domain is split at every node, every cell midpoint (the knots of the quadratic
-    B-splines) and every breakpoint inside it; each piece gets ``GAUSS_POINTS`` points.
-    """
+
+def _pieces(grid: Grid, breakpoints=()) -> np.ndarray:
+    """Edges of the pieces of the domain: every node, every cell midpoint (the knots of the
+    quadratic B-splines) and every breakpoint inside it."""
     a, b = grid.domain
     cuts = [grid.nodes, 0.5 * (grid.nodes[:-1] + grid.nodes[1:])]
     inner = np.asarray(breakpoints, dtype=float)
     cuts.append(inner[(inner > a) & (inner < b)])
-    edges = np.unique(np.concatenate(cuts))
+    return np.unique(np.concatenate(cuts))
+
+
+def quadrature(grid: Grid, breakpoints=()) -> tuple[np.ndarray, np.ndarray]:
+    """Points and weights of the composite Gauss-Legendre rule on the grid's domain: ``GAUSS_POINTS``
+    points on each piece of :func:`_pieces` (split at nodes, half cells and breakpoints)."""
+    edges = _pieces(grid, breakpoints)
     left, width = edges[:-1], np.diff(edges)
     x = (left + 0.5 * width)[:, None] + 0.5 * width[:, None] * _XI
     w = 0.5 * width[:, None] * _W
     return x.ravel(), w.ravel()
 
 
-def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float) -> GridData:
+@BilinearForm
+def _density_mass(u, v, w):
+    """The mass form with the density as a field: ``rho u v``."""
+    return w["rho"] * u * v
+
+
+def fe_mass(grid: Grid, basis: str, fields: ExactFields, t: float, rho: np.ndarray | None = None
+            ) -> tuple[sp.csr_matrix, np.ndarray]:
+    """The FE mass matrices of the exact density, assembled by scikit-fem:
+
+        M_ij = int rho S_i S_j dx          (a BilinearForm ``rho u v``),      m_i = sum_j M_ij,
+
+    the lumped mass being the row sums (``= int rho S_i dx``: the grid functions sum to 1).
+    scikit-fem assembles the form on the pieces of :func:`quadrature` (a line mesh split at the
+    nodes, half cells and breakpoints, so the exact density is smooth on each), with
+    ``GAUSS_POINTS`` Gauss points per piece and ``rho`` evaluated there from the exact fields. On
+    each piece a grid function ``S_i`` (P1 hat, or quadratic B-spline for ``"bspline"``) is a
+    polynomial of the piece's element (P1, or P2), so ``S_i = sum_k S_i(y_k) phi_k`` over its
+    degrees of freedom ``y_k`` and ``M = E^T M_pieces E``, ``E_ki = S_i(y_k)``. ``rho``: the
+    density at the points of :func:`quadrature` (the same Gauss points, in the same order) if the
+    caller has it, else evaluated here.
+    """
+    functions = grid_functions(basis)
+    element = ElementLineP2() if functions == "bspline" else ElementLineP1()
+    pieces = Basis(MeshLine(_pieces(grid, fields.breakpoints(t))), element, intorder=2 * GAUSS_POINTS - 1)
+    if rho is None:
+        rho = fields.integrand(np.asarray(pieces.global_coordinates()[0]), t)[0]
+    rho = np.reshape(rho, (pieces.nelems, GAUSS_POINTS))
+    y = pieces.doflocs[0]
+    E = make_shape(grid, y, np.zeros_like(y), functions).matrix()
+    M = (E.T @ asm(_density_mass, pieces, rho=rho) @ E).tocsr()
+    return M, np.asarray(M.sum(axis=1)).ravel()
+
+
+def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float, with_fe_mass: bool = False) -> GridData:
     """``m_i = int rho S_i``, ``P_i = int rho v S_i``, ``F_i = -int sigma S_i'`` of the exact fields.
 
     The grid functions are the P1 hats for the point-mass and GIMP bases (GIMP averages the same
-    hats over the particle domain) and the quadratic B-splines for ``"bspline"`` and ``"bspline_gimp"``. The quadrature
-    points act as particles of mass ``w_q rho_q`` and volume ``w_q``, so the consistent mass of the
-    exact projection is ``int rho S_i S_j`` by the same code as the particle mass matrix.
+    hats over the particle domain) and the quadratic B-splines for ``"bspline"`` and ``"bspline_gimp"``.
+    The quadrature points act as particles of mass ``w_q rho_q`` and volume ``w_q``, so ``m_i`` and the consistent
+    mass ``int rho S_i S_j`` come from the same code as the particle mass matrix. ``with_fe_mass``
+    (the exact form of the mass stage): the mass matrices are instead the FE mass of
+    :func:`fe_mass`, assembled by scikit-fem, ``m_i`` its row sums (the same integrals).
     """
     x, w = quadrature(grid, fields.breakpoints(t))
     rho, v, sigma = fields.integrand(x, t)
     shape = make_shape(grid, x, w, grid_functions(basis))
     mass = w * rho
-    m_i = nodal_mass(shape, mass)
-    return GridData(shape, mass, m_i, nodal_momentum(shape, mass, v), nodal_internal_force(shape, w, sigma))
+    M, m_i = fe_mass(grid, basis, fields, t, rho) if with_fe_mass else (None, nodal_mass(shape, mass))
+    return GridData(shape, mass, m_i, nodal_momentum(shape, mass, v), nodal_internal_force(shape, w, sigma), M)
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,9 @@
 ``FieldWriter`` is an observer of :func:`mpm_fem.solve.run`: at every ``every``-th step it writes the
 particles (points with their state as point data) and the grid (P1 line cells with nodal mass,
 velocity and acceleration) to ``folder/particles_NNNNN.vtu`` and ``folder/grid_NNNNN.vtu``, and
-``close()`` writes ``particles.pvd`` and ``grid.pvd``, the time series ParaView opens.
+``close()`` adds the final frame at ``T`` and writes ``particles.pvd`` and ``grid.pvd``, the time
+series ParaView opens. The grid's final frame is the projection of the final particles: its mass
+and velocity; its acceleration is NaN, since no step is taken at ``T``.
 """
 
 from __future__ import annotations
@@ -62,10 +64,12 @@ class FieldWriter:
             self._write("particles", particle_mesh(old), t)
             self._write("grid", grid_mesh(self.grid, state), t)
 
-    def close(self, t_final: float, particles: Particles) -> None:
-        """Write the final particles (if not yet written) and the two ``.pvd`` series."""
+    def close(self, t_final: float, particles: Particles, nodal_mass: np.ndarray, nodal_velocity: np.ndarray) -> None:
+        """Write the final particles and grid (if not yet written) and the two ``.pvd`` series."""
         if not self.series["particles"] or self.series["particles"][-1][0] < t_final:
             self._write("particles", particle_mesh(particles), t_final)
+            state = GridState(nodal_mass, nodal_velocity, np.full_like(nodal_mass, np.nan), nodal_velocity)
+            self._write("grid", grid_mesh(self.grid, state), t_final)
         for kind, entries in self.series.items():
             lines = ['<?xml version="1.0"?>', '<VTKFile type="Collection" version="0.1">', "  <Collection>"]
             lines += [f'    <DataSet timestep="{t:.10g}" part="0" file={quoteattr(name)}/>' for t, name in entries]

@@ -3,9 +3,12 @@
 Notation (slides, "MPM Basis Overview"): nodes ``x_i``, cells ``I_i = [x_{i-1}, x_i]`` of size
 ``h_i``, P1 hat functions ``S_i(x)``. The consistent mass matrix is
 
-    M_ij = int rho S_i S_j dx          (rho = 1 here: a geometric mass, scaled by the caller)
+    M_ij = int rho S_i S_j dx          (rho = 1 here: the geometric mass)
 
-assembled with a scikit-fem ``BilinearForm``; the lumped mass is its row sum ``diag(M 1)``.
+assembled with a scikit-fem ``BilinearForm``; the lumped mass is its row sum ``diag(M 1)``. The
+fixed-mesh baselines solve with these; the MPM step solves with the particle mass
+(:mod:`mpm_fem.transfer`), and its exact FE + mass lumping stage with the same form weighted by
+the exact density (:func:`mpm_fem.exact_stages.fe_mass`).
 """
 
 from __future__ import annotations

@@ -19,9 +19,11 @@ import numpy as np  # noqa: E402
 
 
 def profiles(path, x_exact, exact: dict, x_particles, particles: dict, x_nodes=None, nodes: dict | None = None, title: str = ""):
-    """One panel per field: exact (line), particles (dots), grid nodes (crosses). Saves a PNG."""
+    """One panel per field: exact (line), particles (dots), grid nodes (crosses). Saves a PNG; the
+    layout is constrained, so the title (lines split by ``\\n``) fits above the panels."""
     names = list(exact)
-    fig, axes = plt.subplots(1, len(names), figsize=(4.2 * len(names), 3.6), squeeze=False)
+    fig, axes = plt.subplots(1, len(names), figsize=(max(4.2 * len(names), 6.0), 3.8), squeeze=False,
+                             layout="constrained")
     for ax, name in zip(axes[0], names):
         ax.plot(x_exact, exact[name], "k-", lw=1.2, label="exact")
         if name in particles:
@@ -33,7 +35,6 @@ def profiles(path, x_exact, exact: dict, x_particles, particles: dict, x_nodes=N
     axes[0][0].legend(fontsize=8)
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
 

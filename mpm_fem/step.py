@@ -24,7 +24,7 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from .exact_stages import ExactFields, GridData, exact_projection
+from .exact_stages import ExactFields, GridData, exact_projection, nodal_values
 from .grid import Grid
 from .particles import Particles
 from .reconstruction import RECONSTRUCTIONS, reconstructed_force
@@ -226,7 +226,8 @@ def _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exa
 
     The same pipeline as the plain step; at each stage the MPM value is replaced as follows.
     projection: ``m_i, P_i, F_i`` are the exact integrals. mass ``"exact"``: a nodal value is the
-    exact nodal value plus the projection error carried through the lumped solve. interpolation:
+    exact nodal value plus the projection error carried through the lumped solve (MPM data: the
+    particle mass; exact data: the FE mass assembled by scikit-fem). interpolation:
     ``f_p = f*(x_p) + sum_i S_ip (f_i - f*_i)`` for the particle acceleration, the velocity that
     moves the particle and the velocity gradient.
     """
@@ -236,18 +237,19 @@ def _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exa
     h_p = grid.h[shape.cell]
     m = particles.mass
     mpm = GridData(shape, m, nodal_mass(shape, m), nodal_momentum(shape, m, particles.velocity))
-    quad = exact_projection(grid, stages.basis, exact, t) if stages.projection == "exact" or stages.mass == "exact" else None
+    fe_mass_stage = stages.mass == "exact" and stages.projection == "mpm"  # solves exact data with the FE mass
+    quad = (exact_projection(grid, stages.basis, exact, t, with_fe_mass=fe_mass_stage)
+            if stages.projection == "exact" or stages.mass == "exact" else None)
     source = quad if stages.projection == "exact" else mpm
     kind = "lumped" if stages.mass == "exact" else stages.mass
     ref_v, _, ref_a = exact.reference(grid.nodes, t)
 
     def solve(rhs: np.ndarray, exact_rhs: np.ndarray | None, reference: np.ndarray) -> np.ndarray:
         if stages.mass != "exact":
-            return grid_values(source.shape, source.mass, source.m_i, rhs, kind)
+            return nodal_values(source, rhs, kind)
         if stages.projection == "exact":
             return reference.copy()
-        own = grid_values(mpm.shape, mpm.mass, mpm.m_i, rhs, kind)
-        return reference + own - grid_values(quad.shape, quad.mass, quad.m_i, exact_rhs, kind)
+        return reference + nodal_values(mpm, rhs, kind) - nodal_values(quad, exact_rhs, kind)
 
     P_exact = quad.P_i if quad is not None else None
     v_i = boundary.velocity(grid, solve(source.P_i, P_exact, ref_v), t)

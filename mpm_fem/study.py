@@ -1,5 +1,9 @@
 """What every study shares: where it writes, how it writes a table, and its run options.
 
+The run options are parsed here (:func:`add_study_options`, :func:`study_options`), for both
+``mpm-fem study <name>`` and ``python studies/<name>.py`` (:func:`script_main`): a study script
+never goes through the command line module.
+
 A study writes ``figures/<name>/<table>.csv`` (one row per measurement), a ``<table>.json`` with
 the exact settings and the package versions beside it, and its ``.png`` figures. The cache of
 finished cases lives in ``figures/<name>/.cache/`` (git-ignored).
@@ -7,13 +11,16 @@ finished cases lives in ``figures/<name>/.cache/`` (git-ignored).
 
 from __future__ import annotations
 
+import argparse
 import csv
-import sys
+import importlib
 import io
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from .output import versions, write_atomic, write_json
+from . import guard
+from .output import ensure_writable_dir, versions, write_atomic, write_json
 from .sweep import code_version, run_cases
 
 
@@ -82,8 +89,46 @@ def _fmt(value):
     return value
 
 
-def script_main(name: str, argv=None) -> int:
-    """Entry point of ``python studies/<name>.py``: the same options as ``mpm-fem study <name>``."""
-    from .cli import main
+def add_study_options(parser: argparse.ArgumentParser, quick_flag: bool = True, out_help: str | None = None) -> None:
+    """The options of a study run: ``--quick``, ``--jobs``, ``--scheduler``, ``--out``, ``--quiet``."""
+    if quick_flag:
+        parser.add_argument("--quick", action="store_true", help="the subset of meshes of the quick reproduction")
+    parser.add_argument("--jobs", type=int, default=None,
+                        help="worker processes, at most the number of cores (default: the cores, at most 8)")
+    parser.add_argument("--scheduler", default=None,
+                        help="address of a running Dask scheduler, tcp://HOST:PORT (checked with a 3 s connect)")
+    parser.add_argument("--out", default=None, help=out_help or "figures folder (default: figures, or figures/quick with --quick)")
+    parser.add_argument("--quiet", action="store_true", help="no progress output")
 
-    return main(["study", name, *(sys.argv[1:] if argv is None else argv)])
+
+def study_options(args: argparse.Namespace) -> StudyOptions:
+    """:class:`StudyOptions` from parsed options; bad input raises :class:`mpm_fem.guard.UsageError`."""
+    jobs = guard.cap_jobs(args.jobs)
+    scheduler = guard.check_scheduler(args.scheduler)
+    out = args.out or ("figures/quick" if args.quick else "figures")
+    try:
+        out = ensure_writable_dir(out)
+    except PermissionError as err:
+        raise guard.UsageError(str(err)) from None
+    return StudyOptions(quick=args.quick, jobs=jobs, scheduler=scheduler, out=out, progress=False if args.quiet else None)
+
+
+def run_study(name: str, options: StudyOptions) -> str:
+    """Run ``studies/<name>.py`` with ``options``; returns the line reporting where it wrote."""
+    importlib.import_module(f"studies.{name}").run(options)
+    return f"study {name} written to {options.folder(name)}"
+
+
+def script_main(name: str, argv=None) -> int:
+    """Entry point of ``python studies/<name>.py``: the same options, errors and exit statuses as
+    ``mpm-fem study <name>``."""
+    parser = guard.OneLineParser(prog=f"studies/{name}.py", description=f"Run the {name} study.")
+    add_study_options(parser)
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+
+    def command():
+        line = run_study(name, study_options(args))
+        if not args.quiet:
+            print(line)
+
+    return guard.exit_status(f"studies/{name}.py", command)

@@ -10,14 +10,21 @@ is interrupted resumes where it stopped and never reads a half-written result.
 Parallelism: ``jobs`` worker processes (``concurrent.futures``), or an existing Dask cluster when
 ``scheduler="tcp://HOST:PORT"`` is given (``dask.distributed``, the optional extra ``[dask]``).
 Progress: a ``tqdm`` bar on a terminal, plain lines otherwise (CI logs).
+
+Workers die with their parent: each worker ignores Ctrl-C (the parent handles it and ends them),
+asks Linux to kill it when its parent dies (``prctl(PR_SET_PDEATHSIG)``), and runs a watchdog
+thread that ends it within half a second once the parent process is gone (any platform).
 """
 
 from __future__ import annotations
 
+import ctypes
 import hashlib
 import json
 import os
+import signal
 import sys
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from functools import lru_cache
@@ -55,6 +62,43 @@ def _load(path: Path) -> dict | None:
         return json.loads(path.read_text())["result"]
     except (OSError, ValueError, KeyError):
         return None
+
+
+def _watch_parent(parent: int, interval: float = 0.5) -> None:
+    while os.getppid() == parent:
+        time.sleep(interval)
+    os._exit(1)  # the parent is gone: nobody waits for this worker's result
+
+
+def _worker_init(parent: int) -> None:
+    """Runs in each worker process before its first case: see the module docstring."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != parent:  # the parent died before prctl took effect
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True, name="watch-parent").start()
+
+
+def _run_pool(fn, cases, todo, jobs: int, finish) -> None:
+    """``fn`` over ``todo`` in ``jobs`` worker processes. If the parent is interrupted (Ctrl-C) or
+    fails, the workers are ended at once instead of finishing their cases."""
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),))
+    try:
+        futures = {pool.submit(fn, cases[k]): (k, path) for k, path in todo}
+        for future in as_completed(futures):
+            k, path = futures[future]
+            finish(k, path, future.result())
+    except BaseException:
+        workers = list(getattr(pool, "_processes", {}).values())  # no public handle on the workers
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in workers:
+            process.kill()
+        raise
+    pool.shutdown()
 
 
 def _default_jobs() -> int:
@@ -103,11 +147,7 @@ def run_cases(
             for k, path in todo:
                 finish(k, path, fn(cases[k]))
         else:
-            with ProcessPoolExecutor(max_workers=min(jobs, len(todo))) as pool:
-                futures = {pool.submit(fn, cases[k]): (k, path) for k, path in todo}
-                for future in as_completed(futures):
-                    k, path = futures[future]
-                    finish(k, path, future.result())
+            _run_pool(fn, cases, todo, min(jobs, len(todo)), finish)
     finally:
         reporter.close()
     return results  # type: ignore[return-value]
@@ -118,7 +158,12 @@ def _run_dask(fn, cases, todo, scheduler, finish) -> None:
         from dask.distributed import Client, as_completed as dask_completed
     except ImportError:
         raise RuntimeError("--scheduler needs dask.distributed: pip install 'mpm-fem[dask]'") from None
-    with Client(scheduler, timeout="30s") as client:
+    try:
+        client = Client(scheduler, timeout="10s")
+    except Exception as err:  # noqa: BLE001 -- one line, whatever the failure of the connection
+        raise RuntimeError(f"cannot connect to the Dask scheduler at {scheduler}: {err.__class__.__name__}: "
+                           f"{str(err).splitlines()[0] if str(err) else ''}") from None
+    with client:
         futures = {}
         for k, path in todo:
             futures[client.submit(fn, cases[k], pure=False, key=f"case-{k}-{time.time_ns()}")] = (k, path)

@@ -26,7 +26,7 @@ The wave (c) and the rarefaction (d) state their formulas in their classes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from typing import ClassVar
 
 import numpy as np
@@ -37,6 +37,11 @@ __all__ = ["Front", "ThreeExponential", "ColeHopfWave", "Rarefaction", "SOLUTION
 
 def _broadcast(x, t):
     return np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(t, dtype=float))
+
+
+def _above(default: float, bound: float, why: str):
+    """A parameter that must exceed ``bound`` (checked by ``_BurgersSolution.__post_init__``)."""
+    return field(default=default, metadata={"above": bound, "why": why})
 
 
 @dataclass(frozen=True)
@@ -51,25 +56,32 @@ class _BurgersSolution:
     def __post_init__(self):
         if not np.isfinite(self.eps) or self.eps <= 0.0:
             raise ValueError(f"{self.name}: the viscosity must satisfy eps > 0, got eps = {self.eps}")
+        for parameter in fields(self):
+            if "above" in parameter.metadata:
+                value, bound = getattr(self, parameter.name), parameter.metadata["above"]
+                if not value > bound:
+                    raise ValueError(f"{self.name}: {parameter.name} must be > {bound:g} "
+                                     f"{parameter.metadata['why']}, got {parameter.name} = {value}")
 
     def _fields(self, x, t):
+        """``(v, v_x, v_xx, v_t)`` at the arrays ``x``, ``t`` of one shape."""
         raise NotImplementedError
 
     def fields(self, x, t):
         """``(v, v_x, v_xx, v_t)`` at ``(x, t)`` from one evaluation."""
-        return self._fields(x, t)
+        return self._fields(*_broadcast(x, t))
 
     def v(self, x, t):
-        return self._fields(x, t)[0]
+        return self.fields(x, t)[0]
 
     def v_x(self, x, t):
-        return self._fields(x, t)[1]
+        return self.fields(x, t)[1]
 
     def v_xx(self, x, t):
-        return self._fields(x, t)[2]
+        return self.fields(x, t)[2]
 
     def v_t(self, x, t):
-        return self._fields(x, t)[3]
+        return self.fields(x, t)[3]
 
 
 def _exponential_mixture(x, t, eps, kappa, tau, c):
@@ -157,17 +169,11 @@ class ColeHopfWave(_BurgersSolution):
     sqrt(A^2 - 1)``, so the amplitude is proportional to eps.
     """
 
-    A: float = 2.0
+    A: float = _above(2.0, 1.0, "so that phi > 0")
 
     name: ClassVar[str] = "cole_hopf"
 
-    def __post_init__(self):
-        super().__post_init__()
-        if not self.A > 1.0:
-            raise ValueError(f"cole_hopf: A must be > 1 so that phi > 0, got A = {self.A}")
-
     def _fields(self, x, t):
-        x, t = _broadcast(x, t)
         eps, big_a, pi = self.eps, self.A, np.pi
         decay = np.exp(-(pi**2) * eps * t)
         sin, cos = np.sin(pi * x), np.cos(pi * x)
@@ -222,17 +228,11 @@ class Rarefaction(_BurgersSolution):
     u_left: float = 0.5
     u_right: float = 1.0
     x_step: float = 0.5
-    t0: float = 0.05
+    t0: float = _above(0.05, 0.0, "so that the data are smooth")
 
     name: ClassVar[str] = "rarefaction"
 
-    def __post_init__(self):
-        super().__post_init__()
-        if not self.t0 > 0.0:
-            raise ValueError(f"rarefaction: t0 must be > 0 so that the data are smooth, got t0 = {self.t0}")
-
     def _fields(self, x, t):
-        x, t = _broadcast(x, t)
         eps, u_l, u_r = self.eps, self.u_left, self.u_right
         du = u_r - u_l
         s = self.t0 + t

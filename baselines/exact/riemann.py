@@ -18,8 +18,16 @@ with the pressure function (4.6)-(4.7)
 
 and ``u_star = (u_L + u_R)/2 + (f_R(p_star) - f_L(p_star))/2`` (4.9). The root is found by Newton's
 method (4.44) from Toro's adaptive initial guess (section 9.5.1: PVRS, two-rarefaction or
-two-shock). Vacuum is generated when ``u_R - u_L >= 2 (a_L + a_R)/(gamma - 1)`` (4.40); this
-solver does not handle it and raises ``ValueError``.
+two-shock), unfloored: near vacuum both waves are rarefactions and the two-rarefaction guess (4.46)
+is the root itself. Newton stops on a relative change of ``p`` below ``1e-12``, or when ``f(p)``
+is at the round-off of its three terms (near vacuum ``p_star`` is tiny and ``f`` cancels).
+
+Vacuum is generated when ``u_R - u_L >= 2 (a_L + a_R)/(gamma - 1)`` (4.40, the pressure positivity
+condition). There is no star region then: :func:`sample` gives Toro's solution of section 4.6.3,
+a left rarefaction whose tail ``S*_L = u_L + 2 a_L/(gamma - 1)`` (4.76) meets vacuum, vacuum
+(``rho = p = 0``; the velocity is set to ``S``, continuous with both fans), and a right rarefaction
+from ``S*_R = u_R - 2 a_R/(gamma - 1)`` (4.79). :func:`star_state` and :func:`wave_positions`,
+which need a star region, raise ``ValueError`` for such data.
 
 The solution is self-similar in ``S = (x - x0)/t`` and is sampled as in Toro section 4.5. The
 right wave is the mirror image of a left wave (``x -> -x``, ``u -> -u``), so only the left wave is
@@ -30,8 +38,9 @@ from __future__ import annotations
 
 import numpy as np
 
-_NEWTON_RTOL = 1e-13
+_NEWTON_RTOL = 1e-12
 _NEWTON_MAXITER = 100
+_ROUND_OFF = 8.0 * np.finfo(float).eps
 
 
 def _checked_state(state, side: str) -> tuple[float, float, float]:
@@ -92,21 +101,34 @@ def _initial_guess(left, right, gamma: float) -> float:
     return float((g_l * p_l + g_r * p_r - (u_r - u_l)) / (g_l + g_r))
 
 
+def _vacuum_speeds(left, right, gamma: float) -> tuple[float, float] | None:
+    """``(S*_L, S*_R)`` of the vacuum front speeds, Toro (4.76) and (4.79), if the data generate
+    vacuum, Toro (4.40) (``u_R - u_L >= 2 (a_L + a_R)/(gamma - 1)``); otherwise ``None``."""
+    (rho_l, u_l, p_l), (rho_r, u_r, p_r) = left, right
+    a_l, a_r = _sound_speed(rho_l, p_l, gamma), _sound_speed(rho_r, p_r, gamma)
+    if u_r - u_l < 2.0 * (a_l + a_r) / (gamma - 1.0):
+        return None
+    return u_l + 2.0 * a_l / (gamma - 1.0), u_r - 2.0 * a_r / (gamma - 1.0)
+
+
 def _solve_star(left, right, gamma: float) -> tuple[float, float]:
     rho_l, u_l, p_l = left
     rho_r, u_r, p_r = right
-    a_l, a_r = _sound_speed(rho_l, p_l, gamma), _sound_speed(rho_r, p_r, gamma)
-    if u_r - u_l >= 2.0 * (a_l + a_r) / (gamma - 1.0):
+    if _vacuum_speeds(left, right, gamma) is not None:
+        a_l, a_r = _sound_speed(rho_l, p_l, gamma), _sound_speed(rho_r, p_r, gamma)
         raise ValueError(
             "the initial data generate vacuum: u_R - u_L = "
             f"{u_r - u_l:.6g} >= 2 (a_L + a_R)/(gamma - 1) = {2.0 * (a_l + a_r) / (gamma - 1.0):.6g} "
-            "(Toro (4.40)); this solver assumes a non-vacuum star region"
+            "(Toro (4.40)): there is no star region (sample() gives the vacuum solution)"
         )
-    p = max(_initial_guess(left, right, gamma), 1e-8 * min(p_l, p_r))
+    p = _initial_guess(left, right, gamma)
     for _ in range(_NEWTON_MAXITER):
         f_l, df_l = _pressure_function(p, rho_l, p_l, gamma)
         f_r, df_r = _pressure_function(p, rho_r, p_r, gamma)
-        p_new = p - (f_l + f_r + u_r - u_l) / (df_l + df_r)
+        residual = f_l + f_r + u_r - u_l
+        if abs(residual) <= _ROUND_OFF * (abs(f_l) + abs(f_r) + abs(u_r - u_l)):
+            break  # f(p) = 0 to round-off: a Newton step would only move p by noise
+        p_new = p - residual / (df_l + df_r)
         # f is increasing and concave: after an overshoot to p <= 0, iterates from the left of
         # the root rise monotonically to it, so stepping part-way towards zero is safe.
         if p_new <= 0.0:
@@ -126,7 +148,7 @@ def star_state(left, right, gamma: float = 1.4) -> tuple[float, float]:
     """Pressure and velocity ``(p_star, u_star)`` of the star region, Toro (4.5) and (4.9).
 
     ``left`` and ``right`` are ``(rho, u, p)``. Raises ``ValueError`` for non-positive density or
-    pressure, ``gamma <= 1``, or data that generate vacuum.
+    pressure, ``gamma <= 1``, or data that generate vacuum (no star region).
     """
     gamma = _checked_gamma(gamma)
     return _solve_star(_checked_state(left, "left"), _checked_state(right, "right"), gamma)
@@ -177,11 +199,24 @@ def _mirror(state):
     return rho, -u, p
 
 
+def _sample_vacuum(s, left, right, gamma: float, s_left: float, s_right: float):
+    """Toro section 4.6.3: the left fan up to ``S*_L``, vacuum, the right fan from ``S*_R``.
+
+    A rarefaction to vacuum is the fan of :func:`_sample_left_wave` with ``p_star = 0``: its tail
+    speed ``u_star - a_star`` is then ``S*_L`` (``a_star = 0``, ``u_star = S*_L``)."""
+    rho_l, u_l, p_l = _sample_left_wave(s, left, 0.0, s_left, gamma)
+    rho_r, u_r, p_r = _sample_left_wave(-s, _mirror(right), 0.0, -s_right, gamma)
+    regions = [s <= s_left, s >= s_right]
+    return (np.select(regions, [rho_l, rho_r], 0.0), np.select(regions, [u_l, -u_r], s),
+            np.select(regions, [p_l, p_r], 0.0))
+
+
 def sample(x, t: float, left, right, x0: float = 0.5, gamma: float = 1.4):
     """Exact solution ``(rho, u, p)`` of the Riemann problem at points ``x`` and time ``t``.
 
     Data ``left`` for ``x < x0`` and ``right`` for ``x > x0`` at ``t = 0``; the solution is the
-    self-similar sampling of Toro section 4.5 at ``S = (x - x0)/t``. At ``t == 0`` the initial data
+    self-similar sampling of Toro section 4.5 at ``S = (x - x0)/t`` (section 4.6.3 if the data
+    generate vacuum: ``rho = p = 0`` between the two fans). At ``t == 0`` the initial data
     are returned (``left`` for ``x < x0``, ``right`` for ``x >= x0``). ``x`` is any array; the three
     returned arrays have its shape. The domain is unbounded: no wall reflections.
     """
@@ -194,8 +229,11 @@ def sample(x, t: float, left, right, x0: float = 0.5, gamma: float = 1.4):
     if t == 0.0:
         is_left = x < x0
         return tuple(np.where(is_left, ql, qr) for ql, qr in zip(left, right))
-    p_star, u_star = _solve_star(left, right, gamma)
     s = (x - x0) / t
+    vacuum = _vacuum_speeds(left, right, gamma)
+    if vacuum is not None:
+        return _sample_vacuum(s, left, right, gamma, *vacuum)
+    p_star, u_star = _solve_star(left, right, gamma)
     rho_l, u_l, p_l = _sample_left_wave(s, left, p_star, u_star, gamma)
     rho_r, u_r, p_r = _sample_left_wave(-s, _mirror(right), p_star, -u_star, gamma)
     is_left = s <= u_star

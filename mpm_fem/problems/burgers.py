@@ -34,12 +34,17 @@ from ..models.burgers import ViscousBurgers
 from ..particles import Particles, make_particles, seed_positions
 from ..solve import Problem, Result, run
 from ..step import ACCELERATIONS, Dirichlet, Stages
-from . import burgers_fast, check_run_settings
+from . import Cost, burgers_fast, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
 
 
 WEIGHTS = ("volume", "cell")
 FORCES = ("weak", "slides")
 DT_RULES = ("stable", "advective")
+# The explicit step's stable CFL range: CFL 1 of min(h / max|v|, h^2 / (2 eps)) is the limit of
+# forward-Euler diffusion with lumped mass (h^2 / (2 eps)); with consistent mass and the calculated
+# acceleration the diffusion limit is a third of it (0.33 runs, 0.5 loses positivity, measured on
+# the default problem; the study's budget shows the failure at 0.5).
+CFL_LIMIT_CONSISTENT = 1.0 / 3.0
 
 
 @dataclass(frozen=True)
@@ -166,6 +171,46 @@ def simulate_general(settings: BurgersSettings = BurgersSettings(), progress: bo
         exact=exact_fields(settings),
     )
     return run(problem, grid, initial_particles(settings, grid), settings.stages, progress, observer)
+
+
+def check_stable(settings: BurgersSettings) -> None:
+    """Refuse a CFL number outside the stable range (``ValueError``): (0, 1], and (0, 1/3] with
+    consistent mass and the calculated acceleration."""
+    if settings.mass == "consistent" and settings.acceleration == "calculated":
+        check_stable_cfl(settings, CFL_LIMIT_CONSISTENT, "with consistent mass and the calculated acceleration")
+
+
+def cost(settings: BurgersSettings) -> Cost:
+    """The run's size from the settings alone: ``dt = CFL min(h / max|v|, h^2 / (2 eps))`` (no
+    viscous limit with dt rule "advective"), ``max|v|`` of the exact solution over the domain at
+    ``t = 0, T/2, T`` (1001 points each; Burgers obeys a maximum principle), times 1.25; the
+    particles fed in through the ends are not counted."""
+    solution = settings.exact
+    x = np.linspace(*solution.domain, 1001)
+    vmax = max(float(np.max(np.abs(solution.v(x, t)))) for t in (0.0, 0.5 * settings.T, settings.T))
+    cap = settings.h**2 / (2 * settings.eps) if settings.dt_rule == "stable" else np.inf
+    return run_cost(settings, solution.domain, 1.25 * vmax, cap)
+
+
+def conservation(settings: BurgersSettings, result: Result) -> dict:
+    """Mass ``sum V_p`` (unit density), momentum ``sum V_p v_p`` and energy ``sum V_p v_p^2 / 2``
+    the particles carry at ``t = 0`` and at ``T``, beside the exact solution's integrals over the
+    domain (trapezoidal rule on 4001 points). The ends are open (particles leave, the reservoir
+    feeds), so nothing is conserved: ``relative_change`` compares the particles' change with the
+    exact change."""
+    solution = settings.exact
+    start = totals(initial_particles(settings, uniform_grid(*solution.domain, settings.h)))
+    end = totals(result.particles)
+    x = np.linspace(*solution.domain, 4001)
+
+    def exact_totals(t):
+        v = solution.v(x, t)
+        return {"mass": float(x[-1] - x[0]), "momentum": float(np.trapezoid(v, x)), "energy": float(np.trapezoid(0.5 * v * v, x))}
+
+    exact0, exactT = exact_totals(0.0), exact_totals(result.t)
+    expected = {k: exactT[k] - exact0[k] for k in start}
+    return {"t0": start, "T": end, "exact_t0": exact0, "exact_T": exactT, "expected_change": expected,
+            "relative_change": {k: relative_change(start[k], end[k], expected[k]) for k in start}}
 
 
 def errors(settings: BurgersSettings, result: Result) -> dict:

@@ -1,0 +1,132 @@
+"""The FE + mass lumping stage's mass matrices, assembled by scikit-fem (mpm_fem.exact_stages.fe_mass),
+against the particle mass matrix on Gauss points, an exact matrix, and where the step uses them."""
+
+import numpy as np
+import pytest
+
+from mpm_fem import exact_stages
+from mpm_fem.exact_stages import RiemannFields, exact_projection, fe_mass, nodal_values, quadrature
+from mpm_fem.grid import uniform_grid
+from mpm_fem.models.euler import IdealGas
+from mpm_fem.problems import sod
+from mpm_fem.shape import make_shape
+from mpm_fem.step import Stages, Walls, explicit_step
+from mpm_fem.transfer import particle_mass_matrix
+
+SOD = ((1.0, 0.0, 1.0), (0.125, 0.0, 0.1))
+
+
+class Cubic:
+    """A smooth density ``1 + x + x^3`` with two breakpoints that cut cells (tests the splits)."""
+
+    def integrand(self, x, t):
+        return 1 + x + x**3, x, x
+
+    def breakpoints(self, t):
+        return np.array([0.3141, 0.777])
+
+
+FIELDS = {"sod at t = 0.13": (RiemannFields(*SOD, 0.5, 1.4, 0.01), 0.13), "cubic": (Cubic(), 0.0)}
+
+
+@pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline"])
+@pytest.mark.parametrize("case", FIELDS)
+def test_scikit_fem_mass_equals_the_particle_matrix_on_gauss_points(basis, case):
+    """Particles at the Gauss points of :func:`quadrature`, of mass ``w_q rho(x_q)``, give the
+    same ``M_ij = sum_q w_q rho_q S_iq S_jq`` as scikit-fem's ``rho u v`` form, to round-off."""
+    fields, t = FIELDS[case]
+    grid = uniform_grid(0.0, 1.0, 0.05)
+    M, m = fe_mass(grid, basis, fields, t)
+    x, w = quadrature(grid, fields.breakpoints(t))
+    kernel = "bspline" if basis == "bspline" else "mpm"
+    particles = particle_mass_matrix(make_shape(grid, x, w, kernel), w * fields.integrand(x, t)[0])
+    gap = np.abs((M - particles).toarray()).max()
+    assert gap < 1e-14 * np.abs(M).max(), f"largest difference {gap:.2e}"
+    np.testing.assert_allclose(m, np.asarray(M.sum(axis=1)).ravel(), rtol=1e-15)  # lumped = row sums
+
+
+def test_sod_lumped_mass_sums_to_the_exact_total_mass():
+    """``sum_i m_i = int rho dx``: the Sod tube holds 0.5625 at any time before the waves reach the walls."""
+    grid = uniform_grid(0.0, 1.0, 0.01)
+    for basis in ("mpm", "bspline"):
+        _, m = fe_mass(grid, basis, RiemannFields(*SOD, 0.5, 1.4, 0.005), 0.17)
+        assert m.sum() == pytest.approx(0.5625, rel=1e-14)
+
+
+def test_unit_density_gives_the_textbook_p1_mass_matrix():
+    """rho = 1: ``M = h/6 [2 1; 1 2]`` per cell, i.e. 2h/3 and h/6 inside, h/3 at the ends."""
+    h = 0.1
+    M, m = fe_mass(uniform_grid(0.0, 1.0, h), "mpm", exact_stages.SmoothBurgersFields(_Flat(), 0.1), 0.0)
+    A = M.toarray()
+    np.testing.assert_allclose(np.diag(A), [h / 3] + [2 * h / 3] * 9 + [h / 3], rtol=1e-14)
+    np.testing.assert_allclose(np.diag(A, 1), h / 6, rtol=1e-14)
+    assert np.abs(np.triu(A, 2)).max() == 0.0
+    np.testing.assert_allclose(m, [h / 2] + [h] * 9 + [h / 2], rtol=1e-14)
+
+
+class _Flat:
+    """A Burgers 'solution' v = 0 (only the unit density matters here)."""
+
+    def fields(self, x, t):
+        zero = np.zeros_like(np.asarray(x, dtype=float))
+        return zero, zero, zero, zero
+
+
+def _sod_step(stages):
+    settings = sod.SodSettings(h=0.05, ppc=4)
+    grid = uniform_grid(0.0, 1.0, settings.h)
+    particles = sod.initial_particles(settings, grid)
+    return explicit_step(grid, particles, IdealGas(), Walls(), 0.1, 1e-3, stages, exact=sod.exact_fields(settings))
+
+
+def test_only_the_exact_mass_stage_assembles_with_scikit_fem(monkeypatch):
+    """The MPM stages (lumped, consistent particle mass) and the exact projection never call
+    :func:`fe_mass`; the FE + mass lumping stage does, once a step, and its nodal values differ
+    from those with the Gauss-point sums by round-off only."""
+    calls = []
+    real = exact_stages.fe_mass
+
+    def spy(*args, **kwargs):
+        calls.append(args[1])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(exact_stages, "fe_mass", spy)
+    for stages in (Stages(), Stages(mass="consistent"), Stages(projection="exact"),
+                   Stages(projection="exact", mass="consistent"), Stages(projection="exact", mass="exact")):
+        _sod_step(stages)
+    assert calls == []
+    _, with_fe = _sod_step(Stages(mass="exact"))
+    assert calls == ["mpm"]
+
+    def gauss_sums(grid, basis, fields, t, rho=None):
+        x, w = quadrature(grid, fields.breakpoints(t))
+        M = particle_mass_matrix(make_shape(grid, x, w, "mpm"), w * fields.integrand(x, t)[0])
+        return M, np.asarray(M.sum(axis=1)).ravel()
+
+    monkeypatch.setattr(exact_stages, "fe_mass", gauss_sums)
+    _, with_sums = _sod_step(Stages(mass="exact"))
+    for name in ("velocity", "acceleration"):
+        a, b = getattr(with_fe, name), getattr(with_sums, name)
+        assert np.abs(a - b).max() < 1e-13 * np.abs(b).max(), name
+
+
+def test_exact_projection_mass_agrees_with_and_without_scikit_fem():
+    grid = uniform_grid(0.0, 1.0, 0.02)
+    fields = RiemannFields(*SOD, 0.5, 1.4, 0.01)
+    sums = exact_projection(grid, "bspline", fields, 0.1)
+    fe = exact_projection(grid, "bspline", fields, 0.1, with_fe_mass=True)
+    assert sums.matrix is None and fe.matrix is not None
+    np.testing.assert_allclose(fe.m_i, sums.m_i, rtol=1e-14)
+    np.testing.assert_array_equal(fe.P_i, sums.P_i)
+
+
+@pytest.mark.parametrize("kind", ["lumped", "consistent"])
+def test_solves_with_the_fe_mass_equal_those_with_the_gauss_point_particles(kind):
+    grid = uniform_grid(0.0, 1.0, 0.02)
+    fields = RiemannFields(*SOD, 0.5, 1.4, 0.01)
+    sums = exact_projection(grid, "mpm", fields, 0.1)
+    fe = exact_projection(grid, "mpm", fields, 0.1, with_fe_mass=True)
+    want = nodal_values(sums, sums.P_i, kind)
+    assert np.abs(nodal_values(fe, fe.P_i, kind) - want).max() < 1e-13 * np.abs(want).max()
+    with pytest.raises(ValueError, match="unknown mass kind"):
+        nodal_values(fe, fe.P_i, "diagonal")
