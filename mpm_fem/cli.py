@@ -124,7 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_settings_options(burgers, BurgersSettings, {"solution": tuple(SOLUTIONS), "weights": WEIGHTS, "force": FORCES,
                                                      "dt_rule": DT_RULES}, BURGERS_HELP)
 
-    from studies import STUDIES
+    from .study import STUDIES
 
     study = sub.add_parser("study", help="run one study: tables and figures into figures/<name>/ (figures/quick/<name>/ with --quick)",
                            description="Run one study of the error analysis; results are cached per case.")

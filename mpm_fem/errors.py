@@ -41,3 +41,11 @@ def orders_column(h, errors) -> list:
     if e.size < 2 or not np.all(e > 0):
         return [""] * e.size
     return [""] + [float(o) for o in observed_orders(h, e)]
+
+
+def orders_row(h, errors) -> dict:
+    """A row of an orders table: the least-squares order (``fitted``), the first and last observed
+    orders, the meshes (``h_range``) and the order between each pair (``order_<h1>_<h2>``)."""
+    o = observed_orders(h, errors)
+    return {"fitted": fitted_order(h, errors), "first": float(o[0]), "last": float(o[-1]), "h_range": f"{h[0]}-{h[-1]}",
+            **{f"order_{a}_{b}": float(x) for a, b, x in zip(h[:-1], h[1:], o)}}

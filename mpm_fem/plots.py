@@ -7,6 +7,7 @@ Figures that need more than a table holds (profiles) use :func:`profile_grid` an
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -106,25 +107,44 @@ def stacked_shares(path, rows: list[dict], names, title: str = "", ylabel: str =
     fig.tight_layout(rect=(0, 0, 0.89, 1))
     fig.savefig(path, dpi=110)
     plt.close(fig)
+    record_caption(path, title)
 
 
-def save(fig, path, title: str = "") -> None:
-    """Title, tight layout, PNG at the studies' resolution, and the figure closed."""
+def save(fig, path, title: str = "", caption: str = "") -> None:
+    """Title, tight layout, PNG at the studies' resolution, the figure closed, and its one-line
+    ``caption`` (the title when not given) recorded beside it (:func:`record_caption`)."""
     if title:
         fig.suptitle(title, fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+    if caption or title:
+        record_caption(path, caption or title)
+
+
+CAPTIONS = "figures.json"
+
+
+def record_caption(path, caption: str) -> None:
+    """Record ``caption`` for the figure ``path`` in ``figures.json`` beside it, which the report reads."""
+    path = Path(path)
+    index = path.parent / CAPTIONS
+    captions = json.loads(index.read_text()) if index.exists() else {}
+    captions[path.name] = caption
+    index.write_text(json.dumps(dict(sorted(captions.items())), indent=1) + "\n")
 
 
 def profile_grid(path, exact: dict, rows: dict, title: str = "") -> None:
-    """One column per field of ``exact = {field: (x, values)}`` (drawn as a black line in every row)
-    and one row per entry of ``rows = {row label: [(label, x, {field: values}, fmt, options)]}``; a
-    series draws only the fields it has."""
-    fig, axes = plt.subplots(len(rows), len(exact), figsize=(4 * len(exact), 3.2 * len(rows)), sharex=True,
+    """One column per field of ``exact = {field: (x, values)}`` (drawn as a black line in every row;
+    ``{row label: {field: (x, values)}}`` for an exact solution per row) and one row per entry of
+    ``rows = {row label: [(label, x, {field: values}, fmt, options)]}``; a series draws only the
+    fields it has."""
+    per_row = isinstance(next(iter(exact.values())), dict)
+    fields = next(iter(exact.values())) if per_row else exact
+    fig, axes = plt.subplots(len(rows), len(fields), figsize=(4 * len(fields), 3.2 * len(rows)), sharex=True,
                              squeeze=False)
     for axes_row, (row_label, series) in zip(axes, rows.items()):
-        for ax, (field, (xe, ye)) in zip(axes_row, exact.items()):
+        for ax, (field, (xe, ye)) in zip(axes_row, (exact[row_label] if per_row else exact).items()):
             ax.plot(xe, ye, "k-", lw=1.0, label="exact")
             ax.set_title(field, fontsize=9)
             for label, x, values, fmt, options in series:
@@ -141,22 +161,24 @@ def profile_grid(path, exact: dict, rows: dict, title: str = "") -> None:
 
 @dataclass(frozen=True)
 class Curve:
-    """Column ``y`` against the plot's ``x`` over the rows matching ``where``, in ``panel``; with
-    ``group`` (a column) one line per value of it, ``label`` formatted with ``{group}``. The
-    source's points are a curve of the source's column, drawn black and open (``fmt="k*"``)."""
+    """Column ``y`` against the plot's ``x`` over the rows matching ``where`` (a tuple value: any of
+    them), in ``panel``; with ``group`` (columns) one line per combination of their values, ``label``
+    formatted with them (``"h = {h}"``). The source's points are a curve of the source's column,
+    drawn black and open (``fmt="k*"``)."""
 
     label: str
     y: str
     fmt: str = "o-"
     where: dict = field(default_factory=dict)
     panel: str = ""
-    group: str = ""
+    group: tuple[str, ...] = ()
     options: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
 class Plot:
-    """A figure ``file`` with its one-line ``caption`` (also its title), drawn from ``table``."""
+    """A figure ``file`` with its one-line ``caption`` (also its title), drawn from ``table``; with
+    ``split`` (columns) one panel per combination of their values."""
 
     file: str
     caption: str
@@ -167,6 +189,8 @@ class Plot:
     ylabel: str = "error"
     slopes: tuple = ()
     size: tuple = (5.2, 4.0)
+    split: tuple[str, ...] = ()
+    ncols: int | None = None
 
 
 def _value(v) -> float:
@@ -177,7 +201,11 @@ def _value(v) -> float:
 
 
 def _matches(row: dict, where: dict) -> bool:
-    return all(str(row.get(k)) == str(v) or _value(row.get(k)) == _value(v) for k, v in where.items())
+    """Every column of ``where`` equals its value, or one of its values when that is a tuple."""
+    def same(value, wanted):
+        return str(value) == str(wanted) or _value(value) == _value(wanted)
+
+    return all(any(same(row.get(k), w) for w in (v if isinstance(v, tuple) else (v,))) for k, v in where.items())
 
 
 def draw(folder, plot: Plot, rows: list[dict]) -> None:
@@ -185,12 +213,14 @@ def draw(folder, plot: Plot, rows: list[dict]) -> None:
     content: dict = {}
     for c in plot.curves:
         sel = [r for r in rows if _matches(r, c.where)]
-        for g in dict.fromkeys(r.get(c.group) for r in sel) if c.group else (None,):
-            pts = sorted((_value(r[plot.x]), _value(r.get(c.y))) for r in sel if not c.group or r.get(c.group) == g)
+        for key in dict.fromkeys(tuple(r.get(k) for k in plot.split + c.group) for r in sel):
+            values = dict(zip(plot.split + c.group, key))
+            pts = sorted((_value(r[plot.x]), _value(r.get(c.y))) for r in sel if _matches(r, values))
             pts = [(x, y) for x, y in pts if math.isfinite(x) and math.isfinite(y) and y > 0]
             if pts:
-                label = c.label.format(group=g)
-                content.setdefault(c.panel or plot.caption, {})[label] = (
+                panel = ", ".join([c.panel] * bool(c.panel) + [f"{k} = {values[k]}" for k in plot.split]) or plot.caption
+                content.setdefault(panel, {})[c.label.format(**values)] = (
                     [x for x, _ in pts], [y for _, y in pts], c.fmt, {"mfc": "none", **c.options} if c.fmt[0] == "k" else c.options)
     panels(Path(folder) / plot.file, content, plot.xlabel, plot.ylabel, plot.caption if len(content) > 1 else "",
-           slopes=plot.slopes, size=plot.size, legends=len(content) > 1)
+           slopes=plot.slopes, size=plot.size, legends=len(content) > 1 and not plot.split, ncols=plot.ncols)
+    record_caption(Path(folder) / plot.file, plot.caption)

@@ -1,8 +1,8 @@
 """``REPORT.md``, rendered from the claims (:mod:`mpm_fem.claims`) and the tables, never typed.
 
-Each study describes its section as a :class:`Page`: a title, a caption in words, the views of its
-tables (a table, the rows and columns shown, the figure beside it) and its other figures with one-line
-captions. The report opens with a one-screen summary (claim, verdict, key number, link), then shows
+Each study's section is a :class:`~mpm_fem.pages.Page` (:data:`mpm_fem.pages.PAGES`): a title, a
+caption in words, and views of its tables (a table, the rows and columns shown, the figure beside
+it); the figures' one-line captions are those the study recorded when it drew them. The report opens with a one-screen summary (claim, verdict, key number, link), then shows
 every study's claims (verdict, evidence, the source's number, the thresholds) beside the tables and
 figures they rest on. Every number in it comes from the tables it was rendered from, so rendering the
 committed tables again gives the same bytes: ``python -m mpm_fem.report [--out figures]``.
@@ -11,43 +11,20 @@ committed tables again gives the same bytes: ``python -m mpm_fem.report [--out f
 from __future__ import annotations
 
 import argparse
-import importlib
+import json
 import math
 import sys
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from .claims import CLAIMS, STATEMENTS, Claim, claims_of, select
 from .output import write_atomic
+from .pages import PAGES, Page, View  # noqa: F401  (View: part of this module's interface)
+from .plots import CAPTIONS
 from .tables import Tables, load_tables
 
 TITLE = "# mpm-fem: where does the error of MPM come from?"
 #: Views longer than this are cut, with a pointer to the whole CSV.
 MAX_ROWS = 40
-
-
-@dataclass(frozen=True)
-class View:
-    """Rows of ``table`` (``"sod/convergence"``) matching ``where``, in ``columns`` (all when empty),
-    under ``caption``, with the ``figure`` (a file in the study's folder) shown above them."""
-
-    table: str
-    caption: str
-    columns: tuple[str, ...] = ()
-    where: dict = field(default_factory=dict)
-    figure: str = ""
-
-
-@dataclass(frozen=True)
-class Page:
-    """A study's section: ``name`` (its folder), ``title``, ``caption`` (words, no numbers), its
-    ``views`` and its other ``figures`` as ``(file, one-line caption)``."""
-
-    name: str
-    title: str
-    caption: str
-    views: tuple[View, ...] = ()
-    figures: tuple[tuple[str, str], ...] = ()
 
 
 # ----------------------------------------------------------------------------- Markdown
@@ -118,15 +95,25 @@ def claim_section(c: Claim, tables: Tables) -> list[str]:
     return lines + ([f"- Why: {c.explanation}", ""] if c.explanation else [""])
 
 
-def figure(page: str, file: str, caption: str) -> list[str]:
+def figure(page: str, file: str, captions: dict) -> list[str]:
+    caption = captions.get(file, file)
     return [f"![{caption}]({page}/{file})", "", f"*{caption}*", ""]
 
 
-def view_section(page: Page, v: View, tables: Tables) -> list[str]:
+def captions_of(folder: Path) -> dict[str, str]:
+    """``{file: one-line caption}`` of the figures in ``folder``: recorded by the study when it drew
+    them (``figures.json``), else the file name of every PNG."""
+    index = Path(folder) / CAPTIONS
+    if index.exists():
+        return json.loads(index.read_text())
+    return {p.name: p.name for p in sorted(Path(folder).glob("*.png"))}
+
+
+def view_section(page: Page, v: View, tables: Tables, captions: dict) -> list[str]:
     rows = select(tables.get(v.table, []), **v.where)
     lines = [f"#### {v.caption}", ""]
     if v.figure:
-        lines += figure(page.name, v.figure, v.caption)
+        lines += figure(page.name, v.figure, captions)
     if not rows:
         return lines + [f"No rows in `{v.table}.csv`.", ""]
     lines += markdown_table(rows[:MAX_ROWS], v.columns)
@@ -134,14 +121,16 @@ def view_section(page: Page, v: View, tables: Tables) -> list[str]:
     return lines + ([""] + ([f"{more} more rows in [{v.table}.csv]({v.table}.csv)."] if more > 0 else []) + [""])
 
 
-def page_section(page: Page, tables: Tables) -> list[str]:
+def page_section(page: Page, tables: Tables, captions: dict) -> list[str]:
     lines = [f'<a id="{page.name}"></a>', "", f"## {page.title}", "", page.caption, ""]
     for c in claims_of(page.name):
         lines += claim_section(c, tables)
     for v in page.views:
-        lines += view_section(page, v, tables)
-    for file, caption in page.figures:
-        lines += figure(page.name, file, caption)
+        lines += view_section(page, v, tables, captions)
+    shown = {v.figure for v in page.views}
+    for file in captions:
+        if file not in shown:
+            lines += figure(page.name, file, captions)
     own = sorted(t for t in tables if t.startswith(page.name + "/"))
     return lines + ["All tables, with their settings in the JSON beside each: "
                     + ", ".join(f"[{t.split('/')[1]}.csv]({t}.csv)" for t in own) + ".", ""]
@@ -154,8 +143,10 @@ def reproduction_section(tables: Tables) -> list[str]:
     return lines + markdown_table(tables.get("versions", []), ("table", "code", "quick")) + [""]
 
 
-def render(tables: Tables, pages: list[Page]) -> str:
-    """The whole report, from ``tables`` (:func:`mpm_fem.tables.load_tables`) and the study ``pages``."""
+def render(tables: Tables, pages, captions: dict[str, dict] | None = None) -> str:
+    """The whole report, from ``tables`` (:func:`mpm_fem.tables.load_tables`), the study ``pages`` and
+    the figure ``captions`` of each study folder (``{study: {file: caption}}``)."""
+    captions = captions or {}
     quick = is_quick(tables)
     head = [TITLE, "",
             f"Rendered by `python -m mpm_fem.report` from the tables of code version {code_version(tables)}, "
@@ -168,52 +159,72 @@ def render(tables: Tables, pages: list[Page]) -> str:
     lines = head + summary(tables) + [""]
     for page in pages:
         if any(t.startswith(page.name + "/") for t in tables):
-            lines += page_section(page, tables)
+            lines += page_section(page, tables, captions.get(page.name, {}))
     return "\n".join(lines + reproduction_section(tables))
 
 
 # ----------------------------------------------------------------------------- the command
 
 def study_pages(folder: Path) -> list[Page]:
-    """Every study's :class:`Page`, found by name (``studies.<name>.PAGE``): the studies are the top
-    layer and are loaded as plug-ins, never imported by this module. A study without a page gets its
-    figures listed under its folder name."""
-    studies = importlib.import_module("studies")
-    pages = []
-    for name in studies.STUDIES:
-        page = getattr(importlib.import_module(f"studies.{name}"), "PAGE", None)
-        if page is None:
-            pngs = sorted(p.name for p in (Path(folder) / name).glob("*.png"))
-            page = Page(name, name, "Tables and figures of this study.", figures=tuple((f, f) for f in pngs))
-        pages.append(page)
-    return pages
+    """The pages of :data:`mpm_fem.pages.PAGES`, then a plain page for every other study folder."""
+    named = {p.name for p in PAGES}
+    others = [Page(d.name, d.name, "Tables and figures of this study.") for d in sorted(Path(folder).iterdir())
+              if d.is_dir() and d.name not in named and any(d.glob("*.csv"))]
+    return list(PAGES) + others
 
 
 def write_report(out: Path, pages: list[Page] | None = None) -> Path:
-    """Render ``<out>/REPORT.md`` from the tables in ``out``; returns its path."""
+    """Render ``<out>/REPORT.md`` from the tables and figure captions in ``out``; returns its path."""
     out = Path(out)
+    pages = study_pages(out) if pages is None else pages
+    text = render(load_tables(out), pages, {p.name: captions_of(out / p.name) for p in pages})
     path = out / "REPORT.md"
-    write_atomic(path, render(load_tables(out), study_pages(out) if pages is None else pages) + "\n")
+    write_atomic(path, text + "\n")
     return path
 
 
 def reproduce(options) -> Path:
     """Run every study with ``options`` (:class:`mpm_fem.study.StudyOptions`), then write the report."""
-    studies = importlib.import_module("studies")
-    for name in studies.STUDIES:
-        importlib.import_module(f"studies.{name}").run(options)
+    from .study import STUDIES, run_study
+
+    for name in STUDIES:
+        run_study(name, options)
     return write_report(options.out)
+
+
+README_BEGIN = "<!-- results in brief: generated by `python -m mpm_fem.report --readme README.md` -->"
+README_END = "<!-- end of the results in brief -->"
+
+
+def results_in_brief(tables: Tables, report: str = "figures/REPORT.md") -> str:
+    """README's "Results in brief": the summary of the report, its links pointing into ``report``."""
+    return "\n".join([README_BEGIN, f"Verdicts computed from the committed tables (code version "
+                      f"{code_version(tables)}); each claim links to its section of `{report}`.", "",
+                      *summary(tables, report), README_END])
+
+
+def update_readme(readme: Path, tables: Tables) -> None:
+    """Replace the block between :data:`README_BEGIN` and :data:`README_END` of ``readme``."""
+    text = Path(readme).read_text()
+    if README_BEGIN not in text or README_END not in text:
+        raise ValueError(f"{readme} has no results block ({README_BEGIN} ... {README_END})")
+    head, rest = text.split(README_BEGIN, 1)
+    write_atomic(Path(readme), head + results_in_brief(tables) + rest.split(README_END, 1)[1])
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m mpm_fem.report",
                                      description="Render REPORT.md from the tables already written; runs nothing.")
     parser.add_argument("--out", type=Path, default=Path("figures"), help="the figures folder (default: figures)")
+    parser.add_argument("--readme", type=Path, help="also rewrite the results in brief of this README")
     args = parser.parse_args(argv)
-    if not (args.out / "REPORT.md").parent.is_dir():
+    if not args.out.is_dir():
         print(f"error: no folder {args.out}", file=sys.stderr)
         return 2
     print(f"report written to {write_report(args.out)}")
+    if args.readme:
+        update_readme(args.readme, load_tables(args.out))
+        print(f"results in brief written to {args.readme}")
     return 0
 
 

@@ -14,7 +14,7 @@ import numpy as np
 from baselines.exact import riemann
 
 from .errors import norms
-from .problems.sod import SodSettings
+from .problems.sod import SodSettings, conservation
 from .regions import by_region, head_shift, sod_regions
 
 
@@ -36,8 +36,9 @@ def _profile(values: dict) -> dict:
 
 def mpm(settings: SodSettings, result, errors: dict, extrema: dict, half_width: float, profiles: bool) -> dict:
     """An MPM run measured: norms over particles and nodes (``errors``, from the problem), the error
-    by region at both, the new extrema counted during the run, the particles' volume gain, the head
-    shift at the nodes and, when asked for, the profiles."""
+    by region at both, the new extrema counted during the run, the particles' volume gain, the
+    relative drift of the total energy (:func:`mpm_fem.problems.sod.conservation`), the head shift at
+    the nodes and, when asked for, the profiles."""
     P, g, t = result.particles, result.grid, result.t
     split = {"particles": measure(P.x, P.density, P.volume, t, half_width)[1],
              "nodes": measure(g.nodes, result.nodal_density, g.lumped_mass, t, half_width)[1]}
@@ -45,6 +46,7 @@ def mpm(settings: SodSettings, result, errors: dict, extrema: dict, half_width: 
            **{k: errors[k] for k in ("density", "velocity", "pressure")},
            "regions": {k: s["L1"] for k, s in split.items()}, "mean_error": {k: s["mean"] for k, s in split.items()},
            "extrema": extrema, "volume_drift": float(P.volume.sum() - 1.0),
+           "energy_drift": conservation(settings, result)["relative_change"]["energy"],
            "head_shift": head_shift(g.nodes, result.nodal_density, lambda x: exact_density(x, t))}
     if profiles:
         out["profile"] = _profile(dict(x=P.x, density=P.density, velocity=P.velocity, energy=P.energy,

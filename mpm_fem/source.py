@@ -18,22 +18,14 @@ SOD = {
 
 #: Burgers at T = 0.5 (slides, "Burgers' Problem(cont.)"): row -> eps -> errors on ``BURGERS_H``.
 BURGERS_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625)
-BURGERS = {
-    "exact": {
-        0.045: (2.67e-4, 1.24e-4, 6.07e-5, 3.03e-5, 1.52e-5),
-        0.04: (2.67e-4, 1.25e-4, 6.09e-5, 3.06e-5, 1.53e-5),
-        0.03: (2.78e-4, 1.27e-4, 6.19e-5, 3.09e-5, 1.55e-5),
-        0.02: (2.97e-4, 1.24e-4, 6.16e-5, 3.10e-5, 1.55e-5),
-        0.01: (5.34e-4, 1.58e-4, 6.18e-5, 3.10e-5, 1.55e-5),
-    },
-    "calculated": {
-        0.045: (9.82e-4, 5.39e-4, 2.84e-4, 1.42e-4, 7.09e-5),
-        0.04: (8.54e-4, 4.61e-4, 2.35e-4, 1.17e-4, 5.86e-5),
-        0.03: (5.97e-4, 3.20e-4, 1.61e-4, 8.05e-5, 4.03e-5),
-        0.02: (3.73e-4, 1.93e-4, 9.91e-5, 4.95e-5, 2.47e-5),
-        0.01: (4.12e-4, 1.51e-4, 6.52e-5, 3.20e-5, 1.60e-5),
-    },
+_BURGERS_ROWS = {  # eps: (exact acceleration, calculated acceleration), each on BURGERS_H
+    0.045: ((2.67e-4, 1.24e-4, 6.07e-5, 3.03e-5, 1.52e-5), (9.82e-4, 5.39e-4, 2.84e-4, 1.42e-4, 7.09e-5)),
+    0.04: ((2.67e-4, 1.25e-4, 6.09e-5, 3.06e-5, 1.53e-5), (8.54e-4, 4.61e-4, 2.35e-4, 1.17e-4, 5.86e-5)),
+    0.03: ((2.78e-4, 1.27e-4, 6.19e-5, 3.09e-5, 1.55e-5), (5.97e-4, 3.20e-4, 1.61e-4, 8.05e-5, 4.03e-5)),
+    0.02: ((2.97e-4, 1.24e-4, 6.16e-5, 3.10e-5, 1.55e-5), (3.73e-4, 1.93e-4, 9.91e-5, 4.95e-5, 2.47e-5)),
+    0.01: ((5.34e-4, 1.58e-4, 6.18e-5, 3.10e-5, 1.55e-5), (4.12e-4, 1.51e-4, 6.52e-5, 3.20e-5, 1.60e-5)),
 }
+BURGERS = {row: {eps: values[k] for eps, values in _BURGERS_ROWS.items()} for k, row in enumerate(("exact", "calculated"))}
 #: (row, eps, h) of the entries whose exponent the slide misprints; corrected by one power of ten
 #: to the sequence they belong to (``docs/claims.md``, "Corrections").
 BURGERS_CORRECTED = {("exact", e, 0.0025) for e in (0.04, 0.03, 0.02, 0.01)} | {
@@ -56,3 +48,11 @@ def band_text(quantity: str) -> str:
     if isinstance(band, str):
         return f"order of {band}"
     return f"{band[0]}" if band[0] == band[1] else f"[{band[0]}, {band[1]}]"
+
+
+def burgers_value(row: str | None, eps: float, h: float) -> float | None:
+    """The source's Burgers error of ``row`` (``"exact"``, ``"calculated"``) at ``eps`` and ``h``;
+    ``None`` where the table has no entry."""
+    if row is None or eps not in BURGERS[row] or h not in BURGERS_H:
+        return None
+    return BURGERS[row][eps][BURGERS_H.index(h)]

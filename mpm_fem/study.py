@@ -21,6 +21,7 @@ from pathlib import Path
 
 from . import guard
 from .output import ensure_writable_dir, versions, write_atomic, write_json
+from .tables import read_table  # noqa: F401  (re-exported: the studies' and tests' reader)
 from .sweep import code_version, run_cases
 
 
@@ -77,10 +78,18 @@ def write_table(folder: Path, table: str, rows: list[dict], settings: dict) -> P
     return path
 
 
-def read_table(path: Path) -> list[dict]:
-    """Rows of a CSV table written by :func:`write_table` (values as strings)."""
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+def publish(folder: Path, tables: dict[str, list[dict]], settings: dict, extra: dict | None = None, figures=()) -> None:
+    """Write every non-empty table of ``tables`` (``{name: rows}``) with ``settings`` (and the
+    ``extra`` settings of that table), then draw the ``figures`` (:class:`mpm_fem.plots.Plot`) whose
+    table was written."""
+    from . import plots
+
+    for name, rows in tables.items():
+        if rows:
+            write_table(folder, name, rows, {**settings, **(extra or {}).get(name, {})})
+    for plot in figures:
+        if tables.get(plot.table):
+            plots.draw(folder, plot, tables[plot.table])
 
 
 def _fmt(value):
@@ -111,6 +120,11 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
     except PermissionError as err:
         raise guard.UsageError(str(err)) from None
     return StudyOptions(quick=args.quick, jobs=jobs, scheduler=scheduler, out=out, progress=False if args.quiet else None)
+
+
+#: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
+#: layer and import it, never the other way round).
+STUDIES = ("projection", "sod", "burgers", "budget", "remedies")
 
 
 def run_study(name: str, options: StudyOptions) -> str:

@@ -29,8 +29,9 @@ from mpm_fem.errors import fitted_order, observed_orders
 from mpm_fem.grid import uniform_grid
 from mpm_fem.projection import QUANTITIES, Advection, cell_weights, layout, projection_errors, quadrature_checks, smooth_fields
 from mpm_fem.quadrature import cell_points, discrepancy_d2, estimate_c, expected_offset, offset_term
-from mpm_fem.claims import BAND_TOLERANCE, ORDERS
-from mpm_fem.report import Page, View
+from mpm_fem import plots
+from mpm_fem.claims import BAND_TOLERANCE
+from mpm_fem.plots import Curve, Plot
 from mpm_fem.source import D2_C, PROJECTION_BANDS, band_text
 from mpm_fem.study import StudyOptions, script_main, write_table
 
@@ -193,77 +194,29 @@ def run(options: StudyOptions) -> None:
 # ----------------------------------------------------------------------------- figures
 
 COLORS = {"regular": "tab:blue", "jittered": "tab:orange", "random": "tab:green", "advected": "tab:red"}
-TITLES = {"E_m": "mass E_m", "E_P": "momentum E_P", "E_F": "force E_F", "E_a": "acceleration E_a",
-          "E_a_pred": "E_a predicted: E_F/m - a E_m/m", "E_v": "velocity E_v", "E_v1": "E_v1 = v(x_i) - P_i/m_i",
-          "E_VG": "velocity gradient at particles", "E_VG_proj": "E_VG^i = (E_v^{i+1} - E_v^i)/h"}
 
-
-def _guides(ax, h, e, slopes=(1, 2)):
-    h = np.asarray(h)
-    for k in slopes:
-        ax.loglog(h, e * (h / h[0]) ** k, ":", color="gray", lw=0.9)
-        ax.annotate(f"slope {k}", (h[-1], e * (h[-1] / h[0]) ** k), fontsize=6, color="gray")
-
-
-def _panels(path, series_of, title):
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(3, 3, figsize=(12, 10.5))
-    for ax, q in zip(axes.ravel(), QUANTITIES):
-        top = 0.0
-        for label, (h, v, style, color) in series_of(q).items():
-            ax.loglog(h, v, style, color=color, label=label, ms=3.5, lw=1.1)
-            top = max(top, v[0])
-        if top > 0:
-            _guides(ax, h, top * 1.5)
-        ax.set_title(TITLES[q], fontsize=9)
-        ax.set_xlabel("h")
-        ax.set_ylabel("error (L1 over nodes)" if q != "E_VG" else "error (L1 over particles)")
-    axes[0][0].legend(fontsize=7)
-    fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+N_SHOW = 4  # the particle count of the per-layout figure (in every plan)
+_VARIANT = {("cell", "mpm"): ("", "o-"), ("volume", "mpm"): (", V_p weights", "s--"), ("volume", "gimp"): (", GIMP, V_p", "^:")}
+_PANELS = dict(split=("quantity",), ncols=3, slopes=(1, 2), ylabel="error (L1; E_VG over particles)", size=(4.0, 3.5))
+PLOTS = (
+    Plot("errors_vs_h.png", f"Projection errors against h, N_p = {N_SHOW} (mean over seeds): point mass with the slides' "
+         "weights h/N_p^i unless marked", "errors", "h", tuple(
+             Curve(lay + suffix, "value", fmt, {"layout": lay, "weights": w, "basis": b, "N_p": N_SHOW, "norm": "L1"},
+                   options={"color": COLORS[lay]})
+             for lay in LAYOUT_NAMES for (w, b), (suffix, fmt) in _VARIANT.items() if b == "mpm" or lay in ("advected", "random")),
+         **_PANELS),
+    Plot("errors_vs_h_random.png", "Projection errors against h, random layouts (mean over seeds), one line per N_p",
+         "errors", "h", (Curve("N_p = {N_p}", "value", "o-", {"layout": "random", "basis": "mpm", "norm": "L1"}, group=("N_p",)),),
+         **_PANELS),
+)
 
 
 def figures(folder: Path, t: dict, results: list) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    rows = [r for r in t["errors"] if r["norm"] == "L1"]
-    ppcs = sorted({r["N_p"] for r in rows})
-    n_show = 4 if 4 in ppcs else ppcs[len(ppcs) // 2]
-
-    def by_layout(q):
-        out = {}
-        for lay in LAYOUT_NAMES:
-            for (weights, basis), style in ((("cell", "mpm"), "o-"), (("volume", "mpm"), "s--"), (("volume", "gimp"), "^:")):
-                if basis == "gimp" and lay not in ("advected", "random"):
-                    continue
-                sel = [r for r in rows if r["quantity"] == q and r["layout"] == lay and r["weights"] == weights
-                       and r["basis"] == basis and r["N_p"] == n_show]
-                if sel:
-                    label = lay + {("cell", "mpm"): "", ("volume", "mpm"): ", V_p weights",
-                                   ("volume", "gimp"): ", GIMP, V_p"}[(weights, basis)]
-                    out[label] = ([r["h"] for r in sel], [r["value"] for r in sel], style, COLORS[lay])
-        return out
-
-    _panels(folder / "errors_vs_h.png", by_layout,
-            f"Projection errors vs h, N_p = {n_show} (mean over seeds): point mass with the slides' weights h/N_p^i "
-            "unless marked")
-    cmap = plt.get_cmap("viridis")
-
-    def by_ppc(q):
-        out = {}
-        for j, n in enumerate(ppcs):
-            sel = [r for r in rows if r["quantity"] == q and r["layout"] == "random" and r["N_p"] == n and r["basis"] == "mpm"]
-            out[f"N_p = {n}"] = ([r["h"] for r in sel], [r["value"] for r in sel], "o-", cmap(j / max(1, len(ppcs) - 1)))
-        return out
-
-    _panels(folder / "errors_vs_h_random.png", by_ppc, "Projection errors vs h, random layouts (mean over seeds)")
-
+    for plot in PLOTS:
+        plots.draw(folder, plot, t[plot.table])
+    ppcs, n_show = sorted({r["N_p"] for r in t["errors"]}), N_SHOW
     # D2 against N_p (finest mesh) and against h (N_p shown above)
     d2 = t["d2"]
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
@@ -292,9 +245,7 @@ def figures(folder: Path, t: dict, results: list) -> None:
     a2.set_ylabel(f"mean D2 over cells (N_p = {n_show})")
     a2.set_title("D2 vs h: scale-free, no h-dependence", fontsize=9)
     a2.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(folder / "d2.png", dpi=110)
-    plt.close(fig)
+    plots.save(fig, folder / "d2.png", caption="D2 against N_p and against h, beside the closed forms and the slides' formula")
 
     # measured quadrature error against Hickernell's bound
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
@@ -315,31 +266,7 @@ def figures(folder: Path, t: dict, results: list) -> None:
         ax.set_ylabel("|measured error|")
         ax.set_title(f"{labels[check]}\nsmallest bound/error = {smallest[check]:.3g}", fontsize=9)
         ax.legend(fontsize=7, markerscale=3)
-    fig.tight_layout()
-    fig.savefig(folder / "hickernell.png", dpi=110)
-    plt.close(fig)
-
-
-# ----------------------------------------------------------------------------- report page
-
-_SHOWN = {"norm": "L1", "weights": "cell", "basis": "mpm"}
-PAGE = Page(
-    NAME, "Projection and particle quadrature",
-    "Smooth fields on the unit interval are sampled by regular, jittered, random and advected particles; each "
-    "nodal projection of the slides is compared with the exact integral it stands in for, and Hickernell's "
-    "discrepancy and bound are measured on every cell. Orders are least-squares slopes over all meshes.",
-    views=(
-        View(ORDERS, "Least-squares L1 orders per layout at the middle particle count, point mass with the slides' "
-             "weights", ("quantity", "layout", "N_p", "order", "order_coarse", "order_fine", "band"),
-             {**_SHOWN, "N_p": 4}, "errors_vs_h.png"),
-        View(ORDERS, "The same with the volumes a run carries and with GIMP, advected particles",
-             ("quantity", "weights", "basis", "N_p", "order", "band"), {"layout": "advected", "norm": "L1", "N_p": 4,
-                                                                          "weights": "volume"}),
-        View("projection/d2_constant", "The C of the slides' D2 formula fitted per layout and N_p", (), {}, "d2.png"),
-    ),
-    figures=(("errors_vs_h_random.png", "Projection errors of random layouts against h, one line per N_p"),
-             ("hickernell.png", "Measured quadrature error against Hickernell's bound on every cell and node")),
-)
+    plots.save(fig, folder / "hickernell.png", caption="Measured quadrature error against Hickernell's bound on every cell and node")
 
 
 if __name__ == "__main__":

@@ -21,8 +21,7 @@ from mpm_fem.particles import PositivityError
 from mpm_fem.problems import sod
 from mpm_fem.regions import REGION_NAMES, ExtremaCounter, describe
 from mpm_fem.plots import Curve, Plot
-from mpm_fem.report import Page, View
-from mpm_fem.study import StudyOptions, script_main, write_table
+from mpm_fem.study import StudyOptions, publish, script_main
 
 NAME = "sod"
 H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)
@@ -30,8 +29,9 @@ SOURCE = source.SOD
 T = sod.SodSettings.T
 # One set of MPM settings for every h (never tuned per mesh); why these: ppc.csv and plateau.csv
 MPM = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", scheme="usl", basis="mpm", layout="regular", seed=0)
-FEM = dict(cfl=0.3, viscosity_linear=0.1, viscosity_quadratic=1.0)  # baselines.fem_euler defaults
-FV_CFL = 0.8  # baselines.fv_euler default
+# E3: FEM with the baselines.fem_euler defaults (viscosity on every cell); FV with the stronger of its limiters
+FEM = dict(cfl=0.3, viscosity_linear=0.1, viscosity_quadratic=1.0, compression_only=False)
+FV = dict(cfl=0.8, limiter="mc")
 REGION_HALF_WIDTH = 0.02  # every wave, every mesh: two cells of the coarsest mesh on each side
 PROFILE_H = (0.01, 0.0025)
 PPC = (1, 2, 4, 8, 16, 32)
@@ -50,11 +50,11 @@ def run_case(case: dict) -> dict:
     :data:`MPM` and ``h``), ``"fem"`` (``h``, ``mass`` and the keys of :data:`FEM`) or ``"fv"``."""
     h, width, profiles = case["h"], case.get("region_half_width"), case.get("profiles", False)
     if case["solver"] == "fv":
-        return shock_tube.fv(fv_euler.solve(h, cfl=case["cfl"]), h)
+        return shock_tube.fv(fv_euler.solve(h, cfl=case["cfl"], limiter=case["limiter"]), h)
     if case["solver"] == "fem":
         try:
             r = fem_euler.solve(h, mass=case["mass"], cfl=case["cfl"],
-                                viscosity=fem_euler.Viscosity(case["viscosity_linear"], case["viscosity_quadratic"]))
+                                viscosity=_viscosity(case))
         except fem_euler.PositivityError as err:
             return {"ok": False, "error": str(err)}
         return shock_tube.fem(r, uniform_grid(0.0, 1.0, h).lumped_mass, width, profiles)
@@ -65,6 +65,10 @@ def run_case(case: dict) -> dict:
     except (PositivityError, FloatingPointError) as err:
         return {"ok": False, "error": str(err), "steps": counter.steps}
     return shock_tube.mpm(settings, result, sod.errors(settings, result), counter.summary(), width, profiles)
+
+
+def _viscosity(fem: dict) -> fem_euler.Viscosity:
+    return fem_euler.Viscosity(fem["viscosity_linear"], fem["viscosity_quadratic"], fem["compression_only"])
 
 
 def mpm_case(h: float, **changes) -> dict:
@@ -94,7 +98,7 @@ def _plan(quick: bool) -> dict:
         "mpm_consistent": {h: mpm_case(h, mass="consistent") for h in consistent_h},
         "fem_consistent": {h: fem_case(h, "consistent") for h in hs},
         "fem_lumped": {h: fem_case(h, "lumped") for h in hs},
-        "fv": {h: {"solver": "fv", "h": h, "cfl": FV_CFL} for h in hs},
+        "fv": {h: {"solver": "fv", "h": h, **FV} for h in hs},
         "ppc": {(h, n): mpm_case(h, ppc=n) if n != MPM["ppc"] else mpm_case(h) for h in ppc_h for n in PPC},
         "plateau": {(h, name): mpm_case(h, **change) if change else mpm_case(h)
                     for h in plateau_h for name, change in PLATEAU_VARIANTS.items()},
@@ -105,17 +109,18 @@ def run(options: StudyOptions) -> None:
     """All cases in one sweep (shared ones run once), then tables and figures."""
     got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
     folder = options.folder(NAME)
-    settings = {"mpm": MPM, "fem": FEM, "fv": {"cfl": FV_CFL, "scheme": "MUSCL-Hancock + HLLC"}, "region_half_width": REGION_HALF_WIDTH, "T": T,
+    settings = {"mpm": MPM, "fem": {**FEM, "viscosity": _viscosity(FEM).name}, "fv": {**FV, "scheme": fv_euler.label(FV["limiter"])},
+                "region_half_width": REGION_HALF_WIDTH, "T": T,
                 "quick": options.quick, "problem": sod.SodSettings().as_dict()}
     tables = {"convergence": _convergence(got), "regions": _regions(got), "extrema": _extrema(got), "ppc": _ppc(got),
               "mass": _mass(got), "plateau": _plateau(got) if got["plateau"] else []}
     waves = riemann.wave_positions(T, sod.SodSettings.left, sod.SodSettings.right)
     extra = {"regions": {"regions": describe(REGION_HALF_WIDTH, waves, T)}, "extrema": {
         "rtol": 1e-9, "definition": "new strict local extremum among position-ordered particles"}}
-    for name, rows in tables.items():
-        if rows:
-            write_table(folder, name, rows, {**settings, **extra.get(name, {})})
-    _figures(folder, got, tables)
+    publish(folder, tables, settings, extra, PLOTS)
+    plots.stacked_shares(folder / "regions.png", tables["regions"], REGION_NAMES, f"C12: density L1 error by region of "
+                         f"the exact solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
+    _profiles(folder, got)
 
 
 def _L1(r, where="nodes", norm="L1"):
@@ -146,7 +151,7 @@ def _convergence(got) -> list[dict]:
             "mpm_volume_drift": r.get("volume_drift", ""), "mpm_head_shift": r.get("head_shift", ""),
             "fem_consistent_head_shift": got["fem_consistent"][h].get("head_shift", ""),
             "mpm_steps": r.get("steps"), "mpm_particles": r.get("particles"),
-            "mpm_wall_s": round(r.get("wall_s", float("nan")), 2)})
+            "mpm_wall_s": round(r.get("wall_s", float("nan")), 2), "mpm_energy_drift": r.get("energy_drift", "")})
         rows.append(row)
     return rows
 
@@ -226,7 +231,7 @@ PLOTS = (
     Plot("convergence.png", f"Sod, T = {T}: density L1 error against h, beside the source's table", "convergence", "h", (
         Curve("MPM, grid nodes", "mpm_nodes_L1"), Curve("MPM, particles", "mpm_particles_L1", "s-"),
         Curve("FEM consistent", "fem_consistent_L1", "^--"), Curve("FEM lumped", "fem_lumped_L1", "v--"),
-        Curve("FV (MUSCL-Hancock + HLLC)", "fv_L1", "x-."), Curve("source (slides)", "source_L1", "k*")),
+        Curve(fv_euler.label(FV["limiter"]), "fv_L1", "x-."), Curve("source (slides)", "source_L1", "k*")),
         ylabel="density error (L1)", slopes=(0.5, 1)),
     Plot("extrema.png", "C14: new extrema of particle density and energy, per step and per particle-step", "extrema", "h",
          tuple(Curve(n, f"{n}_new_per_step", f, panel="new extrema per step") for n, f in _STYLES.items())
@@ -235,18 +240,10 @@ PLOTS = (
                                                                ("elsewhere", "other particles", {"alpha": 0.5}))),
          ylabel="new extrema", size=(4.5, 3.6)),
     Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", "ppc", "ppc", tuple(
-        Curve("h = {group}", f"{w}_L1", panel=f"over {name}", group="h", where={"ok": True})
+        Curve("h = {h}", f"{w}_L1", panel=f"over {name}", group=("h",), where={"ok": True})
         for w, name in (("nodes", "grid nodes"), ("particles", "particles"))),
         xlabel="particles per cell N_p", ylabel="density error (L1)", size=(4.5, 3.6)),
 )
-
-
-def _figures(folder, got, t) -> None:
-    for plot in PLOTS:
-        plots.draw(folder, plot, t[plot.table])
-    plots.stacked_shares(folder / "regions.png", t["regions"], REGION_NAMES, f"C12: density L1 error by region of the exact "
-                         f"solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
-    _profiles(folder, got)
 
 
 def _profiles(folder, got) -> None:
@@ -266,33 +263,6 @@ def _profiles(folder, got) -> None:
                                                           ("MPM grid nodes", mp["nodes"], nodal, "x", {"ms": 3, "color": "tab:red"})],
             f"FEM (P1, SSPRK3, CFL {FEM['cfl']})": fem},
             f"Sod at T = {T}, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh")
-
-
-_CONVERGENCE = ("h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1",
-                "mpm_particles_L1", "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1", "order_fv_L1")
-PAGE = Page(
-    NAME, "Sod's shock tube",
-    "Density error at the final time against the exact Riemann solution, with one set of MPM settings for every "
-    "mesh (recorded in the JSON beside each table), over particles and over grid nodes, beside P1 FEM with "
-    "consistent and lumped mass and a finite-volume reference on the same mesh, and beside the source's table.",
-    views=(
-        View("sod/convergence", "Density L1 against h, beside the source", _CONVERGENCE, {}, "convergence.png"),
-        View("sod/convergence", "What sets the floor: volume gained by the particles, signed mean error in the "
-             "smooth region, position error of the rarefaction head", ("h", "mpm_volume_drift",
-             "mpm_particles_mean_error_smooth", "mpm_nodes_mean_error_smooth", "mpm_head_shift", "fem_consistent_head_shift")),
-        View("sod/regions", "Share of the L1 error by region of the exact solution",
-             ("method", "h", "L1") + tuple(f"share_{k}" for k in range(len(REGION_NAMES))), {}, "regions.png"),
-        View("sod/extrema", "New extrema per step, at cell crossings and elsewhere", ("h", "steps", "crossings_per_step",
-             "density_new_per_step", "density_rate_crossing", "density_rate_elsewhere", "density_rate_ratio",
-             "energy_new_per_step", "energy_rate_ratio"), {}, "extrema.png"),
-        View("sod/ppc", "Error against particles per cell", ("h", "ppc", "ok", "nodes_L1", "particles_L1"), {}, "ppc.png"),
-        View("sod/mass", "Lumped against consistent mass, MPM and FEM"),
-        View("sod/plateau", "What moves the floor: one setting changed at a time", ("h", "variant", "ok", "nodes_L1",
-             "nodes_vs_study", "particles_L1", "particles_vs_study", "density_new_extrema_per_step")),
-    ),
-    figures=tuple((f"profiles_h{h:g}.png", "Profiles against the exact solution, MPM above and FEM below, on the "
-                   "mesh named in the file") for h in PROFILE_H),
-)
 
 
 if __name__ == "__main__":

@@ -134,3 +134,12 @@ def test_e4_refutes_a_table_from_another_code_version():
     assert "sod/mass" in judge("E4", failing)[1]
     missing = {**TABLES, "versions": [r for r in TABLES["versions"] if r["table"] != "sod/mass"]}
     assert judge("E4", missing)[0] == "partly"
+
+
+def test_e3_names_the_fv_limiter_and_the_fem_viscosity_recorded_with_the_table():
+    settings = [{"table": "sod/convergence", "key": "fv.scheme", "value": "FV MUSCL-HLLC (MC)"},
+                {"table": "sod/convergence", "key": "fv.limiter", "value": "mc"},
+                {"table": "sod/convergence", "key": "fem.viscosity", "value": "viscosity everywhere"}]
+    evidence = judge("E3", {**TABLES, "settings": settings})[1]
+    assert "FV: FV MUSCL-HLLC (MC); FEM: viscosity everywhere" in evidence
+    assert "limiter not recorded" in judge("E3", {**TABLES, "settings": []})[1]

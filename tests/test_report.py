@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from mpm_fem.claims import STATEMENTS
-from mpm_fem.report import Page, View, cell, markdown_table, render, study_pages, write_report
+from mpm_fem.report import Page, View, captions_of, cell, markdown_table, render, study_pages, write_report
 from mpm_fem.tables import load_tables
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"
@@ -22,7 +22,8 @@ def committed():
 
 
 def test_the_committed_report_is_the_rendering_of_the_committed_tables(committed):
-    rendered = render(load_tables(FIGURES), study_pages(FIGURES)) + "\n"
+    pages = study_pages(FIGURES)
+    rendered = render(load_tables(FIGURES), pages, {p.name: captions_of(FIGURES / p.name) for p in pages}) + "\n"
     assert rendered == committed, "figures/REPORT.md differs from `python -m mpm_fem.report --out figures`"
 
 
@@ -62,10 +63,11 @@ def test_a_quick_report_links_only_to_its_own_folder(tmp_path):
     (tmp_path / "toy").mkdir()
     (tmp_path / "toy" / "t.csv").write_text("h,quick_value\n0.5,1.25\n0.25,|x|\n")
     (tmp_path / "toy" / "t.json").write_text('{"settings": {"quick": true}, "code": "abc"}')
+    (tmp_path / "toy" / "figures.json").write_text('{"t.png": "A toy figure"}')
     page = Page("toy", "Toy", "A toy study.", views=(View("toy/t", "The toy table", (), {}, "t.png"),))
     text = write_report(tmp_path, [page]).read_text()
     assert "reproduce --quick" in text and "code version abc" in text
-    assert "![The toy table](toy/t.png)" in text and "[t.csv](toy/t.csv)" in text
+    assert "![A toy figure](toy/t.png)" in text and "[t.csv](toy/t.csv)" in text
     assert "| 0.25 | \\|x\\| |" in text
     assert "not measured" in text
 
@@ -73,3 +75,18 @@ def test_a_quick_report_links_only_to_its_own_folder(tmp_path):
 def test_cells_keep_four_significant_digits_and_escape_pipes():
     assert [cell("0.0083452"), cell("16"), cell("nan"), cell("a|b")] == ["0.008345", "16", "", "a\\|b"]
     assert markdown_table([{"a": "1", "b": "x"}]) == ["| a | b |", "|---|---|", "| 1 | x |"]
+
+
+def test_readme_results_in_brief_are_generated_from_the_committed_tables():
+    from mpm_fem.report import README_BEGIN, README_END, results_in_brief
+
+    readme = (FIGURES.parent / "README.md").read_text()
+    block = README_BEGIN + readme.split(README_BEGIN, 1)[1].split(README_END, 1)[0] + README_END
+    assert block == results_in_brief(load_tables(FIGURES)), "run `python -m mpm_fem.report --readme README.md`"
+
+
+def test_the_command_refuses_a_missing_folder(tmp_path, capsys):
+    from mpm_fem.report import main
+
+    assert main(["--out", str(tmp_path / "absent")]) == 2
+    assert "no folder" in capsys.readouterr().err

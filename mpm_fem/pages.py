@@ -1,0 +1,109 @@
+"""What the report shows of each study: its title, a caption in words, and views of its tables.
+
+The report layer's knowledge of the studies, as data: each :class:`View` names a
+table written by a study, the rows and columns shown, and the figure shown above it. The figures and
+their one-line captions come from the studies themselves (``figures.json`` beside the PNGs, written
+when a study draws them). A study without a page here gets its claims, figures and table links.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .claims import BURGERS_SHOWN
+from .regions import REGION_NAMES
+from .source import BURGERS
+
+
+@dataclass(frozen=True)
+class View:
+    """Rows of ``table`` (``"sod/convergence"``) matching ``where``, in ``columns`` (all when empty),
+    under ``caption``, with the ``figure`` (a file in the study's folder) shown above them."""
+
+    table: str
+    caption: str
+    columns: tuple[str, ...] = ()
+    where: dict = field(default_factory=dict)
+    figure: str = ""
+
+
+@dataclass(frozen=True)
+class Page:
+    """A study's section: ``name`` (its folder), ``title``, ``caption`` (words, no numbers) and the
+    ``views`` of its tables."""
+
+    name: str
+    title: str
+    caption: str
+    views: tuple[View, ...] = ()
+
+
+_SOLUTION, _WHERE, _NORM = BURGERS_SHOWN["solution"], BURGERS_SHOWN["where"], BURGERS_SHOWN["norm"]
+_COMPARED = f"{_WHERE}_{_NORM}"
+_FIRST_EPS = max(BURGERS["exact"])
+
+PAGES = (
+    Page("projection", "Projection and particle quadrature",
+         "Smooth fields on the unit interval are sampled by regular, jittered, random and advected particles; each "
+         "nodal projection of the slides is compared with the exact integral it stands in for, and Hickernell's "
+         "discrepancy and bound are measured on every cell. Orders are least-squares slopes over all meshes.",
+         views=(
+             View("projection/orders", "Least-squares L1 orders per layout at the middle particle count, point mass "
+                  "with the slides' weights", ("quantity", "layout", "N_p", "order", "order_coarse", "order_fine", "band"),
+                  {"norm": "L1", "weights": "cell", "basis": "mpm", "N_p": 4}, "errors_vs_h.png"),
+             View("projection/orders", "The same with the volumes a run carries and with GIMP, advected particles",
+                  ("quantity", "weights", "basis", "N_p", "order", "band"),
+                  {"layout": "advected", "norm": "L1", "N_p": 4, "weights": "volume"}),
+             View("projection/d2_constant", "The C of the slides' D2 formula fitted per layout and N_p", (), {}, "d2.png"),
+         )),
+    Page("sod", "Sod's shock tube",
+         "Density error at the final time against the exact Riemann solution, with one set of MPM settings for every "
+         "mesh (recorded in the JSON beside each table), over particles and over grid nodes, beside P1 FEM with "
+         "consistent and lumped mass and a finite-volume reference on the same mesh, and beside the source's table.",
+         views=(
+             View("sod/convergence", "Density L1 against h, beside the source", (
+                 "h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1", "mpm_particles_L1",
+                 "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1", "order_fv_L1"), {}, "convergence.png"),
+             View("sod/convergence", "What sets the floor: volume gained by the particles, relative drift of the "
+                  "total energy, signed mean error in the smooth region, position error of the rarefaction head", (
+                      "h", "mpm_volume_drift", "mpm_energy_drift", "mpm_particles_mean_error_smooth",
+                      "mpm_nodes_mean_error_smooth", "mpm_head_shift", "fem_consistent_head_shift")),
+             View("sod/regions", "Share of the L1 error by region of the exact solution",
+                  ("method", "h", "L1") + tuple(f"share_{k}" for k in range(len(REGION_NAMES))), {}, "regions.png"),
+             View("sod/extrema", "New extrema per step, at cell crossings and elsewhere", (
+                 "h", "steps", "crossings_per_step", "density_new_per_step", "density_rate_crossing",
+                 "density_rate_elsewhere", "density_rate_ratio", "energy_new_per_step", "energy_rate_ratio"), {},
+                  "extrema.png"),
+             View("sod/ppc", "Error against particles per cell", ("h", "ppc", "ok", "nodes_L1", "particles_L1"), {},
+                  "ppc.png"),
+             View("sod/mass", "Lumped against consistent mass, MPM and FEM"),
+             View("sod/plateau", "What moves the floor: one setting changed at a time", (
+                 "h", "variant", "ok", "nodes_L1", "nodes_vs_study", "particles_L1", "particles_vs_study",
+                 "density_new_extrema_per_step")),
+         )),
+    Page("burgers", "Viscous Burgers",
+         "The viscous Burgers equation with initial and boundary data from an exact solution, MPM with the exact and "
+         "with the calculated acceleration beside P1 FEM with consistent and lumped mass, against the source's table "
+         "(the corrected entries are marked in the source_corrected column). The solution and norm compared with "
+         "the source are chosen by the norms table.",
+         views=(
+             View("burgers/orders", "Least-squares orders of the solution and norm compared with the source",
+                  ("method", "eps", "fitted", "first", "last", "h_range", "source_fitted"),
+                  {"solution": _SOLUTION, "where": _WHERE, "norm": _NORM}, "convergence.png"),
+             View("burgers/errors", "Errors on every mesh beside the source, largest eps", (
+                 "method", "h", _COMPARED, "source", "source_corrected", f"ratio_{_COMPARED}", "steps"),
+                  {"solution": _SOLUTION, "eps": _FIRST_EPS}),
+             View("burgers/norms", "Which solution and norm: median measured/source and spread over eps", (
+                 "solution", "method", "median_ratio", "eps_spread_finest", "source_eps_spread_finest"),
+                  {"where": _WHERE, "norm": _NORM}, "solutions.png"),
+             View("burgers/timestep", "Time error: the time step refined at one mesh", (
+                 "method", "eps", "refine", "dt", _COMPARED, f"time_error_{_NORM}", "time_below_space"), {},
+                  "timestep.png"),
+             View("burgers/ppc", "Error against particles per cell", ("method", "h", "ppc", _COMPARED, "best_ppc"), {},
+                  "ppc.png"),
+             View("burgers/lumping", "Lumped against consistent mass", ("method", "mass", "h", "where", "L1", "L2", "max"),
+                  {}, "lumping.png"),
+             View("burgers/diagnosis", "Why the calculated acceleration stalls: one change at a time",
+                  ("variant", "h", f"{_WHERE}_L1", "order_L1"), {}, "diagnosis.png"),
+         )),
+)
