@@ -22,7 +22,6 @@ the particle plateau of the study settings shows from h = 0.00125 on. Burgers h 
 
 from __future__ import annotations
 
-import inspect
 import sys
 import time
 from pathlib import Path
@@ -35,10 +34,10 @@ from mpm_fem.errors import norms
 from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
 from mpm_fem.problems import burgers, sod
-from mpm_fem.report import Page, View
+from mpm_fem.plots import Curve, Plot
 from mpm_fem.shock_tube import exact_density
-from mpm_fem.study import StudyOptions, script_main, write_table
-from studies.sod import FEM, FV_CFL, H, MPM as SOD_MPM
+from mpm_fem.study import StudyOptions, publish, script_main
+from studies.sod import FEM, FV, H, MPM as SOD_MPM
 
 NAME = "remedies"
 SOD_H = H[:4]
@@ -55,7 +54,6 @@ REMEDIES = {
 }
 QUICK = dict(SOD_H=SOD_H[:2], BURGERS_H=BURGERS_H[:2],
              REMEDIES=("MPM", "Taylor LS", "grid volume", "FLIP 0.99", "Taylor + volume"))
-FV_LIMITER = "mc" if "limiter" in inspect.signature(fv_euler.solve).parameters else None
 
 
 # ---------------------------------------------------------------- one case (runs in a worker)
@@ -67,11 +65,11 @@ def run_case(case: dict) -> dict:
     solver, h = case["solver"], case["h"]
     if solver in ("fem", "fv"):
         if solver == "fem":
-            r = fem_euler.solve(h, mass="lumped", cfl=FEM["cfl"],
-                                viscosity=fem_euler.Viscosity(FEM["viscosity_linear"], FEM["viscosity_quadratic"]))
+            r = fem_euler.solve(h, mass="lumped", cfl=FEM["cfl"], viscosity=fem_euler.Viscosity(
+                FEM["viscosity_linear"], FEM["viscosity_quadratic"], FEM["compression_only"]))
             x, w = r.nodes, uniform_grid(0.0, 1.0, h).lumped_mass
         else:
-            r = fv_euler.solve(h, cfl=FV_CFL, **({"limiter": FV_LIMITER} if FV_LIMITER else {}))
+            r = fv_euler.solve(h, cfl=FV["cfl"], limiter=FV["limiter"])
             x, w = r.centres, np.full(r.centres.size, h)
         e = norms(r.rho - exact_density(x, r.t), w)
         return {"ok": True, "nodes": e, "steps": r.steps, "work": r.steps * x.size, "wall_s": time.perf_counter() - start}
@@ -122,14 +120,11 @@ def run(options: StudyOptions) -> None:
     got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
     folder = options.folder(NAME)
     settings = {"sod": SOD_MPM, "burgers": BURGERS, "remedies": REMEDIES, "fem": {"mass": "lumped", **FEM},
-                "fv": {"cfl": FV_CFL, "limiter": FV_LIMITER or "default (MC not available)"},
+                "fv": FV,
                 "criterion": {"plateau_order": PLATEAU_ORDER}, "quick": options.quick}
-    rows = _errors(got)
-    write_table(folder, "errors", rows, settings)
-    write_table(folder, "orders", _summary(rows), settings)
-    cost = _cost_rows(got)
-    write_table(folder, "cost", cost, settings)
-    _figures(folder, rows, cost)
+    rows, cost = _errors(got), _cost_rows(got)
+    publish(folder, {"errors": rows, "orders": _summary(rows), "cost": cost}, settings, figures=PLOTS)
+    _cost_figure(folder, cost)
 
 
 def _l(result, where, norm):
@@ -184,33 +179,32 @@ def _cost_rows(got) -> list[dict]:
         rows.append({"method": "MPM" if name == "MPM" else f"MPM + {name}", "h": h, "density_L1": _l(r, "nodes", "L1"),
                      "particles_L1": _l(r, "particles", "L1"), "work": r.get("work", ""), "steps": r.get("steps", ""),
                      "wall_s": round(r.get("wall_s", float("nan")), 2)})
-    for method, label in (("fem", "FEM P1 lumped"), ("fv", "FV MUSCL-Hancock" + (" MC" if FV_LIMITER else ""))):
+    for method, label in (("fem", "FEM P1 lumped"), ("fv", fv_euler.label(FV["limiter"]))):
         for h, r in got[method].items():
             rows.append({"method": label, "h": h, "density_L1": _l(r, "nodes", "L1"), "particles_L1": "",
                          "work": r["work"], "steps": r["steps"], "wall_s": round(r["wall_s"], 2)})
     return rows
 
 
-def _figures(folder: Path, rows, cost) -> None:
-    from mpm_fem import plots  # noqa: F401  (selects the Agg backend)
-    import matplotlib.pyplot as plt
-    from matplotlib.ticker import NullFormatter
+_SOD, _FV = {"problem": "sod"}, {"problem": "sod", "remedy": "MPM"}
+PLOTS = (
+    Plot("errors.png", "E5: L1 error against h for each remedy; Sod density with the FV reference, Burgers velocity",
+         "errors", "h", (
+             Curve("{remedy}", "nodes_L1", where=_SOD, panel="Sod density, grid nodes", group=("remedy",)),
+             Curve("FV reference", "fv_L1", "k--", where=_FV, panel="Sod density, grid nodes"),
+             Curve("{remedy}", "particles_L1", where=_SOD, panel="Sod density, particles", group=("remedy",)),
+             Curve("FV reference", "fv_L1", "k--", where=_FV, panel="Sod density, particles"),
+             Curve("{remedy}", "particles_L1", where={"problem": "burgers"}, panel="Burgers velocity, particles",
+                   group=("remedy",))),
+         ylabel="L1 error", size=(4.6, 3.8), ncols=3),
+)
 
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
-    for ax, (problem, where) in zip(axes, (("sod", "nodes"), ("sod", "particles"), ("burgers", "particles"))):
-        for name in dict.fromkeys(r["remedy"] for r in rows if r["problem"] == problem):
-            s = [r for r in rows if r["problem"] == problem and r["remedy"] == name]
-            ax.loglog([r["h"] for r in s], [r[f"{where}_L1"] for r in s], "o-", ms=3, label=name)
-        if problem == "sod":
-            s = [r for r in rows if r["problem"] == "sod" and r["remedy"] == rows[0]["remedy"]]
-            ax.loglog([r["h"] for r in s], [r["fv_L1"] for r in s], "k--", label="FV reference")
-        ax.set(xlabel="h", ylabel=f"{'density' if problem == 'sod' else 'velocity'} L1 over {where}", title=f"{problem}, {where}")
-        ax.xaxis.set_minor_formatter(NullFormatter())
-    handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="center right", fontsize=7)
-    fig.tight_layout(rect=(0, 0, 0.84, 1))
-    fig.savefig(folder / "errors.png", dpi=120)
-    plt.close(fig)
+
+def _cost_figure(folder: Path, cost) -> None:
+    """Sod density L1 against work and against wall time, one line per method (``cost.png``)."""
+    from mpm_fem import plots
+    import matplotlib.pyplot as plt
+
     fig, axes = plt.subplots(1, 2, figsize=(13, 4.4))
     for method in dict.fromkeys(r["method"] for r in cost):
         s = sorted((r for r in cost if r["method"] == method), key=lambda r: -r["h"])
@@ -222,30 +216,8 @@ def _figures(folder: Path, rows, cost) -> None:
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="center right", fontsize=7)
     fig.tight_layout(rect=(0, 0, 0.78, 1))
-    fig.savefig(folder / "cost.png", dpi=120)
-    plt.close(fig)
-
-
-# ---------------------------------------------------------------- report
-
-_ORDERS = ("problem", "remedy", "min_order_nodes_L1", "min_order_particles_L1", "fitted_order_nodes_L1",
-           "fitted_order_particles_L1", "h_finest", "finest_nodes_L1", "finest_particles_L1", "max_fv_ratio_nodes_L1",
-           "max_fv_ratio_particles_L1", "removes_plateau")
-PAGE = Page(
-    NAME, "Remedies for the plateau (E5)",
-    "Sod (the Sod study's MPM settings) and Burgers (the few particles per cell at which its calculated acceleration "
-    "stalls; every setting in the JSON beside each table) with each remedy "
-    "alone and in combination: the B-spline averaged over the particle domain, the Taylor least-squares stress "
-    "reconstruction, the volume reset against the grid and a PIC/FLIP blend. Errors over grid nodes and over "
-    "particles; the accuracy per cost beside fixed-mesh FEM and a finite-volume reference.",
-    views=(
-        View("remedies/orders", "Each remedy by its lowest successive order and its error at the finest mesh",
-             _ORDERS, {}, "errors.png"),
-        View("remedies/cost", "Accuracy per cost: Sod density L1 against work (particle-, node- or cell-steps) and "
-             "wall time (one run each on a shared machine; no verdict uses it)",
-             ("method", "h", "density_L1", "particles_L1", "work", "wall_s"), {}, "cost.png"),
-    ),
-)
+    plots.save(fig, folder / "cost.png", caption="E5: Sod density L1 against work and against wall time, one point "
+               "per mesh, for MPM with each remedy, fixed-mesh FEM and the FV reference")
 
 
 if __name__ == "__main__":
