@@ -44,9 +44,10 @@ from ..transfer import solve_consistent
 
 def supports(settings) -> bool:
     """Whether this loop implements ``settings``: point mass, USL, MPM projection and interpolation,
-    lumped or consistent mass (the general :func:`mpm_fem.solve.run` does the rest)."""
+    lumped or consistent mass, no remedy (the general :func:`mpm_fem.solve.run` does the rest)."""
     return (settings.basis == "mpm" and settings.scheme == "usl" and settings.projection == "mpm"
-            and settings.interpolation == "mpm" and settings.mass in ("lumped", "consistent"))
+            and settings.interpolation == "mpm" and settings.mass in ("lumped", "consistent")
+            and not settings.stages.uses_remedy)
 
 
 def cells(x: np.ndarray, a: float, h: float, n_cells: int) -> tuple[np.ndarray, np.ndarray]:
