@@ -46,6 +46,7 @@ STATEMENTS = {
     "E2": "bases: point-mass P1 vs GIMP vs C1 B-spline",
     "E3": "MPM, fixed-mesh FEM and a finite-volume reference side by side on the same mesh",
     "E4": "one command regenerates every table from one code version",
+    "E5": "a remedy (particle-domain B-spline, stress reconstruction, volume reset, PIC/FLIP) removes the MPM plateau",
 }
 
 
@@ -614,3 +615,91 @@ def _e2(t: Tables) -> tuple[str, str]:
 
 
 # --- remedies: E5 ---
+
+REMEDY_ERRORS = "remedies/errors"
+PLATEAU_ORDER = 0.8  # a remedy removes the plateau: every successive order >= this, nodes and particles
+FV_FACTOR = 1.5  # goal on Sod: within this factor of the finite-volume error at every h
+BURGERS_ORDER = 1.0  # goal on Burgers (4 per cell): fitted order >= this, nodes and particles
+REMEDY_MEASURES = ("nodes_L1", "particles_L1")
+
+
+def successive_orders(rows: list[dict], key: str) -> list[float]:
+    """Observed orders between successive rows (sorted by decreasing ``h``); NaN where a run failed."""
+    h, e = [num(r, "h") for r in rows], [num(r, key) for r in rows]
+    out = []
+    for k in range(len(rows) - 1):
+        ok = e[k] > 0 and e[k + 1] > 0
+        out.append(math.log(e[k] / e[k + 1]) / math.log(h[k] / h[k + 1]) if ok else math.nan)
+    return out
+
+
+def remedy_assessment(rows: list[dict]) -> dict:
+    """What E5 asks of one remedy on one problem (rows of one series): per measure the lowest
+    successive order, the least-squares order and the largest ratio to ``fv_L1`` (when present)."""
+    rows = sorted(rows, key=lambda r: -num(r, "h"))
+    out = {}
+    for m in REMEDY_MEASURES:
+        o = successive_orders(rows, m)
+        out[f"min_order_{m}"] = min(o) if o and all(math.isfinite(x) for x in o) else math.nan
+        pts = [(math.log(num(r, "h")), math.log(num(r, m))) for r in rows if num(r, m) > 0]
+        if len(pts) >= 2:
+            mx, my = sum(p[0] for p in pts) / len(pts), sum(p[1] for p in pts) / len(pts)
+            out[f"fitted_order_{m}"] = (sum((x - mx) * (y - my) for x, y in pts) / sum((x - mx) ** 2 for x, _ in pts))
+        else:
+            out[f"fitted_order_{m}"] = math.nan
+        ratios = [num(r, m) / num(r, "fv_L1") for r in rows if num(r, "fv_L1") > 0]
+        out[f"max_fv_ratio_{m}"] = max(ratios) if len(ratios) == len(rows) and rows else math.nan
+    out["removes_plateau"] = all(out[f"min_order_{m}"] >= PLATEAU_ORDER for m in REMEDY_MEASURES)
+    return out
+
+
+def _series(rows: list[dict], problem: str) -> dict[str, list[dict]]:
+    out: dict[str, list[dict]] = {}
+    for r in select(rows, problem=problem):
+        out.setdefault(r["remedy"], []).append(r)
+    return out
+
+
+@claim("E5", source="the goal set for the remedies: an MPM variant whose Sod density error keeps converging on every "
+                    "mesh, over nodes and over particles, within 1.5x of the FV error at every h, and that converges at "
+                    "first order or better on Burgers with 4 particles per cell",
+       tables=(REMEDY_ERRORS,), study="remedies",
+       thresholds=f"a remedy removes the plateau when its observed orders over nodes and over particles stay >= "
+                  f"{PLATEAU_ORDER} between every pair of successive meshes; a remedy that removes it on Sod, stays "
+                  f"within {FV_FACTOR}x of the FV error at every h (nodes and particles) and on Burgers removes it with "
+                  f"fitted orders >= {BURGERS_ORDER} -> confirmed (named); one that only removes the Sod plateau -> "
+                  "partly; none -> refuted, naming the closest. Wall time enters no verdict",
+       explanation="The remedies attack the error sources the budget found: the particle-domain B-spline the "
+                   "force quadrature and the jump of the basis gradient at node crossings, the Taylor reconstruction "
+                   "the force quadrature, the volume reset the volume drift, the PIC/FLIP blend the noise carried "
+                   "by the particle velocities.")
+def _e5(t: Tables) -> tuple[str, str]:
+    rows = t[REMEDY_ERRORS]
+    sod = {k: v for k, v in _series(rows, "sod").items() if len(v) >= 2}
+    burgers = _series(rows, "burgers")
+    if not sod:
+        return "not measured", "no remedy was run on two Sod meshes or more"
+    scored = []
+    for name, series in sod.items():
+        s = remedy_assessment(series)
+        fv = all(s[f"max_fv_ratio_{m}"] <= FV_FACTOR for m in REMEDY_MEASURES)
+        b = remedy_assessment(burgers[name]) if len(burgers.get(name, [])) >= 2 else None
+        b_ok = b is not None and b["removes_plateau"] and all(b[f"fitted_order_{m}"] >= BURGERS_ORDER
+                                                              for m in REMEDY_MEASURES)
+        lowest = min(s[f"min_order_{m}"] for m in REMEDY_MEASURES)
+        scored.append(((s["removes_plateau"] + fv + b_ok, lowest if math.isfinite(lowest) else -math.inf),
+                       name, s, fv, b, b_ok))
+    scored.sort(key=lambda x: x[0], reverse=True)
+    _, name, s, fv, b, b_ok = scored[0]
+    hs = sorted({num(r, "h") for v in sod.values() for r in v}, reverse=True)
+    text = (f"{name}: lowest Sod order {s['min_order_nodes_L1']:.2f} (nodes) / {s['min_order_particles_L1']:.2f} "
+            f"(particles) over h = {hs[0]:g}..{hs[-1]:g}, at most {s['max_fv_ratio_nodes_L1']:.2f}x / "
+            f"{s['max_fv_ratio_particles_L1']:.2f}x the FV error")
+    text += (f"; Burgers (4 per cell) fitted orders {b['fitted_order_nodes_L1']:.2f} / {b['fitted_order_particles_L1']:.2f}, "
+             f"lowest successive {min(b['min_order_nodes_L1'], b['min_order_particles_L1']):.2f}" if b else "; Burgers not run")
+    removers = [n for _, n, sc, *_ in scored if sc["removes_plateau"]]
+    if s["removes_plateau"] and fv and b_ok:
+        return "confirmed", "meets the goal: " + text
+    if removers:
+        return "partly", text + f"; the Sod plateau is removed by {', '.join(removers)}"
+    return "refuted", f"closest: {text}; no remedy keeps the order >= {PLATEAU_ORDER} on every Sod mesh"

@@ -28,9 +28,18 @@ from .particles import LAYOUTS
 from .shape import BASES
 from .step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, SCHEMES, STAGE_MASS
 from .study import add_study_options, run_study, study_options
+from .reconstruction import RECONSTRUCTIONS
+from .volume import VOLUMES
 
 CHOICES = {"mass": STAGE_MASS, "basis": BASES, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
-           "projection": PROJECTIONS, "interpolation": INTERPOLATIONS, "kernel": ("fused", "numpy")}
+           "projection": PROJECTIONS, "interpolation": INTERPOLATIONS}
+# --- remedies (E5): --flip ALPHA, --reconstruct none|taylor, --volume carried|grid, --basis bspline_gimp
+CHOICES.update({"reconstruct": RECONSTRUCTIONS, "volume": VOLUMES, "kernel": ("fused", "numpy")})
+REMEDY_HELP = {
+    "flip": "PIC/FLIP blend alpha in [0, 1]: 1 FLIP (standard), 0 PIC",
+    "reconstruct": "stress before the force integral: none (particle sum) or taylor (per-cell least-squares line)",
+    "volume": "particle volumes: carried by the flow, or grid (reset to tile the grid every step)",
+}
 HELP = {
     "h": "cell size (must divide the domain)",
     "ppc": "particles per cell N_p",
@@ -47,7 +56,8 @@ HELP = {
     "refine": "time stage: the time step divided by this integer",
     "kernel": "step implementation: compiled fused passes, or the numpy reference step",
     "threads": "threads of the fused step (deterministic; equal to one thread to round-off)",
-    "basis": "particle basis: point mass (mpm), particle domain (gimp) or quadratic B-spline (bspline)",
+    "basis": "particle basis: point mass (mpm), particle domain (gimp), quadratic B-spline (bspline) or the "
+             "B-spline averaged over the particle domain (bspline_gimp)",
     "scheme": "stress update order",
     "layout": "initial particle layout in each cell",
     "seed": "random seed (integer >= 0) of jittered/random layouts",
@@ -64,6 +74,7 @@ BURGERS_HELP = {
     "cfl": "CFL number: dt = CFL min(h/max|v|, h^2/(2 eps)); stable range (0, 1], (0, 1/3] with consistent mass and the "
            "calculated acceleration",
 }
+HELP.update(REMEDY_HELP)
 
 
 def _add_settings_options(parser: argparse.ArgumentParser, settings_cls, extra_choices=None, extra_help=None) -> None:

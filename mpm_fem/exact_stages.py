@@ -55,7 +55,7 @@ from scipy.sparse.linalg import spsolve
 from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
 
 from .grid import Grid
-from .shape import Shape, make_shape
+from .shape import Shape, grid_functions, make_shape
 from .transfer import divide_by_lumped, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
 
 GAUSS_POINTS = 5  # exact for polynomials of degree 9 (Sod's fan: rho u S_i has degree 7)
@@ -150,13 +150,14 @@ def fe_mass(grid: Grid, basis: str, fields: ExactFields, t: float, rho: np.ndarr
     density at the points of :func:`quadrature` (the same Gauss points, in the same order) if the
     caller has it, else evaluated here.
     """
-    element = ElementLineP2() if basis == "bspline" else ElementLineP1()
+    functions = grid_functions(basis)
+    element = ElementLineP2() if functions == "bspline" else ElementLineP1()
     pieces = Basis(MeshLine(_pieces(grid, fields.breakpoints(t))), element, intorder=2 * GAUSS_POINTS - 1)
     if rho is None:
         rho = fields.integrand(np.asarray(pieces.global_coordinates()[0]), t)[0]
     rho = np.reshape(rho, (pieces.nelems, GAUSS_POINTS))
     y = pieces.doflocs[0]
-    E = make_shape(grid, y, np.zeros_like(y), "bspline" if basis == "bspline" else "mpm").matrix()
+    E = make_shape(grid, y, np.zeros_like(y), functions).matrix()
     M = (E.T @ asm(_density_mass, pieces, rho=rho) @ E).tocsr()
     return M, np.asarray(M.sum(axis=1)).ravel()
 
@@ -165,15 +166,15 @@ def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float, with
     """``m_i = int rho S_i``, ``P_i = int rho v S_i``, ``F_i = -int sigma S_i'`` of the exact fields.
 
     The grid functions are the P1 hats for the point-mass and GIMP bases (GIMP averages the same
-    hats over the particle domain) and the quadratic B-splines for ``"bspline"``. The quadrature
-    points act as particles of mass ``w_q rho_q`` and volume ``w_q``, so ``m_i`` and the consistent
+    hats over the particle domain) and the quadratic B-splines for ``"bspline"`` and ``"bspline_gimp"``.
+    The quadrature points act as particles of mass ``w_q rho_q`` and volume ``w_q``, so ``m_i`` and the consistent
     mass ``int rho S_i S_j`` come from the same code as the particle mass matrix. ``with_fe_mass``
     (the exact form of the mass stage): the mass matrices are instead the FE mass of
     :func:`fe_mass`, assembled by scikit-fem, ``m_i`` its row sums (the same integrals).
     """
     x, w = quadrature(grid, fields.breakpoints(t))
     rho, v, sigma = fields.integrand(x, t)
-    shape = make_shape(grid, x, w, "bspline" if basis == "bspline" else "mpm")
+    shape = make_shape(grid, x, w, grid_functions(basis))
     mass = w * rho
     M, m_i = fe_mass(grid, basis, fields, t, rho) if with_fe_mass else (None, nodal_mass(shape, mass))
     return GridData(shape, mass, m_i, nodal_momentum(shape, mass, v), nodal_internal_force(shape, w, sigma), M)

@@ -24,8 +24,8 @@ it equals the one-thread step to round-off, not bit for bit.
 
 Supported: the three bases (``"mpm"``, ``"gimp"``, ``"bspline"``), USL, USF, MUSL, lumped and
 consistent mass, calculated or exact acceleration, the ideal gas and viscous Burgers (both its
-forces). Stages with an exact projection, mass or interpolation run the numpy step
-(:func:`supported` says which), as does any ``kernel="numpy"`` run.
+forces). Stages with an exact projection, mass or interpolation, or a plateau remedy, run the
+numpy step (:func:`supported` says which), as does any ``kernel="numpy"`` run.
 """
 
 from __future__ import annotations
@@ -39,19 +39,21 @@ from .grid import Grid
 from .models.burgers import ViscousBurgers
 from .models.euler import IdealGas
 from .particles import Particles, PositivityError
-from .shape import BASES, Shape, make_shape
+from .shape import Shape, make_shape
 from .step import SCHEMES, GridState, Stages
 from .transfer import divide_by_lumped, solve_consistent
 
 KERNELS = ("fused", "numpy")
 GAS, BURGERS = 0, 1
-_BASIS_CODE = {name: k for k, name in enumerate(BASES)}  # mpm 0, gimp 1, bspline 2
+_BASIS_CODE = {"mpm": 0, "gimp": 1, "bspline": 2}
 
 
 def supported(model, stages: Stages) -> str | None:
     """``None`` if the fused step implements this model and these stages, else the reason."""
     if stages.uses_exact_fields:
         return "the exact projection, mass and interpolation stages run the numpy step"
+    if stages.uses_remedy:
+        return "the plateau remedies (flip, reconstruct, volume, bspline_gimp) run the numpy step"
     if not isinstance(model, (IdealGas, ViscousBurgers)):
         return f"the fused step has no kernel for the model {type(model).__name__}"
     return None

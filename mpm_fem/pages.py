@@ -140,4 +140,20 @@ PAGES = (
                   ("basis", "acceleration", "crossings", "median_ratio", "max_ratio_error", "max_abs_ratio",
                    "median_abs_measured"), {}, "crossing.png"),
          )),
+    # --- remedies: E5 ---
+    Page("remedies", "Remedies for the plateau (E5)",
+         "Sod (the Sod study's MPM settings) and Burgers (the few particles per cell at which its calculated "
+         "acceleration stalls; every setting in the JSON beside each table) with each remedy alone and in "
+         "combination: the B-spline averaged over the particle domain, the Taylor least-squares stress "
+         "reconstruction, the volume reset against the grid and a PIC/FLIP blend. Errors over grid nodes and over "
+         "particles; the accuracy per cost beside fixed-mesh FEM and a finite-volume reference.",
+         views=(
+             View("remedies/orders", "Each remedy by its lowest successive order and its error at the finest mesh", (
+                 "problem", "remedy", "min_order_nodes_L1", "min_order_particles_L1", "fitted_order_nodes_L1",
+                 "fitted_order_particles_L1", "h_finest", "finest_nodes_L1", "finest_particles_L1",
+                 "max_fv_ratio_nodes_L1", "max_fv_ratio_particles_L1", "removes_plateau"), {}, "errors.png"),
+             View("remedies/cost", "Accuracy per cost: Sod density L1 against work and wall time (one run each on a "
+                  "shared machine; no verdict uses wall time)", ("method", "h", "density_L1", "particles_L1", "work",
+                                                                 "wall_s"), {}, "cost.png"),
+         )),
 )

@@ -25,7 +25,9 @@ import scipy.sparse as sp
 
 from .grid import Grid
 
-BASES = ("mpm", "gimp", "bspline")
+BASES = ("mpm", "gimp", "bspline", "bspline_gimp")
+# the grid functions S_i(x) behind each basis (the particle-domain bases average them over chi_p)
+GRID_FUNCTIONS = {"mpm": "mpm", "gimp": "mpm", "bspline": "bspline", "bspline_gimp": "bspline"}
 
 
 class OutsideGridError(ValueError):
@@ -208,14 +210,23 @@ def bspline_shape(grid: Grid, x: np.ndarray) -> Shape:
     return Shape(nodes, S, dS / h[0], grid.n_nodes, cell)
 
 
+def grid_functions(basis: str) -> str:
+    """The point basis of the grid functions ``S_i(x)`` of ``basis`` (``"mpm"`` or ``"bspline"``)."""
+    if basis not in GRID_FUNCTIONS:
+        raise ValueError(f"unknown basis {basis!r}; choose one of {', '.join(BASES)}")
+    return GRID_FUNCTIONS[basis]
+
+
 def basis_integrals(grid: Grid, basis: str = "mpm") -> np.ndarray:
     """``int S_i dx`` over the grid (n_nodes,), the weight that turns a nodal mass into a density.
 
     P1 (and GIMP, whose averaged hats integrate like P1): the lumped mass of scikit-fem. The
-    B-spline: two-point Gauss rules on each half cell, exact for its piecewise quadratics (an end
-    node with its folded ghost integrates to ``25h/48``, its neighbour to ``47h/48``).
+    B-spline (point or particle-domain averaged): two-point Gauss rules on each half cell, exact
+    for its piecewise quadratics (an end node with its folded ghost integrates to ``25h/48``, its
+    neighbour to ``47h/48``).
     """
-    if basis in ("mpm", "gimp"):
+    basis = grid_functions(basis)
+    if basis == "mpm":
         return grid.lumped_mass
     left, h = grid.nodes[:-1], grid.h
     g = 0.5 + np.array([-1.0, 1.0]) / (2.0 * np.sqrt(3.0))  # Gauss points on [0, 1]
@@ -225,14 +236,59 @@ def basis_integrals(grid: Grid, basis: str = "mpm") -> np.ndarray:
     return make_shape(grid, x, basis=basis).scatter(weights)
 
 
+def _bspline_integral(r: np.ndarray) -> np.ndarray:
+    """``M(r) = int_{-inf}^r N``, the antiderivative of the quadratic B-spline (0 below -3/2, 1 above 3/2)."""
+    r = np.clip(r, -1.5, 1.5)
+    u = np.clip(r + 1.5, 0.0, 1.0)  # the part of [r_0, r] in each of the three pieces
+    m = np.clip(r, -0.5, 0.5)
+    w = np.clip(1.5 - r, 0.0, 1.0)
+    return u * u * u / 6.0 + (0.75 * (m + 0.5) - (m * m * m + 0.125) / 3.0) + (1.0 - w * w * w) / 6.0
+
+
+def bspline_gimp_shape(grid: Grid, x: np.ndarray, volume: np.ndarray) -> Shape:
+    """The quadratic B-splines averaged over the particle domain (particle-domain quadrature):
+
+        S_ip = 1/V_p int N((x - x_i)/h) chi_p(x) dx = h (M(r_+) - M(r_-)) / (x_+ - x_-),
+        G_ip = 1/V_p int N'((x - x_i)/h)/h chi_p(x) dx = (N(r_+) - N(r_-)) / (x_+ - x_-),
+
+    with ``x_+- = x_p +- V_p/2`` (cut at the ends of the grid, as for GIMP), ``r_+- = (x_+- - x_i)/h``
+    and ``M`` the antiderivative of ``N``. The ghost splines outside each end fold into the end
+    nodes, as in :func:`bspline_shape`: the partition of unity holds on the whole grid.
+    """
+    h = grid.h
+    if np.ptp(h) > 1e-9 * h.max():
+        raise ValueError("the quadratic B-spline basis needs a uniform grid")
+    x = np.asarray(x, dtype=float)
+    volume = np.asarray(volume, dtype=float)
+    if np.any(~(volume > 0)):
+        p = int(np.flatnonzero(~(volume > 0))[0])
+        raise ValueError(f"the particle-domain B-spline needs positive particle volumes; particle {p} has V={volume[p]!r}")
+    a, b = grid.nodes[0], grid.nodes[-1]
+    cell, _ = locate(grid, x)
+    lo = np.maximum(x - 0.5 * volume, a)
+    hi = np.minimum(x + 0.5 * volume, b)
+    c_lo, _ = locate(grid, lo)
+    c_hi, _ = locate(grid, hi)
+    k = int((c_hi - c_lo).max()) + 4
+    j = c_lo[:, None] - 1 + np.arange(k)  # spline centres x_j = a + j h, ghosts at j = -1 and n_nodes
+    r_lo = (lo[:, None] - a) / h[0] - j
+    r_hi = (hi[:, None] - a) / h[0] - j
+    length = (hi - lo)[:, None]
+    S = h[0] * (_bspline_integral(r_hi) - _bspline_integral(r_lo)) / length
+    G = (_quadratic_bspline(r_hi)[0] - _quadratic_bspline(r_lo)[0]) / length
+    nodes = np.clip(j, 0, grid.n_nodes - 1)
+    return Shape(nodes, S, G, grid.n_nodes, cell)
+
+
 def make_shape(grid: Grid, x: np.ndarray, volume: np.ndarray | None = None, basis: str = "mpm") -> Shape:
-    """``S_ip``, ``G_ip`` for the named basis: ``"mpm"`` (point mass), ``"gimp"`` or ``"bspline"``."""
+    """``S_ip``, ``G_ip`` for the named basis: ``"mpm"`` (point mass), ``"gimp"``, ``"bspline"`` or
+    ``"bspline_gimp"`` (the B-spline averaged over the particle domain)."""
     if basis == "mpm":
         return point_shape(grid, x)
     if basis == "bspline":
         return bspline_shape(grid, x)
-    if basis == "gimp":
+    if basis in ("gimp", "bspline_gimp"):
         if volume is None:
-            raise ValueError("the GIMP basis needs the particle volumes")
-        return gimp_shape(grid, x, volume)
+            raise ValueError(f"the {basis} basis needs the particle volumes")
+        return (gimp_shape if basis == "gimp" else bspline_gimp_shape)(grid, x, volume)
     raise ValueError(f"unknown basis {basis!r}; choose one of {', '.join(BASES)}")

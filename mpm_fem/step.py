@@ -27,8 +27,10 @@ import numpy as np
 from .exact_stages import ExactFields, GridData, exact_projection, nodal_values
 from .grid import Grid
 from .particles import Particles
+from .reconstruction import RECONSTRUCTIONS, reconstructed_force
 from .shape import BASES, make_shape
 from .transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
+from .volume import VOLUMES, grid_volume_factor
 
 SCHEMES = ("usl", "usf", "musl")
 ACCELERATIONS = ("calculated", "exact")
@@ -46,7 +48,9 @@ class Stages:
     ``acceleration``: ``"calculated"`` (``F_i/m_i``) or ``"exact"`` (the problem's exact nodal
     acceleration); ``scheme``: ``"usl"``, ``"usf"`` or ``"musl"``; ``projection`` and
     ``interpolation``: ``"mpm"`` or ``"exact"``; ``refine``: the time step is ``dt / refine``.
-    The exact forms are those of :mod:`mpm_fem.exact_stages`.
+    The exact forms are those of :mod:`mpm_fem.exact_stages`. The remedies (module docstring):
+    ``flip`` in [0, 1] (1: FLIP, 0: PIC), ``reconstruct`` ``"none"`` or ``"taylor"``, ``volume``
+    ``"carried"`` or ``"grid"``, and the basis ``"bspline_gimp"``.
     """
 
     basis: str = "mpm"
@@ -56,10 +60,14 @@ class Stages:
     projection: str = "mpm"
     interpolation: str = "mpm"
     refine: int = 1
+    flip: float = 1.0
+    reconstruct: str = "none"
+    volume: str = "carried"
 
     def __post_init__(self):
         for name, allowed in (("basis", BASES), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
-                              ("scheme", SCHEMES), ("projection", PROJECTIONS), ("interpolation", INTERPOLATIONS)):
+                              ("scheme", SCHEMES), ("projection", PROJECTIONS), ("interpolation", INTERPOLATIONS),
+                              ("reconstruct", RECONSTRUCTIONS), ("volume", VOLUMES)):
             value = getattr(self, name)
             if value not in allowed:
                 raise ValueError(f"unknown {name} {value!r}; choose one of {', '.join(allowed)}")
@@ -67,6 +75,15 @@ class Stages:
             raise ValueError(f"the time refinement must be an integer >= 1, got {self.refine!r}")
         if self.uses_exact_fields and self.scheme == "musl":
             raise ValueError("the exact projection, mass and interpolation stages are defined for USL and USF only")
+        if isinstance(self.flip, bool) or not isinstance(self.flip, (int, float, np.number)) or not 0 <= self.flip <= 1:
+            raise ValueError(f"the PIC/FLIP blend must lie in [0, 1] (1: FLIP, 0: PIC), got {self.flip!r}")
+        if self.uses_exact_fields and self.uses_remedy:
+            raise ValueError("the remedies (flip, reconstruct, volume, bspline_gimp) run with the MPM stages only")
+
+    @property
+    def uses_remedy(self) -> bool:
+        """Whether a plateau remedy is on (they run in :func:`explicit_step` only, not in fused loops)."""
+        return self.basis == "bspline_gimp" or self.flip != 1 or self.reconstruct != "none" or self.volume != "carried"
 
     @property
     def uses_exact_fields(self) -> bool:
@@ -84,6 +101,10 @@ class Model(Protocol):
     def update(self, particles: Particles, grad_v: np.ndarray, dt: float, cell_size: np.ndarray) -> Particles: ...
 
     def stable_dt(self, particles: Particles, grid: Grid, cfl: float) -> float: ...
+
+    # the volume remedy also calls ``with_volume(particles, volume) -> Particles``: the state at
+    # the same mass (and specific energy) with the volumes ``volume``
+
 
 
 class Boundary(Protocol):
@@ -168,6 +189,9 @@ def explicit_step(
     m, V = particles.mass, particles.volume
     m_i = nodal_mass(shape, m)
     v_i = boundary.velocity(grid, grid_values(shape, m, m_i, nodal_momentum(shape, m, particles.velocity), stages.mass), t)
+    if stages.volume == "grid":
+        particles = _reset_volume(model, particles, grid_volume_factor(grid, particles.x, V, stages.basis, shape))
+        V = particles.volume
 
     if stages.scheme == "usf":
         particles = model.update(particles, shape.gather_gradient(v_i), dt, h_p)
@@ -180,14 +204,23 @@ def explicit_step(
     elif getattr(model, "force", "weak") == "slides":
         a_i = model.grid_acceleration(grid, shape.cell, v_i)
     else:
-        grad_v = shape.gather_gradient(v_i) if getattr(model, "stress_uses_gradient", True) else None
-        stress = model.stress(particles, grad_v)
-        a_i = grid_values(shape, m, m_i, nodal_internal_force(shape, V, stress), stages.mass)
+        if getattr(model, "stress_uses_gradient", True):
+            stress = model.stress(particles, shape.gather_gradient(v_i))
+        else:
+            stress = model.stress(particles, None)
+        if stages.reconstruct == "taylor":
+            F_i = reconstructed_force(grid, particles.x, stress, stages.basis)
+        else:
+            F_i = nodal_internal_force(shape, V, stress)
+        a_i = grid_values(shape, m, m_i, F_i, stages.mass)
     a_i = boundary.acceleration(grid, a_i, v_i, t, dt)
     v_new = v_i + dt * a_i
 
+    moving = shape.gather(v_new)
     velocity = particles.velocity + dt * shape.gather(a_i)
-    x = particles.x + dt * shape.gather(v_new)
+    if stages.flip != 1:
+        velocity = stages.flip * velocity + (1.0 - stages.flip) * moving
+    x = particles.x + dt * moving
     particles = particles.replace(x=x, velocity=velocity)
 
     if stages.scheme == "musl":
@@ -197,6 +230,13 @@ def explicit_step(
     if stages.scheme in ("usl", "musl"):
         particles = model.update(particles, shape.gather_gradient(v_new), dt, h_p)
     return particles, GridState(m_i, v_i, a_i, v_new)
+
+
+def _reset_volume(model: Model, particles: Particles, factor: np.ndarray) -> Particles:
+    """``V_p <- f_p V_p`` through the model (:mod:`mpm_fem.volume`)."""
+    if not hasattr(model, "with_volume"):
+        raise ValueError(f"the volume reset needs a model with with_volume(); {type(model).__name__} has none")
+    return model.with_volume(particles, particles.volume * factor)
 
 
 def _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exact_acceleration, exact):

@@ -74,6 +74,11 @@ class ViscousBurgers:
         """``max_p |v_p|``, the advective speed of the time step."""
         return float(np.max(np.abs(particles.velocity), initial=0.0))
 
+    def with_volume(self, particles: Particles, volume: np.ndarray) -> Particles:
+        """The quadrature weights ``V_p = volume`` (unit density: ``m_p = V_p`` with them)."""
+        check_positive("volume", volume, particles.x)
+        return particles.replace(volume=volume, mass=volume.copy())
+
     def stable_dt(self, particles: Particles, grid, cfl: float) -> float:
         """``dt = CFL min(h / max|v|, h^2 / (2 eps))``: advective and explicit-diffusion limits
         (the advective one alone without ``viscous_limit``)."""

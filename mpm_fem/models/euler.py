@@ -82,6 +82,15 @@ class IdealGas:
         """``dt = CFL h_min / speed``."""
         return cfl * float(grid.h.min()) / speed
 
+    def with_volume(self, particles: Particles, volume: np.ndarray) -> Particles:
+        """The state at volumes ``volume``, same mass and specific energy (volume reset):
+        ``rho = m / V``, ``p = (gamma - 1) rho eps + q`` with the viscosity ``q`` scaled like ``rho``."""
+        density = particles.mass / volume
+        check_positive("density", density, particles.x)
+        q = particles.pressure - self.thermal_pressure(particles.density, particles.energy)
+        return particles.replace(volume=volume, density=density,
+                                 pressure=self.thermal_pressure(density, particles.energy) + q * density / particles.density)
+
     def stable_dt(self, particles: Particles, grid, cfl: float) -> float:
         """``dt = CFL h_min / max_p (c_p + |v_p|)``."""
         return self.dt_for_speed(self.max_speed(particles), grid, cfl)

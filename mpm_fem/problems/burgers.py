@@ -71,6 +71,9 @@ class BurgersSettings:
     weights: str = "volume"
     force: str = "weak"
     dt_rule: str = "stable"
+    flip: float = 1.0
+    reconstruct: str = "none"
+    volume: str = "carried"
     kernel: str = "fused"
     threads: int = 1
 
@@ -97,7 +100,8 @@ class BurgersSettings:
     @property
     def stages(self) -> Stages:
         return Stages(basis=self.basis, mass=self.mass, acceleration=self.acceleration, scheme=self.scheme,
-                      projection=self.projection, interpolation=self.interpolation, refine=self.refine)
+                      projection=self.projection, interpolation=self.interpolation, refine=self.refine,
+                      flip=self.flip, reconstruct=self.reconstruct, volume=self.volume)
 
     def as_dict(self) -> dict:
         return asdict(self)

@@ -56,6 +56,9 @@ class SodSettings:
     projection: str = "mpm"
     interpolation: str = "mpm"
     refine: int = 1
+    flip: float = 1.0
+    reconstruct: str = "none"
+    volume: str = "carried"
     kernel: str = "fused"
     threads: int = 1
 
@@ -73,7 +76,8 @@ class SodSettings:
     @property
     def stages(self) -> Stages:
         return Stages(basis=self.basis, mass=self.mass, scheme=self.scheme, projection=self.projection,
-                      interpolation=self.interpolation, refine=self.refine)
+                      interpolation=self.interpolation, refine=self.refine, flip=self.flip,
+                      reconstruct=self.reconstruct, volume=self.volume)
 
     def as_dict(self) -> dict:
         return asdict(self)

@@ -1,0 +1,224 @@
+"""E5: which remedy removes the MPM plateau, and what does accuracy cost?
+
+Sod (the Sod study's MPM settings: 16 particles per cell, CFL 0.05, von Neumann-Richtmyer 0.5 /
+2.0, USL, lumped mass; density) and viscous Burgers (rarefaction, eps = 0.045, 4 particles per
+cell, calculated acceleration; velocity) with each remedy of :mod:`mpm_fem.step` alone and in the
+combinations that promise most, errors over grid nodes and over particles:
+
+- ``errors.csv``: every problem, remedy and mesh; observed orders against the previous mesh; on
+  Sod the finite-volume reference (MUSCL-Hancock + HLLC) on the same mesh and the ratio to it.
+- ``orders.csv``: per problem and remedy, the lowest successive and the fitted orders, the errors
+  at the finest mesh, and whether the plateau is removed (E5 criterion, in :mod:`mpm_fem.claims`).
+- ``cost.csv`` / ``cost.png``: Sod density L1 against particle- (or cell-) steps and against wall
+  time, for MPM with each remedy, fixed-mesh P1 FEM (lumped mass) and FV. Wall time is the last
+  column: it varies from run to run and no verdict uses it.
+
+Meshes: Sod h = 0.01 ... 0.00125, the convergence study's meshes without its two finest (0.000625
+and 0.0003125): each halving costs 4x, the B-spline and volume remedies run 5-7x slower per step
+than point mass, and the two finest meshes would cost about 20x the four kept (some 10 CPU hours);
+the particle plateau of the study settings shows from h = 0.00125 on. Burgers h = 0.04 ... 0.005
+(the general time loop runs the remedies; the viscous step limit makes a halving of h cost 8x).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from baselines import fem_euler, fv_euler
+from mpm_fem.claims import PLATEAU_ORDER, remedy_assessment, successive_orders
+from mpm_fem.errors import norms
+from mpm_fem.grid import uniform_grid
+from mpm_fem.particles import PositivityError
+from mpm_fem.problems import burgers, sod
+from mpm_fem.plots import Curve, Plot
+from mpm_fem.shock_tube import exact_density
+from mpm_fem.study import StudyOptions, publish, script_main
+from studies.sod import FEM, FV, H, MPM as SOD_MPM
+
+NAME = "remedies"
+SOD_H = H[:4]
+BURGERS_H = (0.04, 0.02, 0.01, 0.005)
+BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, acceleration="calculated")
+REMEDIES = {
+    "MPM": {},
+    "B-spline domain": {"basis": "bspline_gimp"},
+    "Taylor LS": {"reconstruct": "taylor"},
+    "grid volume": {"volume": "grid"},
+    "FLIP 0.99": {"flip": 0.99},
+    "Taylor + volume": {"reconstruct": "taylor", "volume": "grid"},
+    "B-spline domain + Taylor + volume": {"basis": "bspline_gimp", "reconstruct": "taylor", "volume": "grid"},
+}
+QUICK = dict(SOD_H=SOD_H[:2], BURGERS_H=BURGERS_H[:2],
+             REMEDIES=("MPM", "Taylor LS", "grid volume", "FLIP 0.99", "Taylor + volume"))
+
+
+# ---------------------------------------------------------------- one case (runs in a worker)
+
+def run_case(case: dict) -> dict:
+    """``case["solver"]``: ``"sod"`` / ``"burgers"`` (MPM with the remedy's settings), ``"fem"`` or
+    ``"fv"`` (Sod baselines). Errors, steps, work (particle- or cell-steps) and wall time."""
+    start = time.perf_counter()
+    solver, h = case["solver"], case["h"]
+    if solver in ("fem", "fv"):
+        if solver == "fem":
+            r = fem_euler.solve(h, mass="lumped", cfl=FEM["cfl"], viscosity=fem_euler.Viscosity(
+                FEM["viscosity_linear"], FEM["viscosity_quadratic"], FEM["compression_only"]))
+            x, w = r.nodes, uniform_grid(0.0, 1.0, h).lumped_mass
+        else:
+            r = fv_euler.solve(h, cfl=FV["cfl"], limiter=FV["limiter"])
+            x, w = r.centres, np.full(r.centres.size, h)
+        e = norms(r.rho - exact_density(x, r.t), w)
+        return {"ok": True, "nodes": e, "steps": r.steps, "work": r.steps * x.size, "wall_s": time.perf_counter() - start}
+    changes = {k: v for k, v in case.items() if k not in ("solver", "h")}
+    try:
+        if solver == "sod":
+            settings = sod.SodSettings(h=h, **changes)
+            result = sod.simulate(settings, progress=False)
+            e = sod.errors(settings, result)["density"]
+        else:
+            settings = burgers.BurgersSettings(h=h, **changes)
+            result = burgers.simulate(settings, progress=False)
+            e = burgers.errors(settings, result)["velocity"]
+    except (PositivityError, FloatingPointError) as err:
+        return {"ok": False, "error": str(err)}
+    n = int(result.particles.n)
+    return {"ok": True, "nodes": e["nodes"], "particles": e["particles"], "steps": result.steps, "n_p": n,
+            "work": result.steps * n, "volume_drift": float(result.particles.volume.sum() - 1.0) if solver == "sod" else "",
+            "wall_s": time.perf_counter() - start}
+
+
+def _plan(quick: bool) -> dict:
+    q = QUICK if quick else {}
+    names = q.get("REMEDIES", tuple(REMEDIES))
+    sod_h, burgers_h = q.get("SOD_H", SOD_H), q.get("BURGERS_H", BURGERS_H)
+    return {
+        "sod": {(n, h): {"solver": "sod", "h": h, **SOD_MPM, **REMEDIES[n]} for n in names for h in sod_h},
+        "burgers": {(n, h): {"solver": "burgers", "h": h, **BURGERS, **REMEDIES[n]} for n in names for h in burgers_h},
+        "fem": {h: {"solver": "fem", "h": h} for h in sod_h},
+        "fv": {h: {"solver": "fv", "h": h} for h in sod_h},
+    }
+
+
+def _cost(case: dict) -> float:
+    """Rough work, to start the longest runs first."""
+    h = case["h"]
+    if case["solver"] in ("fem", "fv"):
+        return 1.0 / h**2
+    slow = 6.0 if case.get("basis") == "bspline_gimp" else 1.0
+    if case["solver"] == "burgers":
+        return slow * 4 * 0.09 / h**3
+    return slow * case["ppc"] / (h**2 * case["cfl"])
+
+
+# ---------------------------------------------------------------- the study
+
+def run(options: StudyOptions) -> None:
+    got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
+    folder = options.folder(NAME)
+    settings = {"sod": SOD_MPM, "burgers": BURGERS, "remedies": REMEDIES, "fem": {"mass": "lumped", **FEM},
+                "fv": FV,
+                "criterion": {"plateau_order": PLATEAU_ORDER}, "quick": options.quick}
+    rows, cost = _errors(got), _cost_rows(got)
+    publish(folder, {"errors": rows, "orders": _summary(rows), "cost": cost}, settings, figures=PLOTS)
+    _cost_figure(folder, cost)
+
+
+def _l(result, where, norm):
+    return result[where][norm] if result.get("ok") and where in result else float("nan")
+
+
+def _errors(got) -> list[dict]:
+    rows = []
+    for problem in ("sod", "burgers"):
+        names = list(dict.fromkeys(n for n, _ in got[problem]))
+        for name in names:
+            hs = sorted((h for n, h in got[problem] if n == name), reverse=True)
+            series = []
+            for h in hs:
+                r = got[problem][(name, h)]
+                row = {"problem": problem, "remedy": name, "h": h, "quantity": "density" if problem == "sod" else "velocity"}
+                for where in ("nodes", "particles"):
+                    for norm in ("L1", "L2"):
+                        row[f"{where}_{norm}"] = _l(r, where, norm)
+                fv = _l(got["fv"][h], "nodes", "L1") if problem == "sod" else ""
+                row.update(fv_L1=fv, ratio_fv_nodes_L1=row["nodes_L1"] / fv if fv else "",
+                           ratio_fv_particles_L1=row["particles_L1"] / fv if fv else "",
+                           steps=r.get("steps", ""), n_p=r.get("n_p", ""), volume_drift=r.get("volume_drift", ""),
+                           error=r.get("error", ""))
+                series.append(row)
+            for m in ("nodes_L1", "particles_L1"):
+                o = successive_orders(series, m)
+                for k, row in enumerate(series):
+                    row[f"order_{m}"] = float(o[k - 1]) if k else ""
+            rows += series
+    return rows
+
+
+def _summary(rows) -> list[dict]:
+    out = []
+    for problem in ("sod", "burgers"):
+        for name in dict.fromkeys(r["remedy"] for r in rows if r["problem"] == problem):
+            series = [r for r in rows if r["problem"] == problem and r["remedy"] == name]
+            if len(series) < 2:
+                continue
+            s, last = remedy_assessment(series), series[-1]
+            out.append({"problem": problem, "remedy": name, "h_finest": last["h"],
+                        "finest_nodes_L1": last["nodes_L1"], "finest_particles_L1": last["particles_L1"],
+                        **{k: s[k] for k in s if k != "meshes" and not (problem == "burgers" and k.startswith("max_fv"))},
+                        "removes_plateau": "yes" if s["removes_plateau"] else "no"})
+    return out
+
+
+def _cost_rows(got) -> list[dict]:
+    rows = []
+    for (name, h), r in got["sod"].items():
+        rows.append({"method": "MPM" if name == "MPM" else f"MPM + {name}", "h": h, "density_L1": _l(r, "nodes", "L1"),
+                     "particles_L1": _l(r, "particles", "L1"), "work": r.get("work", ""), "steps": r.get("steps", ""),
+                     "wall_s": round(r.get("wall_s", float("nan")), 2)})
+    for method, label in (("fem", "FEM P1 lumped"), ("fv", fv_euler.label(FV["limiter"]))):
+        for h, r in got[method].items():
+            rows.append({"method": label, "h": h, "density_L1": _l(r, "nodes", "L1"), "particles_L1": "",
+                         "work": r["work"], "steps": r["steps"], "wall_s": round(r["wall_s"], 2)})
+    return rows
+
+
+_SOD, _FV = {"problem": "sod"}, {"problem": "sod", "remedy": "MPM"}
+PLOTS = (
+    Plot("errors.png", "E5: L1 error against h for each remedy; Sod density with the FV reference, Burgers velocity",
+         "errors", "h", (
+             Curve("{remedy}", "nodes_L1", where=_SOD, panel="Sod density, grid nodes", group=("remedy",)),
+             Curve("FV reference", "fv_L1", "k--", where=_FV, panel="Sod density, grid nodes"),
+             Curve("{remedy}", "particles_L1", where=_SOD, panel="Sod density, particles", group=("remedy",)),
+             Curve("FV reference", "fv_L1", "k--", where=_FV, panel="Sod density, particles"),
+             Curve("{remedy}", "particles_L1", where={"problem": "burgers"}, panel="Burgers velocity, particles",
+                   group=("remedy",))),
+         ylabel="L1 error", size=(4.6, 3.8), ncols=3),
+)
+
+
+def _cost_figure(folder: Path, cost) -> None:
+    """Sod density L1 against work and against wall time, one line per method (``cost.png``)."""
+    from mpm_fem import plots
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(13, 4.4))
+    for method in dict.fromkeys(r["method"] for r in cost):
+        s = sorted((r for r in cost if r["method"] == method), key=lambda r: -r["h"])
+        style = "k*--" if method.startswith("FV") else "ks:" if method.startswith("FEM") else "o-"
+        for ax, x in zip(axes, ("work", "wall_s")):
+            ax.loglog([r[x] for r in s], [r["density_L1"] for r in s], style, ms=3, label=method)
+    axes[0].set(xlabel="particle-steps (MPM) or node/cell-steps", ylabel="Sod density L1 (nodes / cells)")
+    axes[1].set(xlabel="wall time [s] (one run, shared machine)", ylabel="Sod density L1 (nodes / cells)")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="center right", fontsize=7)
+    fig.tight_layout(rect=(0, 0, 0.78, 1))
+    plots.save(fig, folder / "cost.png", caption="E5: Sod density L1 against work and against wall time, one point "
+               "per mesh, for MPM with each remedy, fixed-mesh FEM and the FV reference")
+
+
+if __name__ == "__main__":
+    sys.exit(script_main(NAME))

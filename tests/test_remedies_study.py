@@ -1,0 +1,34 @@
+"""E5 study (studies/remedies.py): the quick run writes its tables, figures and verdict."""
+
+import pytest
+
+from claim_mutations import judge
+
+from mpm_fem.study import StudyOptions, read_table
+from mpm_fem.tables import load_tables
+from studies import remedies
+
+
+def test_plan_runs_every_remedy_on_the_stated_meshes():
+    plan = remedies._plan(quick=False)
+    assert {h for _, h in plan["sod"]} == set(remedies.SOD_H) and len(remedies.SOD_H) == 4
+    assert {n for n, _ in plan["burgers"]} == set(remedies.REMEDIES)
+    assert all(case["ppc"] == 16 and case["cfl"] == 0.05 for case in plan["sod"].values())
+    assert all(case["ppc"] == 4 and case["acceleration"] == "calculated" for case in plan["burgers"].values())
+
+
+@pytest.mark.slow
+def test_quick_run_writes_tables_figures_and_the_e5_verdict(tmp_path):
+    remedies.run(StudyOptions(quick=True, out=tmp_path, jobs=1, progress=False))
+    folder = tmp_path / "remedies"
+    for name in ("errors.csv", "orders.csv", "cost.csv", "cost.png", "errors.png"):
+        assert (folder / name).exists(), name
+    errors = read_table(folder / "errors.csv")
+    sod = {r["remedy"]: r for r in errors if r["problem"] == "sod" and r["h"] == "0.01"}
+    assert float(sod["MPM"]["nodes_L1"]) == pytest.approx(0.0083452, rel=1e-4)  # the Sod study's value
+    ratio = float(sod["MPM"]["nodes_L1"]) / float(sod["MPM"]["fv_L1"])
+    assert float(sod["MPM"]["ratio_fv_nodes_L1"]) == pytest.approx(ratio, rel=1e-4) and 1.0 < ratio < 2.0
+    cost = read_table(folder / "cost.csv")
+    assert list(cost[0])[-1] == "wall_s"
+    verdict, evidence = judge("E5", load_tables(tmp_path))
+    assert verdict in ("confirmed", "partly", "refuted") and "FV error" in evidence
