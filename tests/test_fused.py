@@ -190,6 +190,8 @@ def test_what_the_fused_step_refuses():
     assert supported(Elastic(), Stages()) is not None
     assert supported(IdealGas(), Stages(projection="exact")) is not None
     assert supported(IdealGas(), Stages(basis="gimp", scheme="musl", mass="consistent")) is None
+    for remedy in (dict(flip=0.5), dict(reconstruct="taylor"), dict(volume="grid"), dict(basis="bspline_gimp")):
+        assert "remedies" in supported(IdealGas(), Stages(**remedy))
     with pytest.raises(ValueError, match="exact projection"):
         FusedStep(GRID, IdealGas(), Walls(), Stages(interpolation="exact"))
     with pytest.raises(ValueError, match="threads"):
