@@ -24,17 +24,12 @@ LAYERS = {
     1: ("baselines.exact",),
     2: ("mpm_fem.grid", "mpm_fem.shape", "mpm_fem.particles", "mpm_fem.transfer", "mpm_fem.step",
         "mpm_fem.fused", "mpm_fem.exact_stages", "mpm_fem.models", "mpm_fem.solve", "mpm_fem.problems", "mpm_fem.cases",
-        "mpm_fem.reconstruction", "mpm_fem.volume", "baselines", "mpm_fem"),
+        "mpm_fem.reconstruction", "mpm_fem.volume", "mpm_fem.norms", "baselines", "mpm_fem"),
     3: ("mpm_fem.errors", "mpm_fem.quadrature", "mpm_fem.projection", "mpm_fem.regions", "mpm_fem.timing",
         "mpm_fem.claims", "mpm_fem.source", "mpm_fem.tables", "mpm_fem.shock_tube", "mpm_fem.decomposition"),
     4: ("mpm_fem.sweep", "mpm_fem.study", "mpm_fem.guard", "mpm_fem.report", "mpm_fem.pages", "mpm_fem.output", "mpm_fem.fields", "mpm_fem.plots",
         "mpm_fem.cli"),
     5: ("studies",),
-}
-#: Known until the branches fixing them land (issue 16): the lead removes each entry on merge.
-PENDING = {
-    ("mpm_fem.problems.sod", "mpm_fem.errors"): "problems compute their norms with mpm_fem.errors (branch fused)",
-    ("mpm_fem.problems.burgers", "mpm_fem.errors"): "problems compute their norms with mpm_fem.errors (branch fused)",
 }
 
 
@@ -98,7 +93,7 @@ def test_every_module_has_a_layer():
 
 def test_no_module_imports_a_higher_layer():
     upward = [f"{a} (layer {layer(a)}) imports {b} (layer {layer(b)})" for a, bs in graph().items() for b in bs
-              if layer(b) > layer(a) and (a, b) not in PENDING]
+              if layer(b) > layer(a)]
     assert not upward, "\n".join(upward)
 
 
@@ -121,16 +116,8 @@ def _cycles(g):
 
 
 def test_no_import_cycle():
-    cycles = [f"{a} -> {b} -> ... -> {a}" for a, b in _cycles(graph()) if (a, b) not in PENDING]
+    cycles = [f"{a} -> {b} -> ... -> {a}" for a, b in _cycles(graph())]
     assert not cycles, "\n".join(cycles)
-
-
-@pytest.mark.xfail(reason="; ".join(sorted(set(PENDING.values()))), strict=True)
-def test_pending_pairs_are_still_there():
-    """Fails (xfail) while the pending pairs exist; turns into an XPASS error once they are fixed,
-    so that the lead removes them from PENDING."""
-    g = graph()
-    assert not any(b in g.get(a, ()) for a, b in PENDING)
 
 
 def test_the_check_finds_a_cycle_and_names_the_pair():

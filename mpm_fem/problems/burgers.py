@@ -28,7 +28,7 @@ import numpy as np
 
 from baselines.exact import burgers as exact_burgers
 
-from ..errors import norms
+from ..norms import norms
 from ..exact_stages import SmoothBurgersFields
 from ..grid import Grid, uniform_grid
 from ..fused import check_kernel

@@ -15,7 +15,7 @@ import numpy as np
 
 from baselines.exact import riemann
 
-from ..errors import norms
+from ..norms import norms
 from ..exact_stages import RiemannFields
 from ..fused import check_kernel
 from ..grid import uniform_grid
