@@ -287,7 +287,7 @@ SIDE_BY_SIDE = {"MPM nodes": "mpm_nodes_L1", "FEM consistent": "fem_consistent_L
 
 
 def _orders_text(rows: list[dict], key: str) -> str:
-    return ", ".join(f"{num(r, key):.2f}" for r in rows[1:])
+    return ", ".join(f"{num(r, key):.2f}" for r in rows[1:] if r.get(key, "") != "")
 
 
 @claim("C11", source=f"nodal density L1 {SOD[0.01][0]:.3g} at h = 0.01 levelling at {SOD[0.0003125][0]:.3g}",
@@ -301,10 +301,11 @@ def _c11(t: Tables) -> tuple[str, str]:
     rows = t[CONVERGENCE]
     orders = [num(r, "order_nodes_L1") for r in rows[1:]]
     last = rows[-1]
-    evidence = (f"nodal L1 / source {num(last, 'ratio_nodes_L1'):.2f} at h = {last['h']}; orders "
+    compared = [r for r in rows if r.get("ratio_nodes_L1", "") != ""][-1:] or [last]  # the source's finest mesh
+    evidence = (f"nodal L1 / source {num(compared[0], 'ratio_nodes_L1'):.2f} at h = {compared[0]['h']}; orders "
                 f"{_orders_text(rows, 'order_nodes_L1')} (source {_orders_text(rows, 'source_order_L1')}); over "
-                f"particles {num(last, 'mpm_particles_L1'):.2g} ({num(last, 'ratio_particles_L1'):.1f}x the "
-                f"source), orders {_orders_text(rows, 'order_particles_L1')}")
+                f"particles {num(compared[0], 'mpm_particles_L1'):.2g} ({num(compared[0], 'ratio_particles_L1'):.1f}x "
+                f"the source), orders {_orders_text(rows, 'order_particles_L1')}")
     if len(rows) < FLOOR_MESHES:
         return "not measured", evidence + f"; {len(rows)} meshes, the floor needs {FLOOR_MESHES}"
     floor = max(orders[-FLOOR_STEPS:]) < FLOOR_ORDER

@@ -24,7 +24,7 @@ from mpm_fem.plots import Curve, Plot
 from mpm_fem.study import StudyOptions, publish, script_main
 
 NAME = "sod"
-H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)
+H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625)  # the source's meshes and one finer
 SOURCE = source.SOD
 T = sod.SodSettings.T
 # One set of MPM settings for every h (never tuned per mesh); why these: ppc.csv and plateau.csv
@@ -134,13 +134,14 @@ def _convergence(got) -> list[dict]:
     cols.update({f"{m}_L1": [_L1(got[m][h], where) for h in hs]
                  for m, where in (("fem_consistent", "nodes"), ("fem_lumped", "nodes"), ("fv", "cells"))})
     orders = {k: orders_column(hs, v) for k, v in cols.items()}
-    src_orders = orders_column(hs, [SOURCE[h][0] for h in hs])
+    in_source = [h for h in hs if h in SOURCE]  # meshes finer than the source's have no source value
+    src_orders = dict(zip(in_source, orders_column(in_source, [SOURCE[h][0] for h in in_source])))
     rows = []
     for k, (h, r) in enumerate(zip(hs, mpm)):
-        s = dict(zip(("L1", "L2"), SOURCE[h]))
-        row = {"h": h, "source_L1": s["L1"], "source_L2": s["L2"], "source_order_L1": src_orders[k]}
+        s = dict(zip(("L1", "L2"), SOURCE.get(h, ("", ""))))
+        row = {"h": h, "source_L1": s["L1"], "source_L2": s["L2"], "source_order_L1": src_orders.get(h, "")}
         for key in ("nodes_L1", "nodes_L2", "particles_L1", "particles_L2"):
-            row.update({f"mpm_{key}": cols[key][k], f"ratio_{key}": cols[key][k] / s[key[-2:]]})
+            row.update({f"mpm_{key}": cols[key][k], f"ratio_{key}": cols[key][k] / s[key[-2:]] if h in SOURCE else ""})
             if key != "particles_L2":
                 row[f"order_{key}"] = orders[key][k]
         for m in ("fem_consistent", "fem_lumped", "fv"):
