@@ -116,7 +116,7 @@ def test_one_set_of_settings_for_every_mesh():
     keys = set(study.MPM)
     for h, case in plan["mpm"].items():
         assert {k: case[k] for k in keys} == study.MPM, f"h={h} uses other settings"
-    assert set(plan["mpm"]) == set(study.H) == set(study.SOURCE)
+    assert set(plan["mpm"]) == set(study.H) >= set(study.SOURCE), "every mesh of the source's table is run"
 
 
 def _check_quick_outputs(folder, hs, ppc_h):
