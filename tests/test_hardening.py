@@ -228,7 +228,8 @@ def _alive(pid: int) -> bool:
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_ctrl_c_prints_one_line_and_exits_130(tmp_path):
     out = tmp_path / "run"
-    proc = subprocess.Popen([sys.executable, "-m", "mpm_fem.cli", "sod", "--h", "0.0005", "--ppc", "16", "--out", str(out)],
+    proc = subprocess.Popen([sys.executable, "-m", "mpm_fem.cli", "sod", "--h", "0.0005", "--ppc", "16", "--kernel", "numpy",
+                             "--out", str(out)],  # the numpy step: a run of ~1 min, still going at the signal
                             env=ENV, stderr=subprocess.PIPE, text=True)
     line = proc.stderr.readline()  # the estimate: the run has started
     assert "estimated" in line
