@@ -230,7 +230,9 @@ def test_ctrl_c_prints_one_line_and_exits_130(tmp_path):
     out = tmp_path / "run"
     proc = subprocess.Popen([sys.executable, "-m", "mpm_fem.cli", "sod", "--h", "0.0005", "--ppc", "16", "--kernel", "numpy",
                              "--out", str(out)],  # the numpy step: a run of ~1 min, still going at the signal
-                            env=ENV, stderr=subprocess.PIPE, text=True)
+                            env=ENV, stderr=subprocess.PIPE, text=True,
+                            # a shell's background job starts with SIGINT ignored; a user's terminal does not
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     line = proc.stderr.readline()  # the estimate: the run has started
     assert "estimated" in line
     time.sleep(1.0)
