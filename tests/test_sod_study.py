@@ -119,6 +119,13 @@ def test_one_set_of_settings_for_every_mesh():
     assert set(plan["mpm"]) == set(study.H) >= set(study.SOURCE), "every mesh of the source's table is run"
 
 
+def read_csv_rows(path):
+    import csv
+
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
 def _check_quick_outputs(folder, hs, ppc_h):
     """Every table and figure of a quick run exists, and the claims judge them from the tables."""
     from mpm_fem.claims import claims_of
@@ -156,4 +163,9 @@ def test_smoke_a_tiny_plan_writes_every_table_and_figure(tmp_path, monkeypatch):
     monkeypatch.setattr(study, "MPM", {**study.MPM, "ppc": 4, "cfl": 0.1})
     monkeypatch.setattr(study, "SOURCE", {0.04: (0.02, 0.03), 0.02: (0.01, 0.02)})
     study.run(StudyOptions(quick=True, jobs=1, out=tmp_path, progress=False))
-    _check_quick_outputs(tmp_path, tiny["H"], tiny["PPC_H"])
+    verdicts = _check_quick_outputs(tmp_path, tiny["H"], tiny["PPC_H"])
+    assert verdicts["E3"] == "confirmed", verdicts
+    rows = read_csv_rows(tmp_path / "sod" / "convergence.csv")
+    nodal = [float(r["mpm_nodes_L1"]) for r in rows]
+    assert [float(r["h"]) for r in rows] == list(tiny["H"])
+    assert 0 < nodal[1] < nodal[0] < 0.1, f"nodal density L1 {nodal} should fall from h = 0.04 to 0.02"
