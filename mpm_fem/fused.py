@@ -40,7 +40,7 @@ from .models.burgers import ViscousBurgers
 from .models.euler import IdealGas
 from .particles import Particles, PositivityError
 from .shape import Shape, make_shape
-from .step import SCHEMES, GridState, Stages
+from .step import SCHEMES, GridState, Stages, Walls
 from .transfer import divide_by_lumped, solve_consistent
 
 KERNELS = ("fused", "numpy")
@@ -422,19 +422,114 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
         speed[k] = top
 
 
-def _compile(fn, parallel, **constants):
+@njit(cache=True, inline="always")
+def _pymin(a, b):
+    """Python's ``min(a, b)``: ``b`` only if ``b < a`` (NaN and ties as in :func:`mpm_fem.solve.run`)."""
+    return b if b < a else a
+
+
+@njit(cache=True, inline="always")
+def _lumped_walls(rhs, m_i, ends, out):
+    """``out = rhs / m_i`` where ``m_i > 0``, else 0 (:func:`~mpm_fem.transfer.divide_by_lumped`),
+    then 0 at the wall nodes ``ends`` (:class:`~mpm_fem.step.Walls`)."""
+    for i in range(out.size):
+        out[i] = rhs[i] / m_i[i] if m_i[i] > 0 else 0.0
+    for i in ends:
+        out[i] = 0.0
+
+
+def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t, T, speed, fixed_dt, cfl, h_min,
+             refine, viscous_limit, steps, max_steps, budget, cell, rows, S, G, grid, flags, upd, values, speeds):
+    """Up to ``budget`` steps of :meth:`FusedStep.step` between walls with the lumped mass, each with
+    the time step :func:`mpm_fem.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL``
+    from the previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between
+    ``state[cur]`` and ``state[1 - cur]`` (fields in the order x, v, V, m, rho, eps, p). Stops before
+    a step that would fail or leave this path (the time step not positive and finite, ``max_steps``,
+    a particle outside the grid, a GIMP row of another width, lost positivity, a non-finite state):
+    the caller takes that step with :meth:`FusedStep.step`, which raises as the numpy step does.
+    Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
+    n = cell.size
+    gas = MODEL == GAS
+    eps = consts[4]
+    store = BASIS == 1
+    m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[0], grid[1], grid[2], grid[3], grid[4], grid[5], grid[6]
+    done, dt_min, dt_max = 0, np.inf, -np.inf
+    while done < budget and t < T * (1 - 1e-12):
+        if fixed_dt > 0:
+            base = fixed_dt
+        elif gas:
+            if not speed > 0:
+                break
+            base = cfl * h_min / speed
+        else:
+            advective = h_min / speed if speed > 0 else np.inf
+            base = cfl * _pymin(advective, h_min * h_min / (2.0 * eps)) if viscous_limit else cfl * advective
+        dt = _pymin(base / refine, T - t)
+        if not (dt > 0 and np.isfinite(dt)) or steps + done >= max_steps:
+            break
+        x, v, V, m, rho, e, p = state[cur, 0, :n], state[cur, 1, :n], state[cur, 2, :n], state[cur, 3, :n], \
+            state[cur, 4, :n], state[cur, 5, :n], state[cur, 6, :n]
+        o = 1 - cur
+        x_n, v_new, V_n, m_n, rho_n, e_n, p_n = state[o, 0, :n], state[o, 1, :n], state[o, 2, :n], state[o, 3, :n], \
+            state[o, 4, :n], state[o, 5, :n], state[o, 6, :n]
+        PROJECT(nodes, h, inv_spacing, x, V, m, v, p, gas and scheme != 1, store, chunks, rows, S, G, cell,
+                m_i, P_i, F_i, flags)
+        need = 2
+        for k in range(chunks):
+            need = max(need, flags[k, 2])
+        if (flags[:, :2] >= 0).any() or (store and need != WIDTH and n > 0):
+            break
+        _lumped_walls(P_i, m_i, ends, v_i)
+        if scheme == 1:  # USF: the state first, then its force
+            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, True, chunks,
+                   V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
+            if (upd >= 0).any():
+                break
+        elif not gas:
+            VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i)
+        _lumped_walls(F_i, m_i, ends, a_i)
+        for i in range(v_n.size):
+            v_n[i] = v_i[i] + dt * a_i[i]
+        if scheme == 0:
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, True, False,
+                 chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
+        elif scheme == 1:
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V_n, m, v, rho_n, e_n, p_n, dt, consts, False,
+                 False, chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
+        else:  # MUSL: move, re-project the momentum, then the state
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, False, True,
+                 chunks, x_n, v_new, V, m, rho, e, p, P_musl, flags, values, speeds)
+            _lumped_walls(P_musl, m_i, ends, v_n)
+            FINISH(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v_new, rho, e, p, dt, consts, chunks,
+                   V_n, m_n, rho_n, e_n, p_n, x_n, flags, values, speeds)
+        if (flags >= 0).any():
+            break
+        speed = speeds.max()
+        cur = 1 - cur
+        t += dt
+        done += 1
+        dt_min, dt_max = min(dt_min, dt), max(dt_max, dt)
+    return cur, t, done, speed, dt_min, dt_max
+
+
+def _compile(fn, parallel, passes=None, **constants):
     """``fn`` compiled serial or parallel, with ``constants`` (``BASIS``, ``MODEL``) as compile-time
     globals, so that the branches of the other bases and models drop out; each variant has its own
-    name, which keeps the on-disk caches apart."""
+    name, which keeps the on-disk caches apart. ``passes``: further globals (the compiled passes
+    the loop calls)."""
     suffix = "".join(f"_{k.lower()}{v}" for k, v in constants.items()) + ("_parallel" if parallel else "")
-    scope = dict(fn.__globals__, **constants)
+    scope = dict(fn.__globals__, **constants, **(passes or {}))
     variant = types.FunctionType(fn.__code__, scope, fn.__name__ + suffix, fn.__defaults__)
     variant.__qualname__ = variant.__name__
     return njit(cache=True, parallel=parallel)(variant)
 
 
 BASIS, MODEL, WIDTH = 0, 0, 3  # replaced per compiled variant
+PROJECT = VISCOUS = UPDATE = MOVE = FINISH = None  # the passes a compiled _advance calls
 _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
+_FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")  # Particles' names, same order
+_SCHEME_CODE = {"usl": 0, "usf": 1, "musl": 2}
+_PAD = 40  # doubles between advance's particle arrays: 5 cache lines, so that they do not share cache sets
 
 
 class _Passes:
@@ -447,7 +542,14 @@ class _Passes:
     def get(self, fn, **constants):
         key = (fn.__name__, tuple(sorted(constants.items())))
         if key not in self._made:
-            self._made[key] = _compile(fn, self.parallel, **constants)
+            passes = None
+            if fn is _advance:  # the loop calls this variant's passes, compiled into it
+                shape = dict(BASIS=constants["BASIS"], WIDTH=constants["WIDTH"])
+                passes = dict(PROJECT=self.get(_project, **shape), VISCOUS=self.get(_viscous_force, **shape),
+                              **{name: self.get(f, **constants) for name, f in
+                                 (("UPDATE", _update), ("MOVE", _move), ("FINISH", _finish))})
+                constants = dict(constants, THREADED=int(self.parallel))  # a name per variant
+            self._made[key] = _compile(fn, False if fn is _advance else self.parallel, passes, **constants)
         return self._made[key]
 
 
@@ -494,6 +596,10 @@ class FusedStep:
         self._width({"mpm": 2, "bspline": 4, "gimp": 3}[stages.basis])
         self.speed, self.finite = np.nan, True
         self.reuse, self._pools, self._turn = reuse, ({}, {}), 0
+        self._state = self._out = self._scratch = None  # advance's two sets of particle arrays, its last
+        self._cur = 0  # particles, and its scratch arrays
+        self._ends = np.ascontiguousarray(grid.boundary_nodes, dtype=np.intp)
+        self._h_min = float(grid.h.min())
 
     def _width(self, K):
         """Use the passes compiled for K nodes per particle (GIMP: 2 + the cells a domain spans)."""
@@ -527,6 +633,44 @@ class FusedStep:
                 q = int(flags[k, col])
                 if q >= 0:
                     raise PositivityError(quantity, q, float(x[q]), float(values[k, col]))
+
+    def loops(self, problem) -> bool:
+        """Whether :meth:`advance` can take the steps of ``problem``: walls, the lumped mass, the
+        calculated acceleration and the weak force (no particle boundary, no observer: the caller's)."""
+        return (type(problem.boundary) is Walls and self.stages.mass == "lumped"
+                and self.stages.acceleration == "calculated" and not self.slides)
+
+    def advance(self, particles: Particles, t: float, problem, steps: int, max_steps: int, budget: int):
+        """Up to ``budget`` steps from ``t`` in one compiled loop (:func:`_advance`), each the step
+        :meth:`step` takes with the time step :func:`mpm_fem.solve.run` takes after its first step
+        (from :attr:`speed`): the same numbers bit for bit. Returns ``(particles, t, steps taken,
+        dt_min, dt_max)``; zero steps when the next step must go through :meth:`step` (it fails, or
+        a GIMP particle's row changes width)."""
+        n, chunks = particles.n, max(1, min(self.threads, particles.n))
+        if self._out is not particles or self._state.shape[2] != n + _PAD:  # particles from elsewhere: copied into both sets (the mass of
+            self._state = np.empty((2, len(_FIELDS), n + _PAD))  # the gas, rho, eps, p of Burgers stay there)
+            self._state[:, :, :n] = [getattr(particles, name) for name in _FIELDS]
+            self._cur = 0
+        rows_n = n if self.basis == 1 else 0
+        if (self._scratch is None or self._scratch[0].size != n or self._scratch[1].shape != (rows_n, self.K)
+                or self._scratch[5].shape[0] != chunks):
+            self._scratch = (np.empty(n, np.intp), np.empty((rows_n, self.K), np.intp), np.empty((rows_n, self.K)),
+                             np.empty((rows_n, self.K)), np.empty((7, self.grid.n_nodes)),
+                             np.empty((chunks, 3), np.int64), np.empty((chunks, 2), np.int64), np.zeros((chunks, 2)),
+                             np.empty(chunks))
+        loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)
+        fixed = problem.dt if problem.dt is not None else 0.0
+        viscous = bool(getattr(self.model, "viscous_limit", False))
+        cur, t, done, speed, dt_min, dt_max = loop(
+            self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
+            chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
+            float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
+            *self._scratch)
+        if done:
+            self._cur, self.speed, self.finite = cur, float(speed), True
+            self._out = Particles(**{name: self._state[cur, j, :n] for j, name in enumerate(_FIELDS)})
+            particles = self._out
+        return particles, t, done, dt_min, dt_max
 
     def step(self, particles: Particles, t: float, dt: float) -> tuple[Particles, GridState]:
         grid = self.grid

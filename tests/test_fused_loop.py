@@ -1,0 +1,83 @@
+"""The fused step's compiled loop (FusedStep.advance, taken by solve.run between walls with the
+lumped mass) against the numpy step: the same time steps (CFL from each step's max(c + |v|) or
+max |v| with the viscous limit, the last step landing on T) and the same particles, bit for bit."""
+
+import numpy as np
+import pytest
+
+import mpm_fem.fused as fused_module
+from mpm_fem.grid import uniform_grid
+from mpm_fem.models.burgers import ViscousBurgers
+from mpm_fem.particles import make_particles, seed_positions
+from mpm_fem.models.euler import IdealGas
+from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
+from mpm_fem.solve import Problem, run
+from mpm_fem.step import Stages, Walls
+
+FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
+
+
+@pytest.fixture
+def loop_steps(monkeypatch):
+    """Counts the steps the compiled loop takes (the rest go through FusedStep.step)."""
+    taken = []
+    advance = fused_module.FusedStep.advance
+
+    def counting(self, *args, **kwargs):
+        out = advance(self, *args, **kwargs)
+        taken.append(out[2])
+        return out
+
+    monkeypatch.setattr(fused_module.FusedStep, "advance", counting)
+    return taken
+
+
+def _assert_same(a, b):
+    assert (a.steps, a.t, a.dt_min, a.dt_max) == (b.steps, b.t, b.dt_min, b.dt_max)
+    for name in FIELDS:
+        u, v = getattr(a.particles, name), getattr(b.particles, name)
+        assert np.array_equal(u, v), f"{name} differs by {float(np.max(np.abs(u - v))):.3g}"
+    assert np.array_equal(a.nodal_mass, b.nodal_mass) and np.array_equal(a.nodal_velocity, b.nodal_velocity)
+
+
+@pytest.mark.parametrize(("basis", "scheme"), [("mpm", "usl"), ("mpm", "usf"), ("mpm", "musl"), ("gimp", "usl"),
+                                               ("bspline", "usl"), ("gimp", "musl")])
+def test_sod_with_the_cfl_step_equals_the_numpy_step_bit_for_bit(basis, scheme, loop_steps):
+    """Sod's tube to T = 0.1 (about 300 steps of dt = CFL h / max(c + |v|), the last one shortened)."""
+    settings = dict(h=0.01, ppc=4, T=0.1, cfl=0.3, basis=basis, scheme=scheme)
+    reference = simulate(SodSettings(**settings, kernel="numpy"), progress=False)
+    fused = simulate(SodSettings(**settings), progress=False)
+    _assert_same(reference, fused)
+    assert sum(loop_steps) == fused.steps - 1  # every step but the first ran in the loop
+    assert fused.t == pytest.approx(0.1, rel=1e-12) and fused.dt_min < fused.dt_max
+
+
+@pytest.mark.parametrize("scheme", ["usl", "usf", "musl"])
+@pytest.mark.parametrize("refine", [1, 3])
+def test_burgers_between_walls_with_the_viscous_limit_equals_the_numpy_step(scheme, refine, loop_steps):
+    """dt = CFL min(h / max|v|, h^2 / (2 eps)) / refine: the advective limit rules at eps = 0.001
+    early on, the viscous one at eps = 0.02."""
+    grid = uniform_grid(0.0, 1.0, 0.02)
+    x, V = seed_positions(grid, 4)
+    particles = make_particles(x, V, 1.0, np.sin(2 * np.pi * x))
+    for eps in (0.001, 0.02):
+        problem = Problem(model=ViscousBurgers(eps), boundary=Walls(), T=0.05, cfl=0.5)
+        stages = Stages(scheme=scheme, refine=refine)
+        reference = run(problem, grid, particles, stages, progress=False, kernel="numpy")
+        fused = run(problem, grid, particles, stages, progress=False, kernel="fused")
+        _assert_same(reference, fused)
+    assert sum(loop_steps) > 0
+
+
+def test_the_loop_stops_where_the_run_must_fail(loop_steps):
+    """max_steps reached inside the loop: the same error as the numpy path, at the same step."""
+    settings = SodSettings(h=0.01, ppc=4, T=0.1, cfl=0.3)
+    grid = uniform_grid(*DOMAIN, settings.h)
+    problem = Problem(model=IdealGas(), boundary=Walls(), T=settings.T, cfl=settings.cfl)
+    errors = []
+    for kernel in ("numpy", "fused"):
+        with pytest.raises(RuntimeError) as err:
+            run(problem, grid, initial_particles(settings, grid), progress=False, max_steps=50, kernel=kernel)
+        errors.append(str(err.value))
+    assert errors[0] == errors[1] and "50 steps did not reach T=0.1" in errors[1]
+    assert sum(loop_steps) == 49
