@@ -41,7 +41,7 @@ from .models.euler import IdealGas
 from .particles import Particles, PositivityError
 from .shape import Shape, make_shape
 from .step import SCHEMES, GridState, Stages, Walls
-from .transfer import divide_by_lumped, solve_consistent
+from .transfer import solve_consistent
 
 KERNELS = ("fused", "numpy")
 GAS, BURGERS = 0, 1
@@ -175,6 +175,24 @@ def _finite(a, b, c, d, e, f):
             and np.isfinite(f))
 
 
+@njit(cache=True)
+def all_finite(x, v, rho, e, p, V):
+    """Whether every entry of the six particle arrays is finite (one pass; the run's check)."""
+    ok = True
+    for q in range(x.size):  # no branch per particle: the loop vectorizes
+        ok &= (np.isfinite(x[q]) & np.isfinite(v[q]) & np.isfinite(rho[q]) & np.isfinite(e[q]) & np.isfinite(p[q])
+               & np.isfinite(V[q]))
+    return ok
+
+
+@njit(cache=True)
+def _divide_by_lumped(rhs, m_i, out):
+    """:func:`~mpm_fem.transfer.divide_by_lumped` into ``out``: ``rhs_i / m_i`` where ``m_i > 0``, else 0."""
+    for i in range(out.size):
+        out[i] = rhs[i] / m_i[i] if m_i[i] > 0 else 0.0
+    return out
+
+
 def _chunk(n, chunks, k):
     return k * n // chunks, (k + 1) * n // chunks
 
@@ -198,6 +216,82 @@ def _row(basis, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl):
 # --------------------------------------------------------------------------- the passes
 # Written once; compiled per basis and model, serial (threads = 1) or parallel (threads > 1,
 # prange over the chunks). BASIS and MODEL are compile-time globals of each variant (_compile).
+# The helpers below are inlined; each keeps the numpy step's order of operations.
+
+@njit(cache=True, inline="always")
+def _one_row(K):
+    """Scratch for one particle's row: node indices, ``S_ip``, ``G_ip``."""
+    return np.empty(K, np.intp), np.empty(K), np.empty(K)
+
+
+@njit(cache=True, inline="always")
+def _gather(W, f, r, K):
+    """``sum_j W_j f_{r_j}``, left to right: ``(dv/dx)_p`` or ``v_p`` of one particle."""
+    s = W[0] * f[r[0]]
+    for j in range(1, K):
+        s += W[j] * f[r[j]]
+    return s
+
+
+@njit(cache=True, inline="always")
+def _scatter(buf, k, r, W, w, K):
+    """``buf[k, 0, r_j] += W_j w``: one particle's share of a nodal sum, into chunk k's buffer."""
+    for j in range(K):
+        buf[k, 0, r[j]] += W[j] * w
+
+
+@njit(cache=True, inline="always")
+def _sum_chunks(buf, j, out, sign):
+    """``out = sign sum_k buf[k, j]``, the chunks summed in their order."""
+    for i in range(out.size):
+        out[i] = sign * buf[0, j, i]
+    for k in range(1, buf.shape[0]):
+        for i in range(out.size):
+            out[i] += sign * buf[k, j, i]
+
+
+@njit(cache=True, inline="always")
+def _new_state(gas, q, L, dt, l, V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, bad, val):
+    """The model's update of particle q from ``L_p`` (gas: :meth:`IdealGas.update`; Burgers:
+    ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``). Records the first particle with a factor <= 0 in
+    ``bad[0]``, ``val[0]`` and (gas) with an energy <= 0 in ``bad[1]``, ``val[1]``. Returns the
+    sound speed (gas) or 0."""
+    if gas:
+        factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
+            rho[q], e[q], p[q], m[q], L, dt, l, consts[0], consts[1], consts[2], consts[3])
+        if bad[1] < 0 and not (e_new[q] > 0):
+            bad[1], val[1] = q, e_new[q]
+    else:
+        factor, c = 1.0 + L * dt, 0.0
+        V_new[q] = V[q] * factor
+        m_new[q] = V_new[q]
+    if bad[0] < 0 and not (factor > 0):
+        bad[0], val[0] = q, factor
+    return c
+
+
+@njit(cache=True, inline="always")
+def _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, bad, top):
+    """``max(top, c_p + |v_p|)`` (gas) or ``max(top, |v_p|)``; the first non-finite particle into ``bad[2]``."""
+    if gas:
+        top = max(top, c + abs(v_new[q]))
+        ok = _finite(x_new[q], v_new[q], rho_new[q], e_new[q], p_new[q], V_new[q])
+    else:
+        top = max(top, abs(v_new[q]))
+        ok = _finite(x_new[q], v_new[q], V_new[q], 0.0, 0.0, 0.0)
+    if bad[2] < 0 and not ok:
+        bad[2] = q
+    return top
+
+
+@njit(cache=True, inline="always")
+def _flags(k, bad, val, flags, values):
+    """Chunk k's first bad particles (and their values) into the pass's outputs."""
+    for j in range(flags.shape[1]):
+        flags[k, j] = bad[j]
+    for j in range(values.shape[1]):
+        values[k, j] = val[j]
+
 
 def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
              rows, S, G, cell, m_i, P_i, F_i, flags):
@@ -206,14 +300,14 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
     consistent mass and GIMP need them). ``flags[k] = (first particle outside the grid, first
     with V <= 0, the K it needs)`` of chunk k."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
+    K = WIDTH  # nodes per particle
     n_nodes = nodes.size
     a, b = nodes[0], nodes[n_nodes - 1]
     buf = np.zeros((chunks, 3, n_nodes))
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
         outside, empty, need = -1, -1, 0
-        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
+        r, Sl, Gl = _one_row(K)
         for q in range(lo, hi):
             if not (x[q] >= a and x[q] <= b):
                 if outside < 0:
@@ -238,37 +332,22 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
                 if gas_force:
                     buf[k, 2, i] += Gl[j] * Vp
         flags[k, 0], flags[k, 1], flags[k, 2] = outside, empty, need
-    for i in range(n_nodes):
-        m_i[i], P_i[i], F_i[i] = buf[0, 0, i], buf[0, 1, i], buf[0, 2, i]
-    for k in range(1, chunks):
-        for i in range(n_nodes):
-            m_i[i] += buf[k, 0, i]
-            P_i[i] += buf[k, 1, i]
-            F_i[i] += buf[k, 2, i]
+    for j, out in enumerate((m_i, P_i, F_i)):
+        _sum_chunks(buf, j, out, 1.0)
 
 
 def _viscous_force(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i):
     """Burgers' stress before the force: ``F_i = - sum_p V_p eps (sum_j G_jp v_j) G_ip``."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
-    n_nodes = F_i.size
-    buf = np.zeros((chunks, n_nodes))
+    K = WIDTH  # nodes per particle
+    buf = np.zeros((chunks, 1, F_i.size))
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
-        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
+        r, Sl, Gl = _one_row(K)
         for q in range(lo, hi):
             _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            L = Gl[0] * v_i[r[0]]
-            for j in range(1, K):
-                L += Gl[j] * v_i[r[j]]
-            w = V[q] * (eps * L)
-            for j in range(K):
-                buf[k, r[j]] += Gl[j] * w
-    for i in range(n_nodes):
-        F_i[i] = -buf[0, i]
-    for k in range(1, chunks):
-        for i in range(n_nodes):
-            F_i[i] -= buf[k, i]
+            _scatter(buf, k, r, Gl, V[q] * (eps * _gather(Gl, v_i, r, K)), K)
+    _sum_chunks(buf, 0, F_i, -1.0)
 
 
 def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, force, chunks,
@@ -277,44 +356,22 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
     of the updated state into ``F_i`` (if ``force``). ``flags[k] = (first particle with factor <= 0,
     first with energy <= 0)``, ``values[k]`` their values."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
-    n_nodes = F_i.size
-    gm1, g_gm1, c_lin, c_quad, eps = consts[0], consts[1], consts[2], consts[3], consts[4]
-    buf = np.zeros((chunks, n_nodes))
+    K = WIDTH  # nodes per particle
+    gas, eps = MODEL == GAS, consts[4]
+    buf = np.zeros((chunks, 1, F_i.size))
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
-        bad_f, bad_e, val_f, val_e = -1, -1, 0.0, 0.0
-        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
+        bad, val = np.full(2, -1, np.int64), np.zeros(2)
+        r, Sl, Gl = _one_row(K)
         for q in range(lo, hi):
-            factor, w = 0.0, 0.0
             c = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            L = Gl[0] * v_i[r[0]]
-            for j in range(1, K):
-                L += Gl[j] * v_i[r[j]]
-            if MODEL == GAS:
-                factor, rho_new[q], e_new[q], p_new[q], V_new[q], _ = _gas_update(
-                    rho[q], e[q], p[q], m[q], L, dt, h[c], gm1, g_gm1, c_lin, c_quad)
-                w = V_new[q] * p_new[q]
-                if bad_e < 0 and not (e_new[q] > 0):
-                    bad_e, val_e = q, e_new[q]
-            else:
-                factor = 1.0 + L * dt
-                V_new[q] = V[q] * factor
-                m_new[q] = V_new[q]
-                w = -(V_new[q] * (eps * L))
-            if bad_f < 0 and not (factor > 0):
-                bad_f, val_f = q, factor
+            L = _gather(Gl, v_i, r, K)
+            _new_state(gas, q, L, dt, h[c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, bad, val)
             if force:
-                for j in range(K):
-                    buf[k, r[j]] += Gl[j] * w
-        flags[k, 0], flags[k, 1] = bad_f, bad_e
-        values[k, 0], values[k, 1] = val_f, val_e
+                _scatter(buf, k, r, Gl, V_new[q] * p_new[q] if gas else -(V_new[q] * (eps * L)), K)
+        _flags(k, bad, val, flags, values)
     if force:
-        for i in range(n_nodes):
-            F_i[i] = buf[0, i]
-        for k in range(1, chunks):
-            for i in range(n_nodes):
-                F_i[i] += buf[k, i]
+        _sum_chunks(buf, 0, F_i, 1.0)
 
 
 def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
@@ -324,16 +381,14 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
     ``c_p + |v_p|`` (gas) or ``|v_p|`` (Burgers) over chunk k; ``flags[k] = (first bad factor,
     first bad energy, first non-finite particle)``."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
-    n_nodes = P_i.size
-    gm1, g_gm1, c_lin, c_quad = consts[0], consts[1], consts[2], consts[3]
-    buf = np.zeros((chunks if musl else 1, n_nodes))
+    K = WIDTH  # nodes per particle
+    gas, g_gm1 = MODEL == GAS, consts[1]
+    buf = np.zeros((chunks if musl else 1, 1, P_i.size))
     for k in prange(chunks):
         lo, hi = _chunk(n, chunks, k)
-        bad_f, bad_e, bad_n, val_f, val_e, top = -1, -1, -1, 0.0, 0.0, 0.0
-        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
+        bad, val, top = np.full(3, -1, np.int64), np.zeros(2), 0.0
+        r, Sl, Gl = _one_row(K)
         for q in range(lo, hi):
-            factor, c = 0.0, 0.0
             cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             acc = Sl[0] * a_i[r[0]]
             vel = Sl[0] * v_n[r[0]]
@@ -343,44 +398,18 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
             v_new[q] = v[q] + dt * acc
             x_new[q] = x[q] + dt * vel
             if musl:
-                mv = m[q] * v_new[q]
-                for j in range(K):
-                    buf[k, r[j]] += Sl[j] * mv
+                _scatter(buf, k, r, Sl, m[q] * v_new[q], K)
                 continue
             if usl:
-                L = Gl[0] * v_n[r[0]]
-                for j in range(1, K):
-                    L += Gl[j] * v_n[r[j]]
-                if MODEL == GAS:
-                    factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
-                        rho[q], e[q], p[q], m[q], L, dt, h[cq], gm1, g_gm1, c_lin, c_quad)
-                    if bad_e < 0 and not (e_new[q] > 0):
-                        bad_e, val_e = q, e_new[q]
-                else:
-                    factor = 1.0 + L * dt
-                    V_new[q] = V[q] * factor
-                    m_new[q] = V_new[q]
-                if bad_f < 0 and not (factor > 0):
-                    bad_f, val_f = q, factor
-            if MODEL == GAS:
-                if not usl:
-                    c = np.sqrt(g_gm1 * max(e_new[q], 0.0))
-                top = max(top, c + abs(v_new[q]))
-                ok = _finite(x_new[q], v_new[q], rho_new[q], e_new[q], p_new[q], V_new[q])
+                c = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[cq], V, m, rho, e, p,
+                               V_new, m_new, rho_new, e_new, p_new, consts, bad, val)
             else:
-                top = max(top, abs(v_new[q]))
-                ok = _finite(x_new[q], v_new[q], V_new[q], 0.0, 0.0, 0.0)
-            if bad_n < 0 and not ok:
-                bad_n = q
-        flags[k, 0], flags[k, 1], flags[k, 2] = bad_f, bad_e, bad_n
-        values[k, 0], values[k, 1] = val_f, val_e
+                c = np.sqrt(g_gm1 * max(e_new[q], 0.0)) if gas else 0.0
+            top = _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, bad, top)
+        _flags(k, bad, val, flags, values)
         speed[k] = top
     if musl:
-        for i in range(n_nodes):
-            P_i[i] = buf[0, i]
-        for k in range(1, chunks):
-            for i in range(n_nodes):
-                P_i[i] += buf[k, i]
+        _sum_chunks(buf, 0, P_i, 1.0)
 
 
 def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p, dt, consts, chunks,
@@ -388,37 +417,17 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
     """MUSL's last pass: the state update from ``L_p = sum_i G_ip v_i^{n+1}`` (re-projected; the
     shape at ``x_p^n``), the speed and the checks, as in :func:`_move`."""
     n = x.size
-    K = 2 if BASIS == 0 else (4 if BASIS == 2 else WIDTH)
-    gm1, g_gm1, c_lin, c_quad = consts[0], consts[1], consts[2], consts[3]
+    K = WIDTH  # nodes per particle
+    gas = MODEL == GAS
     for k in prange(chunks):
-        lo, hi = _chunk(n, chunks, k)
-        bad_f, bad_e, bad_n, val_f, val_e, top = -1, -1, -1, 0.0, 0.0, 0.0
-        r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
-        for q in range(lo, hi):
-            factor, c = 0.0, 0.0
+        r, Sl, Gl = _one_row(K)
+        bad, val, top = np.full(3, -1, np.int64), np.zeros(2), 0.0
+        for q in range(*_chunk(n, chunks, k)):
             cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            L = Gl[0] * v_n[r[0]]
-            for j in range(1, K):
-                L += Gl[j] * v_n[r[j]]
-            if MODEL == GAS:
-                factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
-                    rho[q], e[q], p[q], m[q], L, dt, h[cq], gm1, g_gm1, c_lin, c_quad)
-                if bad_e < 0 and not (e_new[q] > 0):
-                    bad_e, val_e = q, e_new[q]
-                top = max(top, c + abs(v[q]))
-                ok = _finite(x_new[q], v[q], rho_new[q], e_new[q], p_new[q], V_new[q])
-            else:
-                factor = 1.0 + L * dt
-                V_new[q] = V[q] * factor
-                m_new[q] = V_new[q]
-                top = max(top, abs(v[q]))
-                ok = _finite(x_new[q], v[q], V_new[q], 0.0, 0.0, 0.0)
-            if bad_f < 0 and not (factor > 0):
-                bad_f, val_f = q, factor
-            if bad_n < 0 and not ok:
-                bad_n = q
-        flags[k, 0], flags[k, 1], flags[k, 2] = bad_f, bad_e, bad_n
-        values[k, 0], values[k, 1] = val_f, val_e
+            c = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[cq], V, m, rho, e, p,
+                           V_new, m_new, rho_new, e_new, p_new, consts, bad, val)
+            top = _checked(gas, q, c, x_new, v, rho_new, e_new, p_new, V_new, bad, top)
+        _flags(k, bad, val, flags, values)
         speed[k] = top
 
 
@@ -432,8 +441,7 @@ def _pymin(a, b):
 def _lumped_walls(rhs, m_i, ends, out):
     """``out = rhs / m_i`` where ``m_i > 0``, else 0 (:func:`~mpm_fem.transfer.divide_by_lumped`),
     then 0 at the wall nodes ``ends`` (:class:`~mpm_fem.step.Walls`)."""
-    for i in range(out.size):
-        out[i] = rhs[i] / m_i[i] if m_i[i] > 0 else 0.0
+    _divide_by_lumped(rhs, m_i, out)
     for i in ends:
         out[i] = 0.0
 
@@ -620,9 +628,9 @@ class FusedStep:
             a = pool[name] = np.empty(shape, dtype)
         return a
 
-    def _solve(self, shape, mass, m_i, rhs):
+    def _solve(self, shape, mass, m_i, rhs, name="v_solved"):
         if self.stages.mass == "lumped":
-            return divide_by_lumped(rhs, m_i)
+            return _divide_by_lumped(rhs, m_i, self._empty(name, m_i.shape))
         return solve_consistent(shape, mass, rhs)
 
     def _positivity(self, flags, values, x):
@@ -650,6 +658,7 @@ class FusedStep:
         if self._out is not particles or self._state.shape[2] != n + _PAD:  # particles from elsewhere: copied into both sets (the mass of
             self._state = np.empty((2, len(_FIELDS), n + _PAD))  # the gas, rho, eps, p of Burgers stay there)
             self._state[:, :, :n] = [getattr(particles, name) for name in _FIELDS]
+            self._pools = ({}, {})  # the per-step arrays: refilled if a step falls back to step()
             self._cur = 0
         rows_n = n if self.basis == 1 else 0
         if (self._scratch is None or self._scratch[0].size != n or self._scratch[1].shape != (rows_n, self.K)
@@ -722,7 +731,7 @@ class FusedStep:
         elif self.slides:
             a_i = self.model.grid_acceleration(grid, cell, v_i)
         else:
-            a_i = self._solve(shape, m, m_i, F_i)
+            a_i = self._solve(shape, m, m_i, F_i, "a_solved")
         a_i = self.boundary.acceleration(grid, a_i, v_i, t, dt)
         v_n = v_i + dt * a_i
 
@@ -738,7 +747,7 @@ class FusedStep:
         self.move(*geometry, rows, S, G, cell, a_i, v_n, x, state[0], state[1], v, state[2], state[3], state[4],
                   dt, self.consts, usl, musl, chunks, x_new, vel_new, *state[5:], P_musl, flags, values, speed)
         if musl:
-            v_n = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_musl), t + dt)
+            v_n = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_musl, "v_musl"), t + dt)
             self.finish(*shape_args, v_n, V, m, vel_new, rho, e, p, dt, self.consts, chunks,
                         V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed)
         if usl or musl:
