@@ -251,46 +251,61 @@ def _sum_chunks(buf, j, out, sign):
 
 
 @njit(cache=True, inline="always")
-def _new_state(gas, q, L, dt, l, V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, bad, val):
+def _first(bad, value_at_bad, q, value):
+    """The first particle whose ``value`` is not > 0, and that value: ``(q, value)`` if none yet."""
+    if bad < 0 and not (value > 0):
+        return float(q), value
+    return bad, value_at_bad
+
+
+@njit(cache=True, inline="always")
+def _new_state(gas, q, L, dt, l, V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, tally):
     """The model's update of particle q from ``L_p`` (gas: :meth:`IdealGas.update`; Burgers:
-    ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``). Records the first particle with a factor <= 0 in
-    ``bad[0]``, ``val[0]`` and (gas) with an energy <= 0 in ``bad[1]``, ``val[1]``. Returns the
-    sound speed (gas) or 0."""
+    ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``). ``tally = (first particle with a factor <= 0, first
+    with an energy <= 0 (gas), first non-finite, their two values, max speed, this particle's sound
+    speed)`` is returned updated. Seven floats (indices < 2^53 are exact), not arrays: the tally
+    stays in registers, and numba's parallel analysis takes it (it mistakes integer tuples for shapes)."""
+    bad_f, bad_e, bad_n, val_f, val_e, top, _ = tally
     if gas:
         factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
             rho[q], e[q], p[q], m[q], L, dt, l, consts[0], consts[1], consts[2], consts[3])
-        if bad[1] < 0 and not (e_new[q] > 0):
-            bad[1], val[1] = q, e_new[q]
+        bad_e, val_e = _first(bad_e, val_e, q, e_new[q])
     else:
         factor, c = 1.0 + L * dt, 0.0
         V_new[q] = V[q] * factor
         m_new[q] = V_new[q]
-    if bad[0] < 0 and not (factor > 0):
-        bad[0], val[0] = q, factor
-    return c
+    bad_f, val_f = _first(bad_f, val_f, q, factor)
+    return bad_f, bad_e, bad_n, val_f, val_e, top, c
 
 
 @njit(cache=True, inline="always")
-def _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, bad, top):
-    """``max(top, c_p + |v_p|)`` (gas) or ``max(top, |v_p|)``; the first non-finite particle into ``bad[2]``."""
+def _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, tally):
+    """The tally with ``max(top, c_p + |v_p|)`` (gas) or ``max(top, |v_p|)``, and the first
+    non-finite particle."""
+    bad_f, bad_e, bad_n, val_f, val_e, top, _ = tally
     if gas:
         top = max(top, c + abs(v_new[q]))
         ok = _finite(x_new[q], v_new[q], rho_new[q], e_new[q], p_new[q], V_new[q])
     else:
         top = max(top, abs(v_new[q]))
         ok = _finite(x_new[q], v_new[q], V_new[q], 0.0, 0.0, 0.0)
-    if bad[2] < 0 and not ok:
-        bad[2] = q
-    return top
+    if bad_n < 0 and not ok:
+        bad_n = float(q)
+    return bad_f, bad_e, bad_n, val_f, val_e, top, c
 
 
 @njit(cache=True, inline="always")
-def _flags(k, bad, val, flags, values):
-    """Chunk k's first bad particles (and their values) into the pass's outputs."""
-    for j in range(flags.shape[1]):
-        flags[k, j] = bad[j]
-    for j in range(values.shape[1]):
-        values[k, j] = val[j]
+def _flags(k, tally, flags, values):
+    """Chunk k's tally into the pass's outputs: ``flags[k]`` (the first bad particles: factor,
+    energy and, if it has three columns, non-finite), ``values[k]`` (the two values); returns the speed."""
+    flags[k, 0], flags[k, 1] = int(tally[0]), int(tally[1])
+    if flags.shape[1] > 2:
+        flags[k, 2] = int(tally[2])
+    values[k, 0], values[k, 1] = tally[3], tally[4]
+    return tally[5]
+
+
+_NO_TALLY = (-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0)  # no bad particle yet, speed 0
 
 
 def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
@@ -342,9 +357,8 @@ def _viscous_force(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chun
     K = WIDTH  # nodes per particle
     buf = np.zeros((chunks, 1, F_i.size))
     for k in prange(chunks):
-        lo, hi = _chunk(n, chunks, k)
         r, Sl, Gl = _one_row(K)
-        for q in range(lo, hi):
+        for q in range(*_chunk(n, chunks, k)):
             _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             _scatter(buf, k, r, Gl, V[q] * (eps * _gather(Gl, v_i, r, K)), K)
     _sum_chunks(buf, 0, F_i, -1.0)
@@ -360,16 +374,16 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
     gas, eps = MODEL == GAS, consts[4]
     buf = np.zeros((chunks, 1, F_i.size))
     for k in prange(chunks):
-        lo, hi = _chunk(n, chunks, k)
-        bad, val = np.full(2, -1, np.int64), np.zeros(2)
+        tally = _NO_TALLY
         r, Sl, Gl = _one_row(K)
-        for q in range(lo, hi):
+        for q in range(*_chunk(n, chunks, k)):
             c = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             L = _gather(Gl, v_i, r, K)
-            _new_state(gas, q, L, dt, h[c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, bad, val)
+            tally = _new_state(gas, q, L, dt, h[c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts,
+                               tally)
             if force:
                 _scatter(buf, k, r, Gl, V_new[q] * p_new[q] if gas else -(V_new[q] * (eps * L)), K)
-        _flags(k, bad, val, flags, values)
+        _flags(k, tally, flags, values)
     if force:
         _sum_chunks(buf, 0, F_i, 1.0)
 
@@ -385,10 +399,9 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
     gas, g_gm1 = MODEL == GAS, consts[1]
     buf = np.zeros((chunks if musl else 1, 1, P_i.size))
     for k in prange(chunks):
-        lo, hi = _chunk(n, chunks, k)
-        bad, val, top = np.full(3, -1, np.int64), np.zeros(2), 0.0
+        tally = _NO_TALLY
         r, Sl, Gl = _one_row(K)
-        for q in range(lo, hi):
+        for q in range(*_chunk(n, chunks, k)):
             cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             acc = Sl[0] * a_i[r[0]]
             vel = Sl[0] * v_n[r[0]]
@@ -401,13 +414,13 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
                 _scatter(buf, k, r, Sl, m[q] * v_new[q], K)
                 continue
             if usl:
-                c = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[cq], V, m, rho, e, p,
-                               V_new, m_new, rho_new, e_new, p_new, consts, bad, val)
+                tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[cq], V, m, rho, e, p,
+                                   V_new, m_new, rho_new, e_new, p_new, consts, tally)
+                c = tally[6]
             else:
                 c = np.sqrt(g_gm1 * max(e_new[q], 0.0)) if gas else 0.0
-            top = _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, bad, top)
-        _flags(k, bad, val, flags, values)
-        speed[k] = top
+            tally = _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+        speed[k] = _flags(k, tally, flags, values)
     if musl:
         _sum_chunks(buf, 0, P_i, 1.0)
 
@@ -421,14 +434,13 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
     gas = MODEL == GAS
     for k in prange(chunks):
         r, Sl, Gl = _one_row(K)
-        bad, val, top = np.full(3, -1, np.int64), np.zeros(2), 0.0
+        tally = _NO_TALLY
         for q in range(*_chunk(n, chunks, k)):
             cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            c = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[cq], V, m, rho, e, p,
-                           V_new, m_new, rho_new, e_new, p_new, consts, bad, val)
-            top = _checked(gas, q, c, x_new, v, rho_new, e_new, p_new, V_new, bad, top)
-        _flags(k, bad, val, flags, values)
-        speed[k] = top
+            tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[cq], V, m, rho, e, p,
+                               V_new, m_new, rho_new, e_new, p_new, consts, tally)
+            tally = _checked(gas, q, tally[6], x_new, v, rho_new, e_new, p_new, V_new, tally)
+        speed[k] = _flags(k, tally, flags, values)
 
 
 @njit(cache=True, inline="always")
