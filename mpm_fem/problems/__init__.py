@@ -16,23 +16,30 @@ from ..particles import LAYOUTS
 # Bytes and seconds of one run, measured and then given a margin (stated, not tuned per run):
 # the particle state plus the peak of one step is 212-250 B per particle (benchmarks/step_cost.py,
 # README "Performance"); the grid with its scikit-fem basis and mass matrices peaks at 320 B per
-# node; the run keeps one time step (a Python float in a list, 32 B) per step. A step costs
-# 1.5e-7 to 3.2e-7 s per particle plus about 0.7 ms (Sod, 4 and 16 particles per cell, 2 cores).
+# node; 32 B per step are kept as a margin (the run once kept every time step). A step costs, in
+# CPU time on a shared 2-core machine: the numpy step 1.5e-7 to 3.2e-7 s per particle plus about
+# 0.7 ms (Sod, 4 and 16 particles per cell); the fused step 3e-8 s per particle (P1; GIMP, the
+# B-spline and the consistent mass 7e-8 to 1.6e-7) plus 4 us (walls: the compiled loop) to
+# 0.13 ms (Burgers: one call per step, its inflow and Dirichlet data in Python).
+# The fused constants apply where the fused step runs (not the exact stages, not the remedies).
 BYTES_PER_PARTICLE = 400
 BYTES_PER_NODE = 400
 BYTES_PER_STEP = 32
-SECONDS_PER_PARTICLE_STEP = 3e-7
-SECONDS_PER_STEP = 1e-3
+SECONDS_PER_PARTICLE_STEP = {"numpy": 3e-7, "fused": 1e-7}
+SECONDS_PER_STEP = {"numpy": 1e-3, "fused": 3e-4}
 
 
 @dataclass(frozen=True)
 class Cost:
     """The estimated size of a run: particles ``n_p``, grid nodes, time steps; from these the
-    bytes ``400 n_p + 400 nodes + 32 steps`` and the seconds ``steps (3e-7 n_p + 1e-3)``."""
+    bytes ``400 n_p + 400 nodes + 32 steps`` and the seconds ``steps (a n_p + b)`` with the
+    constants of the ``kernel`` that takes the steps (numpy: a = 3e-7 s, b = 1e-3 s; fused: 1e-7 s,
+    3e-4 s)."""
 
     particles: int
     nodes: int
     steps: int
+    kernel: str = "numpy"
 
     @property
     def bytes(self) -> int:
@@ -40,7 +47,8 @@ class Cost:
 
     @property
     def seconds(self) -> float:
-        return self.steps * (SECONDS_PER_PARTICLE_STEP * self.particles + SECONDS_PER_STEP)
+        per_particle, per_step = SECONDS_PER_PARTICLE_STEP[self.kernel], SECONDS_PER_STEP[self.kernel]
+        return self.steps * (per_particle * self.particles + per_step)
 
     def as_dict(self) -> dict:
         return {"particles": self.particles, "nodes": self.nodes, "steps": self.steps, "bytes": self.bytes,
@@ -53,7 +61,9 @@ def run_cost(settings, domain: tuple[float, float], max_speed: float, dt_cap: fl
     n_cells = n_cells_for(*domain, settings.h)
     dt = settings.cfl * min(settings.h / max_speed if max_speed > 0 else math.inf, dt_cap) / settings.refine
     steps = math.ceil(settings.T / dt) if settings.T > 0 else 0
-    return Cost(particles=n_cells * settings.ppc, nodes=n_cells + 1, steps=steps)
+    stages = settings.stages
+    fused = settings.kernel == "fused" and not (stages.uses_exact_fields or stages.uses_remedy)
+    return Cost(particles=n_cells * settings.ppc, nodes=n_cells + 1, steps=steps, kernel="fused" if fused else "numpy")
 
 
 def check_run_settings(settings, domain: tuple[float, float]) -> None:
