@@ -77,8 +77,9 @@ class Stages:
             raise ValueError("the exact projection, mass and interpolation stages are defined for USL and USF only")
         if isinstance(self.flip, bool) or not isinstance(self.flip, (int, float, np.number)) or not 0 <= self.flip <= 1:
             raise ValueError(f"the PIC/FLIP blend must lie in [0, 1] (1: FLIP, 0: PIC), got {self.flip!r}")
-        if self.uses_exact_fields and self.uses_remedy:
-            raise ValueError("the remedies (flip, reconstruct, volume, bspline_gimp) run with the MPM stages only")
+        if self.uses_exact_fields and (self.flip != 1 or self.reconstruct != "none" or self.volume != "carried"):
+            raise ValueError("the remedies flip, reconstruct and volume run with the MPM stages only "
+                             "(the basis bspline_gimp also with the exact stages)")
 
     @property
     def uses_remedy(self) -> bool:
