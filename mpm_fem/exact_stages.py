@@ -13,8 +13,8 @@ error budget (E1) additive. With ``f*`` the exact field a stage should deliver:
                                         round-off for piecewise-polynomial fields)
     mass (FE + lumping, grid solve)     u_i = u*(x_i) + [solve(MPM data) - solve(exact data)]:
                                         the solve makes no error of its own on exact data
-                                        (exact data: the FE mass matrices of the exact density,
-                                        assembled by scikit-fem, :func:`fe_mass`)
+                                        (exact data: the FE mass matrices of the exact density
+                                        on scikit-fem's basis, :func:`fe_mass`)
     interpolation (grid -> particles)   f_p = f*(x_p) + sum_i S_ip (f_i - f*_i): the interpolant is
                                         exact for the exact field; the nodal error still reaches
                                         the particle
@@ -243,7 +243,7 @@ def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float, with
     The quadrature points act as particles of mass ``w_q rho_q`` and volume ``w_q``, so ``m_i`` and the consistent
     mass ``int rho S_i S_j`` come from the same code as the particle mass matrix. ``with_fe_mass``
     (the exact form of the mass stage): the mass matrices are instead the FE mass of
-    :func:`fe_mass`, assembled by scikit-fem, ``m_i`` its row sums (the same integrals).
+    :func:`fe_mass` (on scikit-fem's basis), ``m_i`` its row sums (the same integrals).
     """
     x, w = quadrature(grid, fields.breakpoints(t))
     rho, v, sigma = fields.integrand(x, t)
