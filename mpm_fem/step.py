@@ -40,7 +40,23 @@ STAGE_MASS = MASS_KINDS + ("exact",)
 
 
 @dataclass(frozen=True)
-class Stages:
+class StageSwitches:
+    """The stage switches of :class:`Stages` that every run's settings carry (all but the
+    acceleration, which only a problem with an exact one offers)."""
+
+    basis: str = "mpm"
+    mass: str = "lumped"
+    scheme: str = "usl"
+    projection: str = "mpm"
+    interpolation: str = "mpm"
+    refine: int = 1
+    flip: float = 1.0
+    reconstruct: str = "none"
+    volume: str = "carried"
+
+
+@dataclass(frozen=True)
+class Stages(StageSwitches):
     """Which form each stage of the step takes.
 
     ``basis``: ``"mpm"`` (point mass), ``"gimp"`` or ``"bspline"``; ``mass``: ``"lumped"``,
@@ -53,16 +69,7 @@ class Stages:
     ``"carried"`` or ``"grid"``, and the basis ``"bspline_gimp"``.
     """
 
-    basis: str = "mpm"
-    mass: str = "lumped"
     acceleration: str = "calculated"
-    scheme: str = "usl"
-    projection: str = "mpm"
-    interpolation: str = "mpm"
-    refine: int = 1
-    flip: float = 1.0
-    reconstruct: str = "none"
-    volume: str = "carried"
 
     def __post_init__(self):
         for name, allowed in (("basis", BASES), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
