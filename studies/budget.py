@@ -22,8 +22,12 @@ terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) -
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.0025 (GIMP, B-spline to 0.005), Burgers 0.04 ... 0.01: ~8 min on 2 cores on the
-numpy path (Sod to 0.000625 and Burgers to 0.005 with every basis: ~2.7 h). E2: Sod, each basis in MPM form.
+Meshes: Sod h = 0.01 ... 0.0025 (GIMP and both B-splines to 0.005), Burgers 0.04 ... 0.01. A Sod case
+(16 runs, the exact stages on the numpy path) measured in CPU seconds, P1 / GIMP / B-spline /
+particle-domain B-spline: h = 0.01: 18 / 35 / 25 / 38; 0.005: 54 / 112 / 90 / 120; 0.0025: 134 (P1; the
+others ~300 / 225 / 360 from their measured time per step); 0.00125: ~445 / 1340 / 820 / 1370; 0.000625:
+P1 ~1840. The plan as it stands is ~13 CPU-minutes; every basis to 0.00125 would add ~1.4 CPU-hours.
+E2: Sod, each basis in MPM form.
 """
 
 from __future__ import annotations
