@@ -74,6 +74,7 @@ class BurgersSettings:
     flip: float = 1.0
     reconstruct: str = "none"
     volume: str = "carried"
+    xpic: int = 0
     kernel: str = "fused"
     threads: int = 1
 
@@ -101,7 +102,7 @@ class BurgersSettings:
     def stages(self) -> Stages:
         return Stages(basis=self.basis, mass=self.mass, acceleration=self.acceleration, scheme=self.scheme,
                       projection=self.projection, interpolation=self.interpolation, refine=self.refine,
-                      flip=self.flip, reconstruct=self.reconstruct, volume=self.volume)
+                      flip=self.flip, reconstruct=self.reconstruct, volume=self.volume, xpic=self.xpic)
 
     def as_dict(self) -> dict:
         return asdict(self)

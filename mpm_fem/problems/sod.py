@@ -59,6 +59,7 @@ class SodSettings:
     flip: float = 1.0
     reconstruct: str = "none"
     volume: str = "carried"
+    xpic: int = 0
     kernel: str = "fused"
     threads: int = 1
 
@@ -77,7 +78,7 @@ class SodSettings:
     def stages(self) -> Stages:
         return Stages(basis=self.basis, mass=self.mass, scheme=self.scheme, projection=self.projection,
                       interpolation=self.interpolation, refine=self.refine, flip=self.flip,
-                      reconstruct=self.reconstruct, volume=self.volume)
+                      reconstruct=self.reconstruct, volume=self.volume, xpic=self.xpic)
 
     def as_dict(self) -> dict:
         return asdict(self)
