@@ -57,6 +57,17 @@ def test_burgers_below_first_order_is_partly():
     assert v == "partly"
 
 
+def test_a_remedy_stopped_before_the_finest_sod_mesh_removes_no_plateau():
+    """Good orders on the three coarse meshes only: not a remover (the plateau shows on fine meshes)."""
+    coarse = rows("sod", "fix", nodes=GOOD_SOD["nodes"][:3], particles=GOOD_SOD["particles"][:3], fv=FV)
+    full = table()
+    stopped = {"errors": [r for r in full["errors"] if not (r["problem"] == "sod" and r["remedy"] == "fix")] + coarse}
+    assert assess(coarse)["removes_plateau"]
+    v, evidence = verdict(stopped)
+    assert v == "refuted" and "over h = 0.01..0.0025" in evidence
+    assert verdict(full)[0] == "confirmed"
+
+
 def test_a_failed_run_counts_as_not_converging():
     sod = dict(GOOD_SOD, nodes=[0.009, 0.0045, 0.00225, float("nan")])
     assert verdict(table(sod=sod))[0] == "refuted"
