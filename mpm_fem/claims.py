@@ -701,7 +701,8 @@ def _e5(t: Tables) -> tuple[str, str]:
             f"{s['max_fv_ratio_particles_L1']:.2f}x the FV error")
     text += (f"; Burgers (4 per cell) fitted orders {b['fitted_order_nodes_L1']:.2f} / {b['fitted_order_particles_L1']:.2f}, "
              f"lowest successive {min(b['min_order_nodes_L1'], b['min_order_particles_L1']):.2f}" if b else "; Burgers not run")
-    removers = [n for _, n, sc, *_ in scored if sc["removes_plateau"]]
+    removers = [f"{n} ({sc['max_fv_ratio_nodes_L1']:.2f}x / {sc['max_fv_ratio_particles_L1']:.2f}x FV)"
+                for _, n, sc, *_ in scored if sc["removes_plateau"]]
     if s["removes_plateau"] and fv and b_ok:
         return "confirmed", "meets the goal: " + text
     if removers:
