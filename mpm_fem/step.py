@@ -41,7 +41,24 @@ STAGE_MASS = MASS_KINDS + ("exact",)
 
 
 @dataclass(frozen=True)
-class Stages:
+class StageSwitches:
+    """The stage switches of :class:`Stages` that every run's settings carry (all but the
+    acceleration, which only a problem with an exact one offers)."""
+
+    basis: str = "mpm"
+    mass: str = "lumped"
+    scheme: str = "usl"
+    projection: str = "mpm"
+    interpolation: str = "mpm"
+    refine: int = 1
+    flip: float = 1.0
+    reconstruct: str = "none"
+    volume: str = "carried"
+    xpic: int = 0
+
+
+@dataclass(frozen=True)
+class Stages(StageSwitches):
     """Which form each stage of the step takes.
 
     ``basis``: ``"mpm"`` (point mass), ``"gimp"`` or ``"bspline"``; ``mass``: ``"lumped"``,
@@ -55,17 +72,7 @@ class Stages:
     ``"taylor"``, ``volume`` ``"carried"`` or ``"grid"``, and the basis ``"bspline_gimp"``.
     """
 
-    basis: str = "mpm"
-    mass: str = "lumped"
     acceleration: str = "calculated"
-    scheme: str = "usl"
-    projection: str = "mpm"
-    interpolation: str = "mpm"
-    refine: int = 1
-    flip: float = 1.0
-    reconstruct: str = "none"
-    volume: str = "carried"
-    xpic: int = 0
 
     def __post_init__(self):
         for name, allowed in (("basis", BASES), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
