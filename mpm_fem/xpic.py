@@ -20,12 +20,13 @@ grid sum of ``m`` terms,
     v* = sum_{k=0}^{m-1} [P (I - B)]^k v_i,     B u = S+ (S u)   (interpolate, then project back),
 
 where ``P`` is the boundary rule applied to a velocity change (zero where the boundary prescribes
-the velocity: walls, Dirichlet data). This equals the paper's alternating binomial form
-``v* = sum_{k=1}^{m} (-1)^{k+1} C(m, k) w_k``, ``w_1 = v_i``, ``w_{k+1}`` = ``B w_k`` with the
-boundary rule, with the same values on the boundary, and never cancels large terms. Mass is
-untouched; with ``sum_i S_ip = 1`` every term ``B u`` has the grid momentum of ``u``
-(``sum_i m_i (B u)_i = sum_p m_p (S u)_p = sum_i m_i u_i``), so the particle momentum is that of
-PIC and FLIP. With the consistent mass ``B = I`` and XPIC(m) is PIC for every ``m``.
+the velocity: walls, Dirichlet data). It equals the alternating binomial form of the same
+expansion, ``v* = sum_{k=1}^{m} (-1)^{k+1} C(m, k) w_k`` with ``w_1 = v_i`` and ``w_{k+1}`` the
+boundary rule applied to ``B w_k`` (prescribed values kept on the boundary), but adds no large
+terms of alternating sign. Mass is untouched; with ``sum_i S_ip = 1`` every term ``B u`` has the
+grid momentum of ``u`` (``sum_i m_i (B u)_i = sum_p m_p (S u)_p = sum_i m_i u_i``), so without a
+boundary rule the particle momentum is that of PIC and FLIP. With the consistent mass ``B = I``
+and XPIC(m) is PIC for every ``m``.
 
 Cost: ``m - 1`` extra interpolations and projections per step (one loop over ``k``, vectorised).
 """

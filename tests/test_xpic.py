@@ -61,7 +61,7 @@ def test_xpic_is_the_truncated_expansion_of_the_identity(basis, m, rng):
 
 @pytest.mark.parametrize("boundary", [Walls(), Dirichlet(lambda x, t: np.where(x < 0.5, 0.3, -0.7) + t)])
 @pytest.mark.parametrize("m", [1, 2, 4, 6])
-def test_with_a_boundary_it_is_the_papers_binomial_sum_with_the_rule_on_every_iterate(boundary, m, rng):
+def test_with_a_boundary_it_is_the_binomial_sum_with_the_rule_on_every_iterate(boundary, m, rng):
     """``v* = sum_{k=1}^m (-1)^{k+1} C(m, k) w_k``, ``w_1 = v_i``, ``w_{k+1} = rule(S+ S w_k)``."""
     grid, shape, mass, m_i = _cloud(rng)
     S, S_plus = _dense(shape, mass, m_i)
