@@ -76,3 +76,15 @@ def test_a_failed_run_counts_as_not_converging():
 @pytest.mark.parametrize("errors", [[], rows("sod", "fix", nodes=[0.01], particles=[0.01], fv=[0.01])])
 def test_fewer_than_two_meshes_is_not_measured(errors):
     assert verdict({"errors": errors})[0] == "not measured"
+
+
+def test_of_two_plateau_removers_the_one_nearer_the_fv_error_is_named():
+    """Both remove the plateau and miss 1.5x FV: the smaller largest FV ratio names the closest, and
+    moving that ratio above the other's names the other."""
+    fv = [x / 2.0 for x in GOOD_SOD["particles"]]  # 'fix': particles at 2x the FV error
+    near = dict(nodes=GOOD_SOD["nodes"], particles=[x * 1.8 for x in fv])  # 1.8x the FV error
+    v, evidence = verdict(table(fv=fv, extra=rows("sod", "near", **near, fv=fv) + rows("burgers", "near", **GOOD_BURGERS)))
+    assert v == "partly" and evidence.startswith("near:")
+    far = dict(near, particles=[x * 2.2 for x in fv])  # now beyond 'fix'
+    v, evidence = verdict(table(fv=fv, extra=rows("sod", "near", **far, fv=fv) + rows("burgers", "near", **GOOD_BURGERS)))
+    assert v == "partly" and evidence.startswith("fix:")
