@@ -14,6 +14,7 @@ block. The statements and the source's tables, with the corrections made to them
 
 from __future__ import annotations
 
+import inspect
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -89,13 +90,15 @@ class Claim:
 CLAIMS: list[Claim] = []
 
 
-def claim(id: str, source: str, tables: tuple[str, ...], thresholds: str, study: str, problem: str = "",
-          explanation: str = "") -> Callable[[Criterion], Criterion]:
-    """Register the decorated criterion as a :class:`Claim` in :data:`CLAIMS`."""
+def claim(id: str, source: str, tables: tuple[str, ...], thresholds: str, study: str,
+          problem: str = "") -> Callable[[Criterion], Criterion]:
+    """Register the decorated criterion as a :class:`Claim` in :data:`CLAIMS`; the criterion's
+    docstring, joined into one line, is the claim's ``explanation``."""
     if id not in STATEMENTS:
         raise ValueError(f"claim id {id!r} is not one of {tuple(STATEMENTS)}")
 
     def register(criterion: Criterion) -> Criterion:
+        explanation = " ".join((inspect.getdoc(criterion) or "").split())
         CLAIMS.append(Claim(id, source, tuple(tables), thresholds, criterion, study, problem, explanation))
         return criterion
 
@@ -206,11 +209,11 @@ _BAND_RULE = (f"least-squares L1 order over all meshes, point mass with the slid
        tables=("projection/bounds", "projection/d2_constant"), study="projection",
        thresholds="bound/error >= 1 on every cell and node of every layout, and the fitted C inside the source's "
                   "band for the jittered and random layouts -> confirmed; the bound holds but C lies outside -> "
-                  "partly; the bound fails somewhere -> refuted",
-       explanation="D2 is scale-free: it depends on the pattern of the points in a cell, not on h. In the slides' "
-                   "formula the offsets are in physical units while the first term is not, so the fitted C is the "
-                   "mean squared offset in cell units and does not approach the slides' band.")
+                  "partly; the bound fails somewhere -> refuted")
 def _c4(t: Tables) -> tuple[str, str]:
+    """D2 is scale-free: it depends on the pattern of the points in a cell, not on h. In the slides'
+    formula the offsets are in physical units while the first term is not, so the fitted C is the mean
+    squared offset in cell units and does not approach the slides' band."""
     ratio = min(num(r, "min_ratio") for r in t["projection/bounds"])
     cs = [num(r, "C") for r in t["projection/d2_constant"] if r["layout"] in ("jittered", "random")]
     inside = all(D2_C[0] <= c <= D2_C[1] for c in cs)
@@ -219,11 +222,11 @@ def _c4(t: Tables) -> tuple[str, str]:
                      f"source [{D2_C[0]:.3g}, {D2_C[1]:.3g}]")
 
 
-@claim("C5", source=band_text("E_m"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE,
-       explanation="Regular midpoints integrate linear functions exactly and the halves of a whole hat cancel, "
-                   "so they converge faster than the band; the other layouts are first order, as Hickernell's "
-                   "bound with a scale-free D2 predicts.")
+@claim("C5", source=band_text("E_m"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE)
 def _c5(t: Tables) -> tuple[str, str]:
+    """Regular midpoints integrate linear functions exactly and the halves of a whole hat cancel, so they
+    converge faster than the band; the other layouts are first order, as Hickernell's bound with a
+    scale-free D2 predicts."""
     return _band_claim("E_m", t)
 
 
@@ -232,37 +235,37 @@ def _c6(t: Tables) -> tuple[str, str]:
     return _band_claim("E_P", t)
 
 
-@claim("C7", source=band_text("E_F"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE,
-       explanation="With the volumes V_p a run carries, a particle whose volume straddles a node puts all of its "
-                   "force into one cell: the force quadrature does not converge with the point-mass basis. "
-                   "GIMP restores it where the particle domains tile the line.")
+@claim("C7", source=band_text("E_F"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE)
 def _c7(t: Tables) -> tuple[str, str]:
+    """With the volumes V_p a run carries, a particle whose volume straddles a node puts all of its force
+    into one cell: the force quadrature does not converge with the point-mass basis. GIMP restores it
+    where the particle domains tile the line."""
     return _band_claim("E_F", t, f"; advected with V_p {span(_orders(t, 'E_F', 'advected', 'volume'))}, "
                                  f"GIMP with V_p {span(_orders(t, 'E_F', 'advected', 'volume', 'gimp'))}")
 
 
-@claim("C8", source=band_text("E_a"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE,
-       explanation="The acceleration is a ratio with m_i = O(h): a first-order force error divided by the mass "
-                   "gives order zero.")
+@claim("C8", source=band_text("E_a"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE)
 def _c8(t: Tables) -> tuple[str, str]:
+    """The acceleration is a ratio with m_i = O(h): a first-order force error divided by the mass gives
+    order zero."""
     return _band_claim("E_a", t, f"; advected with V_p {span(_orders(t, 'E_a', 'advected', 'volume'))}")
 
 
-@claim("C9", source=band_text("E_v"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE,
-       explanation="P_i/m_i is a weighted mean of the particle velocities near node i, so its quadrature error "
-                   "is one order smaller than that of the mass; E_v1 = v(x_i) - P_i/m_i is shown beside.")
+@claim("C9", source=band_text("E_v"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE)
 def _c9(t: Tables) -> tuple[str, str]:
+    """P_i/m_i is a weighted mean of the particle velocities near node i, so its quadrature error is one
+    order smaller than that of the mass; E_v1 = v(x_i) - P_i/m_i is shown beside."""
     return _band_claim("E_v", t, f"; E_v1 {span(_orders(t, 'E_v1', 'random'))} (source: {band_text('E_v1')})")
 
 
 @claim("C10", source=band_text("E_VG_proj"), tables=(ORDERS,), study="projection",
        thresholds=f"the order of (E_v^(i+1) - E_v^i)/h within {BAND_TOLERANCE} of the order of E_v on the same "
                   f"layout and N_p, for every N_p of the {', '.join(JUDGED_LAYOUTS)} layouts -> confirmed, some -> "
-                  "partly, none -> refuted",
-       explanation="The slides' argument assumes E_v^i = C h^p with C smooth in i. On jittered, random and advected "
-                   "layouts E_v^i is uncorrelated from node to node, so its difference quotient loses an order; "
-                   "only the regular layout keeps it.")
+                  "partly, none -> refuted")
 def _c10(t: Tables) -> tuple[str, str]:
+    """The slides' argument assumes E_v^i = C h^p with C smooth in i. On jittered, random and advected
+    layouts E_v^i is uncorrelated from node to node, so its difference quotient loses an order; only the
+    regular layout keeps it."""
     hits, total = _inside(t, "E_VG_proj")
     return count_verdict(hits, total), (f"{hits} of {total} orders within {BAND_TOLERANCE} of E_v's: "
                                         f"{_by_layout(t, 'E_VG_proj')}; E_v {_by_layout(t, 'E_v', ('random',))}")
@@ -297,10 +300,10 @@ def _orders_text(rows: list[dict], key: str) -> str:
        tables=(CONVERGENCE,), study="sod",
        thresholds=f"nodal density L1 order above {CONVERGING_ORDER} between the first meshes and below "
                   f"{FLOOR_ORDER} over the last {FLOOR_STEPS} refinements -> confirmed; still converging -> "
-                  f"refuted; a plateau elsewhere -> partly; fewer than {FLOOR_MESHES} meshes -> not measured",
-       explanation="The floor is set by noise of the force quadrature at node crossings, which does not shrink "
-                   "with h; the floor diagnostics and the plateau variants below show what moves it.")
+                  f"refuted; a plateau elsewhere -> partly; fewer than {FLOOR_MESHES} meshes -> not measured")
 def _c11(t: Tables) -> tuple[str, str]:
+    """The floor is set by noise of the force quadrature at node crossings, which does not shrink with h;
+    the floor diagnostics and the plateau variants below show what moves it."""
     rows = t[CONVERGENCE]
     orders = [num(r, "order_nodes_L1") for r in rows[1:]]
     last = rows[-1]
@@ -333,9 +336,9 @@ def _c12(t: Tables) -> tuple[str, str]:
 
 @claim("C14", source="new extrema appear where particles cross cells", tables=("sod/extrema",), study="sod",
        thresholds=f"a particle crossing a node becomes a new density extremum at least {EXTREMA_RATIO:g}x as often "
-                  "as one that does not, on every mesh -> confirmed, on some -> partly, on none -> refuted",
-       explanation="The exact density is monotone in each region, so every new extremum is spurious.")
+                  "as one that does not, on every mesh -> confirmed, on some -> partly, on none -> refuted")
 def _c14(t: Tables) -> tuple[str, str]:
+    """The exact density is monotone in each region, so every new extremum is spurious."""
     rows = t["sod/extrema"]
     ratio = [num(r, "density_rate_ratio") for r in rows]
     return count_verdict(sum(r >= EXTREMA_RATIO for r in ratio), len(rows)), (
@@ -394,11 +397,11 @@ _LUMPING_RULE = (f"the consistent mass lowers the error below {LUMPING_GAIN} x t
 
 
 @claim("C15", source="one of four error sources", tables=("sod/mass", "budget/shapley"), study="sod", problem="sod",
-       thresholds=_LUMPING_RULE,
-       explanation="In MPM the consistent particle mass matrix spreads the crossing noise rather than removing it. "
-                   "In the budget the mass stage compensates the projection on Sod: the lumped solve of the MPM "
-                   "data lowers the error that exact data with the same projection error would carry.")
+       thresholds=_LUMPING_RULE)
 def _c15_sod(t: Tables) -> tuple[str, str]:
+    """In MPM the consistent particle mass matrix spreads the crossing noise rather than removing it. In
+    the budget the mass stage compensates the projection on Sod: the lumped solve of the MPM data lowers
+    the error that exact data with the same projection error would carry."""
     rows = t["sod/mass"]
     ratios = {f"{m} h = {r['h']}": num(r, key) for m, key in (("MPM", "mpm_consistent_over_lumped_nodes"),
                                                              ("FEM", "fem_consistent_over_lumped")) for r in rows}
@@ -451,11 +454,11 @@ _C13_RULE = (f"least-squares order in [{FIRST_ORDER[0]}, {FIRST_ORDER[1]}] on ev
 
 
 @claim("C13", source="first order with exact and with calculated acceleration", tables=("burgers/orders",),
-       study="burgers", thresholds=_C13_RULE,
-       explanation="With the exact acceleration the O(dt) time error dominates when dt ~ h; with the viscous time "
-                   "step it is second order. The calculated acceleration stalls at four particles per cell: the "
-                   "weight of each cell in the force quadrature jumps whenever a particle crosses a node.")
+       study="burgers", thresholds=_C13_RULE)
 def _c13(t: Tables) -> tuple[str, str]:
+    """With the exact acceleration the O(dt) time error dominates when dt ~ h; with the viscous time step
+    it is second order. The calculated acceleration stalls at four particles per cell: the weight of each
+    cell in the force quadrature jumps whenever a particle crosses a node."""
     rows = t["burgers/orders"]
 
     def fitted(method):
@@ -512,10 +515,10 @@ DOMINANT, CLOSURE = 0.5, 1e-4
        study="time",
        thresholds=f"least-squares order in dt of every global error in [{GLOBAL_ORDER[0]}, {GLOBAL_ORDER[1]}] and of "
                   f"every local position error in [{LOCAL_ORDER[0]}, {LOCAL_ORDER[1]}] -> confirmed; some -> partly; "
-                  "none -> refuted",
-       explanation="With the point-mass basis node crossings make the solution a rough function of dt (C2), so its "
-                   "orders between successive refinements scatter about the fitted one.")
+                  "none -> refuted")
 def _c1(t: Tables) -> tuple[str, str]:
+    """With the point-mass basis node crossings make the solution a rough function of dt (C2), so its
+    orders between successive refinements scatter about the fitted one."""
     fits = {(r["problem"], r["basis"], r["quantity"]): num(r, "fitted_order") for r in select(t["time/time_order"], order="")}
     local = {(r["problem"], r["basis"]): num(r, "fitted_order")
              for r in select(t["time/local_error"], order="", quantity="x")}
@@ -531,10 +534,10 @@ def _c1(t: Tables) -> tuple[str, str]:
        tables=("time/crossing_summary",), study="time",
        thresholds=f"P1 with the exact nodal acceleration matches the formula within {CROSSING_TOLERANCE:.0%} at every "
                   f"crossing and every C1 basis stays below {NO_JUMP:.0%} of it -> confirmed; only the P1 part holds "
-                  "-> partly; P1 does not match -> refuted",
-       explanation="With the calculated acceleration the nodal accelerations themselves jump whenever any particle "
-                   "crosses a node (force quadrature), so the crossing jump is buried in that noise.")
+                  "-> partly; P1 does not match -> refuted")
 def _c2(t: Tables) -> tuple[str, str]:
+    """With the calculated acceleration the nodal accelerations themselves jump whenever any particle
+    crosses a node (force quadrature), so the crossing jump is buried in that noise."""
     rows = select(t["time/crossing_summary"], acceleration="exact")
     p1 = select(rows, basis="mpm")
     smooth = {r["basis"]: num(r, "max_abs_ratio") for r in rows if r["basis"] != "mpm"}
@@ -588,6 +591,9 @@ def _e1_text(basis: str, f: dict) -> str:
 
 def _e1(problem: str) -> Criterion:
     def criterion(t: Tables) -> tuple[str, str]:
+        """The sixteen combinations of the four stages in MPM or exact form give each stage's Shapley
+        value: its main effect plus an equal share of every interaction it is part of. A negative value
+        says that the stage's MPM form compensates the others on average."""
         rows = select(t[SHAPLEY], problem=problem)
         norms = list(dict.fromkeys(r["norm"] for r in rows))
         found, closes = budget_verdicts(rows, norms[0])
@@ -606,12 +612,9 @@ def _e1(problem: str) -> Criterion:
 _E1_RULE = (f"the Shapley shares of every mesh add up to one (within {CLOSURE:g}) and at the finest mesh one stage "
             f"carries at least {DOMINANT:.0%} of v(all MPM) - v(all exact) for every basis -> confirmed; for some "
             "bases the error is shared -> partly; shares that do not add up -> refuted")
-_E1_WHY = ("The sixteen combinations of the four stages in MPM or exact form give each stage's Shapley value: its "
-           "main effect plus an equal share of every interaction it is part of. A negative value says that the "
-           "stage's MPM form compensates the others on average.")
 for _problem in ("sod", "burgers"):
     claim("E1", source="the four error sources of the slides (projection, FE + mass lumping, interpolation, time)",
-          tables=(SHAPLEY,), study="budget", problem=_problem, thresholds=_E1_RULE, explanation=_E1_WHY)(_e1(_problem))
+          tables=(SHAPLEY,), study="budget", problem=_problem, thresholds=_E1_RULE)(_e1(_problem))
 
 
 @claim("E2", source="whether a smooth basis removes the stagnation of C11", tables=("budget/bases",), study="budget",
@@ -717,12 +720,12 @@ def _series(rows: list[dict], problem: str) -> dict[str, list[dict]]:
                   "confirmed (named); one that only removes the Sod plateau -> partly; none -> refuted. The remedy named "
                   "meets most of the three conditions and, among those, has the smallest largest FV ratio. Wall time enters no verdict. The evidence adds which stage carries the largest Shapley "
                   "share of the named remedy's remaining error, from the error budget of its basis at its finest "
-                  "mesh (budget/shapley, when the budget was run)",
-       explanation="The remedies attack the error sources the budget found: the particle-domain B-spline the "
-                   "force quadrature and the jump of the basis gradient at node crossings, the Taylor reconstruction "
-                   "the force quadrature, the volume reset the volume drift, the PIC/FLIP blend and XPIC(m) the noise "
-                   "carried by the particle velocities (XPIC filters FLIP's null-space noise without PIC's diffusion).")
+                  "mesh (budget/shapley, when the budget was run)")
 def _e5(t: Tables) -> tuple[str, str]:
+    """The remedies attack the error sources the budget found: the particle-domain B-spline the force
+    quadrature and the jump of the basis gradient at node crossings, the Taylor reconstruction the force
+    quadrature, the volume reset the volume drift, the PIC/FLIP blend and XPIC(m) the noise carried by the
+    particle velocities (XPIC filters FLIP's null-space noise without PIC's diffusion)."""
     rows = t[REMEDY_ERRORS]
     sod = {k: v for k, v in _series(rows, "sod").items() if len(v) >= 2}
     burgers = _series(rows, "burgers")

@@ -57,12 +57,15 @@ class RunSettings(StageSwitches):
     ``threads``; :func:`mpm_fem.solve.run`). A problem's settings subclass this one, adding its own
     parameters and changing the defaults it needs."""
 
+    # the mesh and the particles
     h: float = 0.01
     ppc: int = 4
-    T: float = 0.2
-    cfl: float = 0.1
     layout: str = "regular"
     seed: int = 0
+    # the time interval and the time step
+    T: float = 0.2
+    cfl: float = 0.1
+    # the implementation of the step
     kernel: str = "fused"
     threads: int = 1
 
