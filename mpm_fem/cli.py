@@ -33,10 +33,11 @@ from .volume import VOLUMES
 
 CHOICES = {"mass": STAGE_MASS, "basis": BASES, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
            "projection": PROJECTIONS, "interpolation": INTERPOLATIONS}
-# --- remedies (E5): --flip ALPHA, --reconstruct none|taylor, --volume carried|grid, --basis bspline_gimp
+# --- remedies (E5): --flip ALPHA, --xpic M, --reconstruct none|taylor, --volume carried|grid, --basis bspline_gimp
 CHOICES.update({"reconstruct": RECONSTRUCTIONS, "volume": VOLUMES, "kernel": ("fused", "numpy")})
 REMEDY_HELP = {
     "flip": "PIC/FLIP blend alpha in [0, 1]: 1 FLIP (standard), 0 PIC",
+    "xpic": "XPIC(M) particle velocity update of order M >= 1 in place of the blend (1: PIC); 0: off",
     "reconstruct": "stress before the force integral: none (particle sum) or taylor (per-cell least-squares line)",
     "volume": "particle volumes: carried by the flow, or grid (reset to tile the grid every step)",
 }

@@ -13,8 +13,8 @@ error budget (E1) additive. With ``f*`` the exact field a stage should deliver:
                                         round-off for piecewise-polynomial fields)
     mass (FE + lumping, grid solve)     u_i = u*(x_i) + [solve(MPM data) - solve(exact data)]:
                                         the solve makes no error of its own on exact data
-                                        (exact data: the FE mass matrices of the exact density,
-                                        assembled by scikit-fem, :func:`fe_mass`)
+                                        (exact data: the FE mass matrices of the exact density
+                                        on scikit-fem's basis, :func:`fe_mass`)
     interpolation (grid -> particles)   f_p = f*(x_p) + sum_i S_ip (f_i - f*_i): the interpolant is
                                         exact for the exact field; the nodal error still reaches
                                         the particle
@@ -46,13 +46,13 @@ with ``v*`` crosses a shock with the Rankine-Hugoniot density ratio, since
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Protocol
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
-from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
+from skfem import Basis, ElementLineP1, ElementLineP2, MeshLine
 
 from .grid import Grid
 from .shape import Shape, grid_functions, make_shape
@@ -122,44 +122,117 @@ def quadrature(grid: Grid, breakpoints=()) -> tuple[np.ndarray, np.ndarray]:
     """Points and weights of the composite Gauss-Legendre rule on the grid's domain: ``GAUSS_POINTS``
     points on each piece of :func:`_pieces` (split at nodes, half cells and breakpoints)."""
     edges = _pieces(grid, breakpoints)
-    left, width = edges[:-1], np.diff(edges)
+    return _gauss(edges[:-1], np.diff(edges))
+
+
+def _gauss(left: np.ndarray, width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``GAUSS_POINTS`` Gauss-Legendre points and weights on each piece ``[left, left + width]``."""
     x = (left + 0.5 * width)[:, None] + 0.5 * width[:, None] * _XI
     w = 0.5 * width[:, None] * _W
     return x.ravel(), w.ravel()
 
 
-@BilinearForm
-def _density_mass(u, v, w):
-    """The mass form with the density as a field: ``rho u v``."""
-    return w["rho"] * u * v
+@dataclass(frozen=True, eq=False)
+class FEMass:
+    """The FE mass matrices of a density on one grid: :func:`fe_mass`'s operator, built once per
+    grid and basis (:func:`fe_mass_operator`).
 
+    What depends on the mesh only is evaluated once, by scikit-fem: a ``Basis`` on the fixed pieces
+    of :func:`_pieces` (nodes and half cells; P1, or P2 for the B-splines) gives the Gauss points
+    ``x_q`` (``GAUSS_POINTS`` per piece), the weights ``dx_q`` (Gauss weight times Jacobian) and its
+    element functions there. The grid functions are polynomials of the piece's element, ``S_i =
+    sum_k S_i(y_k) phi_k`` over its degrees of freedom ``y_k``, which gives ``S_qi = S_i(x_q)``. Per
+    step only the density is evaluated and summed, a sparse matrix-vector product onto the entries
+    of ``M`` (``assemble``, row ``(i, j)`` holding ``S_qi S_qj``):
 
-def fe_mass(grid: Grid, basis: str, fields: ExactFields, t: float, rho: np.ndarray | None = None
-            ) -> tuple[sp.csr_matrix, np.ndarray]:
-    """The FE mass matrices of the exact density, assembled by scikit-fem:
+        M_ij = sum_q dx_q rho(x_q) S_qi S_qj,      m_i = sum_j M_ij.
 
-        M_ij = int rho S_i S_j dx          (a BilinearForm ``rho u v``),      m_i = sum_j M_ij,
-
-    the lumped mass being the row sums (``= int rho S_i dx``: the grid functions sum to 1).
-    scikit-fem assembles the form on the pieces of :func:`quadrature` (a line mesh split at the
-    nodes, half cells and breakpoints, so the exact density is smooth on each), with
-    ``GAUSS_POINTS`` Gauss points per piece and ``rho`` evaluated there from the exact fields. On
-    each piece a grid function ``S_i`` (P1 hat, or quadratic B-spline for ``"bspline"``) is a
-    polynomial of the piece's element (P1, or P2), so ``S_i = sum_k S_i(y_k) phi_k`` over its
-    degrees of freedom ``y_k`` and ``M = E^T M_pieces E``, ``E_ki = S_i(y_k)``. ``rho``: the
-    density at the points of :func:`quadrature` (the same Gauss points, in the same order) if the
-    caller has it, else evaluated here.
+    A piece that a breakpoint of the exact fields cuts (the density jumps or kinks there) drops out,
+    and its sub-pieces come in with the same Gauss rule: the sum is exact for piecewise-polynomial
+    densities, as scikit-fem's assembly on the split mesh is.
     """
-    functions = grid_functions(basis)
-    element = ElementLineP2() if functions == "bspline" else ElementLineP1()
-    pieces = Basis(MeshLine(_pieces(grid, fields.breakpoints(t))), element, intorder=2 * GAUSS_POINTS - 1)
-    if rho is None:
-        rho = fields.integrand(np.asarray(pieces.global_coordinates()[0]), t)[0]
-    rho = np.reshape(rho, (pieces.nelems, GAUSS_POINTS))
+
+    grid: Grid
+    functions: str
+    edges: np.ndarray  # (n_pieces + 1,) the fixed pieces
+    points: np.ndarray  # (n_pieces, GAUSS_POINTS) scikit-fem's Gauss points x_q
+    dx: np.ndarray  # (n_pieces, GAUSS_POINTS) its weights dx_q
+    assemble: sp.csr_matrix  # (nnz of M, n_points): S_qi S_qj in the row of the entry (i, j)
+    pattern: sp.csr_matrix  # M's sparsity pattern, data: the keys i n_nodes + j of its entries
+
+    def __call__(self, fields: ExactFields, t: float) -> tuple[sp.csr_matrix, np.ndarray]:
+        """``(M, m)`` of the exact density of ``fields`` at time ``t``."""
+        bp = np.asarray(fields.breakpoints(t), dtype=float)
+        piece = np.searchsorted(self.edges, bp, side="right") - 1
+        inside = (piece >= 0) & (piece < self.dx.shape[0]) & (bp > self.edges[np.clip(piece, 0, self.dx.shape[0])])
+        cut = np.unique(piece[inside])
+        edges = np.unique(np.concatenate((self.edges[cut], self.edges[cut + 1], bp[inside])))
+        keep = np.isin(np.searchsorted(self.edges, 0.5 * (edges[:-1] + edges[1:])) - 1, cut)
+        x, w = _gauss(edges[:-1][keep], np.diff(edges)[keep])  # the sub-pieces of the cut pieces
+        rho = fields.integrand(np.concatenate((self.points.ravel(), x)), t)[0]
+        q = self.dx * np.reshape(rho[: self.points.size], self.dx.shape)
+        q[cut] = 0.0
+        data = self.assemble @ q.ravel()
+        if x.size:
+            shape = make_shape(self.grid, x, w, self.functions)
+            n = self.grid.n_nodes
+            wanted = shape.nodes[:, :, None] * n + shape.nodes[:, None, :]
+            entry = np.minimum(np.searchsorted(self.keys, wanted), self.keys.size - 1)
+            product = (w * rho[self.points.size:])[:, None, None] * shape.S[:, :, None] * shape.S[:, None, :]
+            if np.any((self.keys[entry] != wanted) & (product != 0)):
+                raise RuntimeError("a sub-piece couples nodes outside the FE mass pattern")
+            data = data + np.bincount(entry.ravel(), product.ravel(), self.keys.size)
+        M = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), self.pattern.shape)
+        return M, np.add.reduceat(data, self.pattern.indptr[:-1])
+
+    @property
+    def keys(self) -> np.ndarray:
+        """``i n_nodes + j`` of each stored entry ``(i, j)`` of ``M``, increasing."""
+        return self.pattern.data
+
+
+@lru_cache(maxsize=8)
+def fe_mass_operator(grid: Grid, functions: str) -> FEMass:
+    """:class:`FEMass` of ``grid`` for the grid functions ``"mpm"`` (P1 hats) or ``"bspline"``; one
+    per grid (a run builds it at its first step)."""
+    edges = _pieces(grid)
+    pieces = Basis(MeshLine(edges), ElementLineP2() if functions == "bspline" else ElementLineP1(),
+                   intorder=2 * GAUSS_POINTS - 1)
+    points = np.asarray(pieces.global_coordinates()[0])
+    if points.shape != (edges.size - 1, GAUSS_POINTS):
+        raise RuntimeError(f"scikit-fem's rule has {points.shape[1]} points per piece, not {GAUSS_POINTS}")
+    n = points.size
+    phi = sp.csr_matrix((np.concatenate([np.asarray(f[0]).ravel() for f in pieces.basis]),
+                         (np.tile(np.arange(n), len(pieces.basis)),
+                          np.concatenate([np.repeat(d, GAUSS_POINTS) for d in pieces.element_dofs]))),
+                        shape=(n, pieces.N))
     y = pieces.doflocs[0]
-    E = make_shape(grid, y, np.zeros_like(y), functions).matrix()
-    M = (E.T @ asm(_density_mass, pieces, rho=rho) @ E).tocsr()
-    return M, np.asarray(M.sum(axis=1)).ravel()
+    S = (phi @ make_shape(grid, y, np.zeros_like(y), functions).matrix()).tocsr()  # S_qi = S_i(x_q)
+    S.sort_indices()
+    # the nonzeros of each row q padded to k columns (a repeated column with value 0)
+    counts = np.diff(S.indptr)
+    k = int(counts.max())
+    slot = np.minimum(np.arange(k), counts[:, None] - 1) + S.indptr[:-1, None]
+    cols = S.indices[slot]
+    vals = np.where(np.arange(k) < counts[:, None], S.data[slot], 0.0)
+    pattern = (S.T @ S).tocsr()
+    pattern.sort_indices()
+    key = np.repeat(np.arange(grid.n_nodes), np.diff(pattern.indptr)) * grid.n_nodes + pattern.indices
+    entry = np.searchsorted(key, cols[:, :, None] * grid.n_nodes + cols[:, None, :])
+    assemble = sp.csr_matrix(((vals[:, :, None] * vals[:, None, :]).ravel(),
+                              (entry.ravel(), np.repeat(np.arange(n), k * k))), shape=(key.size, n))
+    pattern.data = key
+    return FEMass(grid, functions, edges, points, np.asarray(pieces.dx), assemble, pattern)
+
+
+def fe_mass(grid: Grid, basis: str, fields: ExactFields, t: float) -> tuple[sp.csr_matrix, np.ndarray]:
+    """The FE mass matrices of the exact density (:class:`FEMass`):
+
+        M_ij = int rho S_i S_j dx,      m_i = sum_j M_ij,
+
+    the lumped mass being the row sums (``= int rho S_i dx``: the grid functions sum to 1). ``S_i``
+    are the grid functions of ``basis`` (P1 hats, or quadratic B-splines for the B-spline bases)."""
+    return fe_mass_operator(grid, grid_functions(basis))(fields, t)
 
 
 def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float, with_fe_mass: bool = False) -> GridData:
@@ -170,13 +243,13 @@ def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float, with
     The quadrature points act as particles of mass ``w_q rho_q`` and volume ``w_q``, so ``m_i`` and the consistent
     mass ``int rho S_i S_j`` come from the same code as the particle mass matrix. ``with_fe_mass``
     (the exact form of the mass stage): the mass matrices are instead the FE mass of
-    :func:`fe_mass`, assembled by scikit-fem, ``m_i`` its row sums (the same integrals).
+    :func:`fe_mass` (on scikit-fem's basis), ``m_i`` its row sums (the same integrals).
     """
     x, w = quadrature(grid, fields.breakpoints(t))
     rho, v, sigma = fields.integrand(x, t)
     shape = make_shape(grid, x, w, grid_functions(basis))
     mass = w * rho
-    M, m_i = fe_mass(grid, basis, fields, t, rho) if with_fe_mass else (None, nodal_mass(shape, mass))
+    M, m_i = fe_mass(grid, basis, fields, t) if with_fe_mass else (None, nodal_mass(shape, mass))
     return GridData(shape, mass, m_i, nodal_momentum(shape, mass, v), nodal_internal_force(shape, w, sigma), M)
 
 

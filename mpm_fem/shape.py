@@ -148,6 +148,23 @@ def _hat_and_integral(grid: Grid, i: np.ndarray, y: np.ndarray) -> tuple[np.ndar
     return value, left + right
 
 
+def _particle_domains(grid: Grid, x, volume, who: str):
+    """The particle domains ``[x_p - V_p/2, x_p + V_p/2]`` cut at the ends of the grid: the cell of
+    each particle, the domain ends ``lo, hi`` and their cells. ``who`` names the basis in the error
+    raised for a volume that is not positive."""
+    x = np.asarray(x, dtype=float)
+    volume = np.asarray(volume, dtype=float)
+    if np.any(~(volume > 0)):
+        p = int(np.flatnonzero(~(volume > 0))[0])
+        raise ValueError(f"{who} positive particle volumes; particle {p} has V={volume[p]!r}")
+    cell, _ = locate(grid, x)
+    lo = np.maximum(x - 0.5 * volume, grid.nodes[0])
+    hi = np.minimum(x + 0.5 * volume, grid.nodes[-1])
+    c_lo, _ = locate(grid, lo)
+    c_hi, _ = locate(grid, hi)
+    return cell, lo, hi, c_lo, c_hi
+
+
 def gimp_shape(grid: Grid, x: np.ndarray, volume: np.ndarray) -> Shape:
     """GIMP: hats averaged over the particle domain ``[x_p - V_p/2, x_p + V_p/2]``.
 
@@ -156,17 +173,7 @@ def gimp_shape(grid: Grid, x: np.ndarray, volume: np.ndarray) -> Shape:
     the grid is cut at the boundary (and the average taken over what is left), which keeps the
     partition of unity at walls.
     """
-    x = np.asarray(x, dtype=float)
-    volume = np.asarray(volume, dtype=float)
-    if np.any(~(volume > 0)):
-        p = int(np.flatnonzero(~(volume > 0))[0])
-        raise ValueError(f"GIMP needs positive particle volumes; particle {p} has V={volume[p]!r}")
-    a, b = grid.nodes[0], grid.nodes[-1]
-    cell, _ = locate(grid, x)
-    lo = np.maximum(x - 0.5 * volume, a)
-    hi = np.minimum(x + 0.5 * volume, b)
-    c_lo, _ = locate(grid, lo)
-    c_hi, _ = locate(grid, hi)
+    cell, lo, hi, c_lo, c_hi = _particle_domains(grid, x, volume, "GIMP needs")
     k = int((c_hi - c_lo).max()) + 2
     nodes = np.minimum(c_lo[:, None] + np.arange(k), grid.n_nodes - 1)
     s_hi, phi_hi = _hat_and_integral(grid, nodes, hi[:, None])
@@ -258,17 +265,8 @@ def bspline_gimp_shape(grid: Grid, x: np.ndarray, volume: np.ndarray) -> Shape:
     h = grid.h
     if np.ptp(h) > 1e-9 * h.max():
         raise ValueError("the quadratic B-spline basis needs a uniform grid")
-    x = np.asarray(x, dtype=float)
-    volume = np.asarray(volume, dtype=float)
-    if np.any(~(volume > 0)):
-        p = int(np.flatnonzero(~(volume > 0))[0])
-        raise ValueError(f"the particle-domain B-spline needs positive particle volumes; particle {p} has V={volume[p]!r}")
-    a, b = grid.nodes[0], grid.nodes[-1]
-    cell, _ = locate(grid, x)
-    lo = np.maximum(x - 0.5 * volume, a)
-    hi = np.minimum(x + 0.5 * volume, b)
-    c_lo, _ = locate(grid, lo)
-    c_hi, _ = locate(grid, hi)
+    cell, lo, hi, c_lo, c_hi = _particle_domains(grid, x, volume, "the particle-domain B-spline needs")
+    a = grid.nodes[0]
     k = int((c_hi - c_lo).max()) + 4
     j = c_lo[:, None] - 1 + np.arange(k)  # spline centres x_j = a + j h, ghosts at j = -1 and n_nodes
     r_lo = (lo[:, None] - a) / h[0] - j

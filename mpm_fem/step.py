@@ -31,6 +31,7 @@ from .reconstruction import RECONSTRUCTIONS, reconstructed_force
 from .shape import BASES, make_shape
 from .transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
 from .volume import VOLUMES, grid_volume_factor
+from .xpic import boundary_change_rule, check_order, xpic_velocity
 
 SCHEMES = ("usl", "usf", "musl")
 ACCELERATIONS = ("calculated", "exact")
@@ -40,7 +41,24 @@ STAGE_MASS = MASS_KINDS + ("exact",)
 
 
 @dataclass(frozen=True)
-class Stages:
+class StageSwitches:
+    """The stage switches of :class:`Stages` that every run's settings carry (all but the
+    acceleration, which only a problem with an exact one offers)."""
+
+    basis: str = "mpm"
+    mass: str = "lumped"
+    scheme: str = "usl"
+    projection: str = "mpm"
+    interpolation: str = "mpm"
+    refine: int = 1
+    flip: float = 1.0
+    reconstruct: str = "none"
+    volume: str = "carried"
+    xpic: int = 0
+
+
+@dataclass(frozen=True)
+class Stages(StageSwitches):
     """Which form each stage of the step takes.
 
     ``basis``: ``"mpm"`` (point mass), ``"gimp"`` or ``"bspline"``; ``mass``: ``"lumped"``,
@@ -49,20 +67,12 @@ class Stages:
     acceleration); ``scheme``: ``"usl"``, ``"usf"`` or ``"musl"``; ``projection`` and
     ``interpolation``: ``"mpm"`` or ``"exact"``; ``refine``: the time step is ``dt / refine``.
     The exact forms are those of :mod:`mpm_fem.exact_stages`. The remedies (module docstring):
-    ``flip`` in [0, 1] (1: FLIP, 0: PIC), ``reconstruct`` ``"none"`` or ``"taylor"``, ``volume``
-    ``"carried"`` or ``"grid"``, and the basis ``"bspline_gimp"``.
+    ``flip`` in [0, 1] (1: FLIP, 0: PIC), ``xpic`` the order ``m >= 1`` of the XPIC update
+    (:mod:`mpm_fem.xpic`; 0: off, else in place of the blend), ``reconstruct`` ``"none"`` or
+    ``"taylor"``, ``volume`` ``"carried"`` or ``"grid"``, and the basis ``"bspline_gimp"``.
     """
 
-    basis: str = "mpm"
-    mass: str = "lumped"
     acceleration: str = "calculated"
-    scheme: str = "usl"
-    projection: str = "mpm"
-    interpolation: str = "mpm"
-    refine: int = 1
-    flip: float = 1.0
-    reconstruct: str = "none"
-    volume: str = "carried"
 
     def __post_init__(self):
         for name, allowed in (("basis", BASES), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
@@ -77,13 +87,19 @@ class Stages:
             raise ValueError("the exact projection, mass and interpolation stages are defined for USL and USF only")
         if isinstance(self.flip, bool) or not isinstance(self.flip, (int, float, np.number)) or not 0 <= self.flip <= 1:
             raise ValueError(f"the PIC/FLIP blend must lie in [0, 1] (1: FLIP, 0: PIC), got {self.flip!r}")
-        if self.uses_exact_fields and self.uses_remedy:
-            raise ValueError("the remedies (flip, reconstruct, volume, bspline_gimp) run with the MPM stages only")
+        check_order(self.xpic)
+        if self.xpic and self.flip != 1:
+            raise ValueError(f"XPIC replaces the PIC/FLIP blend: use xpic {self.xpic} with flip 1, got flip {self.flip!r}")
+        if self.uses_exact_fields and (self.flip != 1 or self.xpic != 0 or self.reconstruct != "none"
+                                       or self.volume != "carried"):
+            raise ValueError("the remedies flip, xpic, reconstruct and volume run with the MPM stages only "
+                             "(the basis bspline_gimp also with the exact stages)")
 
     @property
     def uses_remedy(self) -> bool:
         """Whether a plateau remedy is on (they run in :func:`explicit_step` only, not in fused loops)."""
-        return self.basis == "bspline_gimp" or self.flip != 1 or self.reconstruct != "none" or self.volume != "carried"
+        return (self.basis == "bspline_gimp" or self.flip != 1 or self.xpic != 0 or self.reconstruct != "none"
+                or self.volume != "carried")
 
     @property
     def uses_exact_fields(self) -> bool:
@@ -217,9 +233,13 @@ def explicit_step(
     v_new = v_i + dt * a_i
 
     moving = shape.gather(v_new)
-    velocity = particles.velocity + dt * shape.gather(a_i)
-    if stages.flip != 1:
-        velocity = stages.flip * velocity + (1.0 - stages.flip) * moving
+    if stages.xpic:
+        velocity = xpic_velocity(shape, m, m_i, v_i, a_i, dt, stages.xpic, stages.mass,
+                                 boundary_change_rule(boundary, grid, t))
+    else:
+        velocity = particles.velocity + dt * shape.gather(a_i)
+        if stages.flip != 1:
+            velocity = stages.flip * velocity + (1.0 - stages.flip) * moving
     x = particles.x + dt * moving
     particles = particles.replace(x=x, velocity=velocity)
 

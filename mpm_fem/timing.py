@@ -46,13 +46,16 @@ class PulseSettings:
     sound speed.
     """
 
+    # the mesh, the particles and the time step
     h: float = 0.02
     ppc: int = 4
     T: float = 0.1
+    cfl: float = 0.4
+    # the pulse
     amplitude: float = 0.2
     width: float = 0.1
     gamma: float = 1.4
-    cfl: float = 0.4
+    # the stages
     basis: str = "mpm"
     refine: int = 1
 

@@ -4,7 +4,8 @@ the bases (E2).
 Caption. Sod's tube (16 particles per cell, CFL 0.05, von Neumann-Richtmyer viscosity 0.5 / 2.0,
 USL, lumped mass) and viscous Burgers (the rarefaction, eps = 0.045, 4 particles per cell, CFL
 0.5, calculated acceleration) are run for each mesh and basis (point-mass P1 "mpm", GIMP, the C1
-quadratic B-spline "bspline") with every subset ``S`` of the four stages {projection, mass
+quadratic B-spline "bspline", and E5's closest remedy, the B-spline averaged over the particle
+domain "bspline_gimp", whose exact stages use the same quadratic B-splines) with every subset ``S`` of the four stages {projection, mass
 (FE + mass lumping), interpolation, time} in MPM form and the others in their exact form
 (:mod:`mpm_fem.exact_stages`). The error field ``e_S(x)`` is the piecewise-linear field through
 the particle values (Sod density, Burgers velocity) minus the exact solution, on fixed points
@@ -21,8 +22,12 @@ terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) -
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.0025 (GIMP, B-spline to 0.005), Burgers 0.04 ... 0.01: ~8 min on 2 cores on the
-numpy path (Sod to 0.000625 and Burgers to 0.005 with every basis: ~2.7 h). E2: Sod, each basis in MPM form.
+Meshes: Sod h = 0.01 ... 0.0025 (GIMP and both B-splines to 0.005), Burgers 0.04 ... 0.01. A Sod case
+(16 runs, the exact stages on the numpy path) measured in CPU seconds, P1 / GIMP / B-spline /
+particle-domain B-spline: h = 0.01: 18 / 35 / 25 / 38; 0.005: 54 / 112 / 90 / 120; 0.0025: 134 (P1; the
+others ~300 / 225 / 360 from their measured time per step); 0.00125: ~445 / 1340 / 820 / 1370; 0.000625:
+P1 ~1840. The plan as it stands is ~13 CPU-minutes; every basis to 0.00125 would add ~1.4 CPU-hours.
+E2: Sod, each basis in MPM form.
 """
 
 from __future__ import annotations
@@ -43,7 +48,9 @@ from mpm_fem.study import StudyOptions, publish, script_main
 from mpm_fem.timing import field_on
 
 NAME = "budget"
-BASES = ("mpm", "gimp", "bspline")
+BASES = ("mpm", "gimp", "bspline")  # E2's bases
+#: the budget's bases: E2's and the closest remedy of E5, the B-spline averaged over the particle domain
+BUDGET_BASES = BASES + ("bspline_gimp",)
 STAGES = ("projection", "mass", "interpolation", "time")
 EXACT_FORM = {"projection": {"projection": "exact"}, "mass": {"mass": "exact"},
               "interpolation": {"interpolation": "exact"}}
@@ -52,7 +59,7 @@ SOD = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", sch
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025), "burgers": (0.04, 0.02, 0.01)}
-FINEST = {("sod", "gimp"): 0.005, ("sod", "bspline"): 0.005}
+FINEST = {("sod", "gimp"): 0.005, ("sod", "bspline"): 0.005, ("sod", "bspline_gimp"): 0.005}
 BASES_H = (0.01, 0.005, 0.0025, 0.00125)  # E2: Sod with each basis, MPM stages only
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
@@ -64,18 +71,24 @@ COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:
 # ---------------------------------------------------------------- the plan
 
 def plan(quick: bool) -> dict:
-    hs, bases = (QUICK["h"], QUICK["bases"]) if quick else (H, BASES)
+    hs, bases = (QUICK["h"], QUICK["bases"]) if quick else (H, BUDGET_BASES)
     budget = {(p, h, b): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K}
               for p, meshes in hs.items() for h in meshes for b in bases if h >= FINEST.get((p, b), 0)}
     e2 = {(h, b): {"kind": "bases", "h": h, "basis": b} for h in (QUICK["bases_h"] if quick else BASES_H) for b in BASES}
     return {"budget": budget, "bases": e2}
 
 
+#: CPU time per particle-step of the exact-stage (numpy) step relative to P1's, measured (Sod, h = 0.01)
+STEP_COST = {"mpm": 1.0, "gimp": 1.9, "bspline": 1.4, "bspline_gimp": 2.1}
+
+
 def cost(case: dict) -> float:
-    """Particle-steps of a case, to start the longest first (16 runs, half of them at dt / K)."""
+    """Particle-steps of a case, weighted by its basis's step cost, to start the longest first (16
+    runs, half of them at dt / K)."""
     if case["kind"] == "bases":
         return SOD["ppc"] / case["h"] ** 2
-    return 24 * (SOD["ppc"] / case["h"] ** 2 if case["problem"] == "sod" else 0.08 * BURGERS["ppc"] / case["h"] ** 3)
+    steps = SOD["ppc"] / case["h"] ** 2 if case["problem"] == "sod" else 0.08 * BURGERS["ppc"] / case["h"] ** 3
+    return 24 * STEP_COST[case["basis"]] * steps
 
 
 # ---------------------------------------------------------------- one case
@@ -222,7 +235,7 @@ BASES_PLOT = Plot("bases.png", "E2: Sod density L1 with each basis, MPM stages",
 def shapley_figure(path: Path, rows: list[dict]) -> None:
     """Per mesh: v(all exact) as a grey bar, beside it each stage's Shapley value stacked from that
     floor (up when positive, down when negative), ending at v(all MPM) (black mark)."""
-    norms, bases = list(dict.fromkeys(r["norm"] for r in rows)), [b for b in BASES if any(r["basis"] == b for r in rows)]
+    norms, bases = list(dict.fromkeys(r["norm"] for r in rows)), [b for b in BUDGET_BASES if any(r["basis"] == b for r in rows)]
     fig, axes = plt.subplots(len(norms), len(bases), figsize=(4.2 * len(bases), 3.6 * len(norms)), squeeze=False)
     for (i, norm), (k, basis) in ((a, b) for a in enumerate(norms) for b in enumerate(bases)):
         ax, sub = axes[i][k], [r for r in rows if r["norm"] == norm and r["basis"] == basis]

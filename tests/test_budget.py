@@ -14,7 +14,7 @@ from mpm_fem.models.euler import IdealGas
 from mpm_fem.problems import burgers, sod
 from mpm_fem.shape import make_shape
 from mpm_fem.step import Stages, Walls, explicit_step
-from mpm_fem.timing import field_difference
+from mpm_fem.timing import field_difference, field_on
 from mpm_fem.transfer import nodal_internal_force
 from studies import budget as study
 
@@ -31,16 +31,17 @@ class Polynomial:
         return np.array([0.3141, 0.777])
 
 
-@pytest.mark.parametrize("basis", ["mpm", "bspline"])
+@pytest.mark.parametrize("basis", ["mpm", "bspline", "bspline_gimp"])
 def test_exact_projection_integrates_polynomial_fields_to_round_off(basis):
     """m_i = int rho S_i, P_i = int rho v S_i, F_i = -int sigma S_i' against a 200 000-point
-    midpoint rule (error ~1e-11) of the same integrands."""
+    midpoint rule (error ~1e-11) of the same integrands, ``S_i`` the grid functions of the basis
+    (the quadratic B-splines for the particle-domain B-spline too)."""
     grid = uniform_grid(0.0, 1.0, 0.1)
     got = exact_projection(grid, basis, Polynomial(), 0.0)
     n = 200_000
     x = (np.arange(n) + 0.5) / n
     w = np.full(n, 1.0 / n)
-    shape = make_shape(grid, x, w, basis)
+    shape = make_shape(grid, x, w, "bspline" if basis.startswith("bspline") else basis)
     rho, v, sigma = Polynomial().integrand(x, 0.0)
     want = (shape.scatter(w * rho), shape.scatter(w * rho * v), nodal_internal_force(shape, w, sigma))
     for name, a, b in zip(("m_i", "P_i", "F_i"), (got.m_i, got.P_i, got.F_i), want):
@@ -78,10 +79,11 @@ def test_riemann_reference_fields_are_the_exact_cell_averages():
     assert np.abs(a - (v_t + v * v_x)).max() < 1e-6 * np.abs(a).max()
 
 
-def test_exact_projection_and_mass_give_the_exact_nodal_values():
+@pytest.mark.parametrize("basis", ["mpm", "bspline", "bspline_gimp"])
+def test_exact_projection_and_mass_give_the_exact_nodal_values(basis):
     """With the projection and the FE + mass stage exact, the grid holds v(x_i, t) and a(x_i, t)
     (Dirichlet data at the ends) whatever the particles carry."""
-    settings = burgers.BurgersSettings(h=0.05, projection="exact", mass="exact")
+    settings = burgers.BurgersSettings(h=0.05, projection="exact", mass="exact", basis=basis)
     grid = uniform_grid(0.0, 2.0, settings.h)
     particles = burgers.initial_particles(settings, grid)
     noisy = particles.replace(velocity=particles.velocity + 0.1 * np.sin(37 * particles.x))
@@ -105,10 +107,13 @@ def test_exact_stages_without_exact_fields_stop_with_a_message():
         Stages(interpolation="exact", scheme="musl")
 
 
-def test_every_stage_exact_leaves_the_time_error_of_the_step():
+@pytest.mark.parametrize("basis", ["mpm", "bspline_gimp"])
+def test_every_stage_exact_leaves_the_time_error_of_the_step(basis):
     """Burgers (h = 0.02): with every stage exact the remainder is first order in dt (halves when
-    dt halves) and its dt -> 0 extrapolation is below 2% of it: no other error is left."""
-    base = burgers.BurgersSettings(h=0.02, projection="exact", mass="exact", interpolation="exact")
+    dt halves) and its dt -> 0 extrapolation is below 2% of it: no other error is left. The
+    particle-domain B-spline too: its stage switches remove its projection, mass and
+    interpolation errors as they do the point-mass ones."""
+    base = burgers.BurgersSettings(h=0.02, projection="exact", mass="exact", interpolation="exact", basis=basis)
     runs = {k: burgers.simulate(replace(base, refine=k), progress=False) for k in (1, 2)}
     points = np.linspace(0.1, 1.9, 4001)
 
@@ -123,7 +128,7 @@ def test_every_stage_exact_leaves_the_time_error_of_the_step():
     assert 1.8 < ratio < 2.2, f"remainder at dt {l1(e1):.3g}, at dt/2 {l1(e2):.3g}: ratio {ratio:.3f}"
     extrapolated = l1(2 * e2 - e1)
     assert extrapolated < 0.02 * l1(e1), f"dt -> 0 remainder {extrapolated:.3g} vs {l1(e1):.3g} at dt"
-    mpm = burgers.simulate(burgers.BurgersSettings(h=0.02), progress=False)
+    mpm = burgers.simulate(burgers.BurgersSettings(h=0.02, basis=basis), progress=False)
     assert field_difference(mpm.particles, runs[1].particles, (0.1, 1.9)) > 0.1 * l1(e1) / 1.8
 
 
@@ -221,3 +226,23 @@ def test_time_exact_is_the_dt_to_zero_extrapolation():
     _, _, (fields, weights, _, _) = _small("burgers")
     l1 = lambda S: float(np.sum(weights["particles"] * np.abs(fields[S]["particles"])))  # noqa: E731
     assert l1(NONE) < 0.05 * l1(frozenset({"time"})), (l1(NONE), l1(frozenset({"time"})))
+
+
+def test_the_particle_domain_bspline_runs_every_subset_and_its_shapley_values_add_up():
+    """E5's closest remedy, the B-spline averaged over the particle domain, in the budget: the
+    sixteen subsets run (Sod, h = 0.05), its stages change the error, the Shapley values add up to
+    v(all MPM) - v(all exact), and its all-MPM run is the remedy's plain run, bit for bit."""
+    h, settings = SMALL["sod"]
+    fields, weights, points, runs = study.subset_fields("sod", h, "bspline_gimp", settings)
+    assert fields is not None and all(r["ok"] for r in runs)
+    for norm, w in weights.items():
+        v = {S: float(np.sum(w * np.abs(f[norm]))) for S, f in fields.items()}
+        gap = v[ALL] - v[NONE]
+        assert abs(gap) > 0.1 * v[ALL], f"{norm}: the stages change nothing? {v}"
+        assert abs(sum(decompose(v, study.STAGES).shapley.values()) - gap) <= 1e-12 * abs(gap)
+    plain = sod.simulate(sod.SodSettings(h=h, basis="bspline_gimp", **{**study.SOD, **settings}), progress=False)
+    exact = sod.exact(sod.SodSettings(), points, plain.t)[0]
+    np.testing.assert_array_equal(field_on(points, plain.particles.x, plain.particles.density) - exact,
+                                  fields[ALL]["particles"])
+    plan = study.plan(quick=False)["budget"]
+    assert {h for p, h, b in plan if (p, b) == ("sod", "bspline_gimp")} == {h for p, h, b in plan if (p, b) == ("sod", "bspline")}

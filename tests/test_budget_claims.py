@@ -94,3 +94,53 @@ def test_e2_follows_the_last_refinement_orders():
     assert judge("E2", stalled)[0] == "refuted"
     p1_converges = mutate(converging, "budget/bases", {**finest, "basis": "mpm"}, particles_L1=0.5 * coarse["mpm"])
     assert judge("E2", p1_converges)[0] == "differs"
+
+
+# ---------------------------------------------------------------- C15: the budget's mass stage
+
+def _c15_tables(mass_share: float, problem: str = "sod") -> dict:
+    """The committed lumping table with every ratio passing, and a budget whose mass stage carries
+    ``mass_share`` at the finest mesh of one basis (0.3 elsewhere)."""
+    shares = {(0.01, "mpm"): (0.6, 0.3, 0.05, 0.05), (0.005, "mpm"): (0.6, 0.3, 0.05, 0.05),
+              (0.01, "gimp"): (0.6, 0.3, 0.05, 0.05), (0.005, "gimp"): (1 - mass_share - 0.1, mass_share, 0.05, 0.05)}
+    if problem == "sod":
+        tables = mutate(TABLES, "sod/mass", mpm_consistent_over_lumped_nodes=0.5, fem_consistent_over_lumped=0.5)
+    else:
+        tables = mutate(TABLES, "burgers/lumping", {"mass": "consistent"}, L2=1e-9)
+    return {**tables, "budget/shapley": _shapley(shares, problem)}
+
+
+def test_c15_reads_the_mass_stage_share_of_the_budget():
+    """A mass stage below 10% at the finest mesh of one basis is one case that fails (partly); 30%
+    passes, and so does -30% (the lumped solve compensating the other stages is a source too)."""
+    assert_flips("C15 (sod)", _c15_tables(0.05), _c15_tables(0.3))
+    assert judge("C15 (sod)", _c15_tables(-0.3))[0] == "confirmed"
+    verdict, evidence = judge("C15 (sod)", _c15_tables(0.05))
+    assert verdict == "partly"
+    assert "Shapley share of the mass stage at the finest budget mesh: mpm particles h = 0.005 30%, " \
+           "gimp particles h = 0.005 5%" in evidence
+    assert_flips("C15 (burgers)", _c15_tables(0.05, "burgers"), _c15_tables(0.3, "burgers"))
+    assert judge("C15 (sod)", {k: v for k, v in TABLES.items() if k != "budget/shapley"})[0] == "not measured"
+
+
+# ---------------------------------------------------------------- E5: the budget of the closest remedy
+
+def _e5_tables(shares: tuple) -> dict:
+    """E5's made-up remedy table (tests/test_remedies_claim.py: "fix" closest) with the remedies'
+    settings ("fix" is the particle-domain B-spline) and a budget of that basis."""
+    from test_remedies_claim import table
+
+    settings = [{"table": "remedies/errors", "key": "remedies.fix.basis", "value": "bspline_gimp"}]
+    budget = _shapley({(0.01, "bspline_gimp"): (0.5, 0.2, 0.2, 0.1), (0.005, "bspline_gimp"): shares,
+                       (0.005, "mpm"): (0.1, 0.1, 0.7, 0.1)}, "sod")
+    return {"remedies/errors": table()["errors"], "settings": settings, "budget/shapley": budget}
+
+
+def test_e5_names_the_stage_that_dominates_the_closest_remedys_remaining_error():
+    verdict, evidence = judge("E5", _e5_tables((0.7, -0.1, 0.3, 0.1)))
+    assert verdict == "confirmed"
+    assert ("the budget of its basis bspline_gimp at h = 0.005 (particle density L1): projection carries 70% of "
+            "the remaining error v(all MPM) - v(all exact) = 0.001, then interpolation 30%, time 10%, mass -10%") in evidence
+    moved = judge("E5", _e5_tables((0.1, 0.1, 0.2, 0.6)))[1]
+    assert "time carries 60%" in moved and "projection carries" not in moved
+    assert "no error budget of its basis bspline_gimp" in judge("E5", {**_e5_tables((0.7, 0, 0.2, 0.1)), "budget/shapley": []})[1]

@@ -24,7 +24,7 @@ LAYERS = {
     1: ("baselines.exact",),
     2: ("mpm_fem.grid", "mpm_fem.shape", "mpm_fem.particles", "mpm_fem.transfer", "mpm_fem.step",
         "mpm_fem.fused", "mpm_fem.exact_stages", "mpm_fem.models", "mpm_fem.solve", "mpm_fem.problems", "mpm_fem.cases",
-        "mpm_fem.reconstruction", "mpm_fem.volume", "mpm_fem.norms", "baselines", "mpm_fem"),
+        "mpm_fem.reconstruction", "mpm_fem.volume", "mpm_fem.xpic", "mpm_fem.norms", "baselines", "mpm_fem"),
     3: ("mpm_fem.errors", "mpm_fem.quadrature", "mpm_fem.projection", "mpm_fem.regions", "mpm_fem.timing",
         "mpm_fem.claims", "mpm_fem.source", "mpm_fem.tables", "mpm_fem.shock_tube", "mpm_fem.decomposition"),
     4: ("mpm_fem.sweep", "mpm_fem.study", "mpm_fem.guard", "mpm_fem.report", "mpm_fem.pages", "mpm_fem.output", "mpm_fem.fields", "mpm_fem.plots",

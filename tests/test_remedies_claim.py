@@ -49,12 +49,23 @@ def test_one_stalled_pair_of_meshes_is_a_plateau():
 
 def test_more_than_one_and_a_half_times_the_fv_error_is_partly():
     v, evidence = verdict(table(fv=[x / 1.6 for x in GOOD_SOD["particles"]]))
-    assert v == "partly" and evidence.endswith("the Sod plateau is removed by fix")
+    assert v == "partly" and evidence.endswith("the Sod plateau is removed by fix (1.31x / 1.60x FV)")
 
 
 def test_burgers_below_first_order_is_partly():
     v, _ = verdict(table(burgers=dict(nodes=[4e-4, 2.2e-4, 1.2e-4], particles=[5e-4, 2.8e-4, 1.5e-4])))  # ~0.87
     assert v == "partly"
+
+
+def test_a_remedy_stopped_before_the_finest_sod_mesh_removes_no_plateau():
+    """Good orders on the three coarse meshes only: not a remover (the plateau shows on fine meshes)."""
+    coarse = rows("sod", "fix", nodes=GOOD_SOD["nodes"][:3], particles=GOOD_SOD["particles"][:3], fv=FV)
+    full = table()
+    stopped = {"errors": [r for r in full["errors"] if not (r["problem"] == "sod" and r["remedy"] == "fix")] + coarse}
+    assert assess(coarse)["removes_plateau"]
+    v, evidence = verdict(stopped)
+    assert v == "refuted" and "over h = 0.01..0.0025" in evidence
+    assert verdict(full)[0] == "confirmed"
 
 
 def test_a_failed_run_counts_as_not_converging():
@@ -65,3 +76,15 @@ def test_a_failed_run_counts_as_not_converging():
 @pytest.mark.parametrize("errors", [[], rows("sod", "fix", nodes=[0.01], particles=[0.01], fv=[0.01])])
 def test_fewer_than_two_meshes_is_not_measured(errors):
     assert verdict({"errors": errors})[0] == "not measured"
+
+
+def test_of_two_plateau_removers_the_one_nearer_the_fv_error_is_named():
+    """Both remove the plateau and miss 1.5x FV: the smaller largest FV ratio names the closest, and
+    moving that ratio above the other's names the other."""
+    fv = [x / 2.0 for x in GOOD_SOD["particles"]]  # 'fix': particles at 2x the FV error
+    near = dict(nodes=GOOD_SOD["nodes"], particles=[x * 1.8 for x in fv])  # 1.8x the FV error
+    v, evidence = verdict(table(fv=fv, extra=rows("sod", "near", **near, fv=fv) + rows("burgers", "near", **GOOD_BURGERS)))
+    assert v == "partly" and evidence.startswith("near:")
+    far = dict(near, particles=[x * 2.2 for x in fv])  # now beyond 'fix'
+    v, evidence = verdict(table(fv=fv, extra=rows("sod", "near", **far, fv=fv) + rows("burgers", "near", **GOOD_BURGERS)))
+    assert v == "partly" and evidence.startswith("fix:")

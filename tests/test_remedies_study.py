@@ -13,6 +13,11 @@ def test_plan_runs_every_remedy_on_the_stated_meshes():
     plan = remedies._plan(quick=False)
     assert {h for _, h in plan["sod"]} == set(remedies.SOD_H) and len(remedies.SOD_H) == 4
     assert {n for n, _ in plan["burgers"]} == set(remedies.REMEDIES)
+    sod_meshes = {n: {h for m, h in plan["sod"] if m == n} for n in remedies.REMEDIES}
+    for name in ("XPIC(2)", "XPIC(5)", "B-spline domain + XPIC(2)"):  # stopped on the coarse meshes
+        assert sod_meshes.pop(name) == set(remedies.SOD_H[:3]), name
+    assert all(hs == set(remedies.SOD_H) for hs in sod_meshes.values())
+    assert plan["sod"][("B-spline domain + XPIC(5)", 0.00125)]["xpic"] == 5
     assert all(case["ppc"] == 16 and case["cfl"] == 0.05 for case in plan["sod"].values())
     assert all(case["ppc"] == 4 and case["acceleration"] == "calculated" for case in plan["burgers"].values())
 

@@ -6,12 +6,13 @@ the particles.
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 
 from ..grid import n_cells_for
 from ..particles import LAYOUTS
+from ..step import Stages, StageSwitches
 
 # Bytes and seconds of one run, measured and then given a margin (stated, not tuned per run):
 # the particle state plus the peak of one step is 212-250 B per particle (benchmarks/step_cost.py,
@@ -53,6 +54,36 @@ class Cost:
     def as_dict(self) -> dict:
         return {"particles": self.particles, "nodes": self.nodes, "steps": self.steps, "bytes": self.bytes,
                 "seconds": round(self.seconds, 3)}
+
+
+@dataclass(frozen=True)
+class RunSettings(StageSwitches):
+    """The settings every MPM run shares, with the command line's defaults: the mesh size ``h``,
+    particles per cell ``ppc`` and their ``layout`` (``seed`` for the random ones), the final time
+    ``T`` and CFL number ``cfl``, the stage switches (:class:`~mpm_fem.step.StageSwitches`; a
+    problem adds ``acceleration`` where it has an exact one), and the step's implementation (``kernel``,
+    ``threads``; :func:`mpm_fem.solve.run`). A problem's settings subclass this one, adding its own
+    parameters and changing the defaults it needs."""
+
+    # the mesh and the particles
+    h: float = 0.01
+    ppc: int = 4
+    layout: str = "regular"
+    seed: int = 0
+    # the time interval and the time step
+    T: float = 0.2
+    cfl: float = 0.1
+    # the implementation of the step
+    kernel: str = "fused"
+    threads: int = 1
+
+    @property
+    def stages(self) -> Stages:
+        """The stage switches of these settings (``Stages``' defaults for those they lack)."""
+        return Stages(**{f.name: getattr(self, f.name) for f in fields(Stages) if hasattr(self, f.name)})
+
+    def as_dict(self) -> dict:
+        return asdict(self)
 
 
 def run_cost(settings, domain: tuple[float, float], max_speed: float, dt_cap: float = math.inf) -> Cost:

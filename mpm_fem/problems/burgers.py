@@ -22,7 +22,7 @@ h/max|v|``: no viscous limit, for the exact acceleration, which computes no visc
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -36,8 +36,8 @@ from ..models.burgers import FORCES, ViscousBurgers
 from ..particles import Particles, make_particles, seed_positions
 from ..shape import locate
 from ..solve import Problem, Result, run
-from ..step import ACCELERATIONS, Dirichlet, Stages
-from . import Cost, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
+from ..step import ACCELERATIONS, Dirichlet
+from . import Cost, RunSettings, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
 
 
 WEIGHTS = ("volume", "cell")
@@ -50,32 +50,20 @@ CFL_LIMIT_CONSISTENT = 1.0 / 3.0
 
 
 @dataclass(frozen=True)
-class BurgersSettings:
-    """Every setting of a Burgers run, with the CLI's defaults."""
+class BurgersSettings(RunSettings):
+    """Every setting of a Burgers run, with the CLI's defaults (:class:`RunSettings` and the
+    solution, the acceleration and the three forms of the module docstring)."""
 
-    h: float = 0.01
+    T: float = 0.5
+    cfl: float = 0.5
+    # the problem, and the acceleration it supplies
     eps: float = 0.045
     solution: str = "rarefaction"
     acceleration: str = "calculated"
-    ppc: int = 4
-    T: float = 0.5
-    cfl: float = 0.5
-    mass: str = "lumped"
-    basis: str = "mpm"
-    scheme: str = "usl"
-    layout: str = "regular"
-    seed: int = 0
-    projection: str = "mpm"
-    interpolation: str = "mpm"
-    refine: int = 1
+    # the slides' own forms
     weights: str = "volume"
     force: str = "weak"
     dt_rule: str = "stable"
-    flip: float = 1.0
-    reconstruct: str = "none"
-    volume: str = "carried"
-    kernel: str = "fused"
-    threads: int = 1
 
     def __post_init__(self):
         if not (np.isfinite(self.eps) and self.eps > 0):
@@ -96,15 +84,6 @@ class BurgersSettings:
     def exact(self):
         """The exact solution object (``v``, ``v_x``, ``v_xx``, ``v_t``, ``domain``)."""
         return exact_burgers.make_solution(self.solution, self.eps)
-
-    @property
-    def stages(self) -> Stages:
-        return Stages(basis=self.basis, mass=self.mass, acceleration=self.acceleration, scheme=self.scheme,
-                      projection=self.projection, interpolation=self.interpolation, refine=self.refine,
-                      flip=self.flip, reconstruct=self.reconstruct, volume=self.volume)
-
-    def as_dict(self) -> dict:
-        return asdict(self)
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ T = 0.2, walls at both ends. Errors are measured against the exact Riemann solut
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -21,9 +21,9 @@ from ..fused import check_kernel
 from ..grid import uniform_grid
 from ..models.euler import IdealGas
 from ..particles import make_particles, seed_positions
-from . import Cost, check_non_negative, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
+from . import Cost, RunSettings, check_non_negative, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
 from ..solve import Problem, Result, run
-from ..step import Stages, Walls
+from ..step import Walls
 
 DOMAIN = (0.0, 1.0)
 
@@ -35,32 +35,15 @@ CFL_LIMIT = {"lumped": 0.5, "exact": 0.5, "consistent": 0.25}
 
 
 @dataclass(frozen=True)
-class SodSettings:
-    """Every setting of a Sod run, with the CLI's defaults."""
+class SodSettings(RunSettings):
+    """Every setting of a Sod run, with the CLI's defaults (:class:`RunSettings` and the gas)."""
 
-    h: float = 0.01
-    ppc: int = 4
-    T: float = 0.2
-    cfl: float = 0.1
     gamma: float = 1.4
     av_linear: float = 0.5
     av_quadratic: float = 2.0
-    mass: str = "lumped"
-    basis: str = "mpm"
-    scheme: str = "usl"
-    layout: str = "regular"
-    seed: int = 0
     left: tuple = (1.0, 0.0, 1.0)
     right: tuple = (0.125, 0.0, 0.1)
     x0: float = 0.5
-    projection: str = "mpm"
-    interpolation: str = "mpm"
-    refine: int = 1
-    flip: float = 1.0
-    reconstruct: str = "none"
-    volume: str = "carried"
-    kernel: str = "fused"
-    threads: int = 1
 
     def __post_init__(self):
         if not (np.isfinite(self.gamma) and self.gamma > 1):
@@ -72,15 +55,6 @@ class SodSettings:
             riemann._checked_state(getattr(self, side), side)  # finite, rho > 0, p > 0
         check_run_settings(self, DOMAIN)
         check_kernel(self.kernel, self.threads)
-
-    @property
-    def stages(self) -> Stages:
-        return Stages(basis=self.basis, mass=self.mass, scheme=self.scheme, projection=self.projection,
-                      interpolation=self.interpolation, refine=self.refine, flip=self.flip,
-                      reconstruct=self.reconstruct, volume=self.volume)
-
-    def as_dict(self) -> dict:
-        return asdict(self)
 
 
 def initial_particles(settings: SodSettings, grid):
