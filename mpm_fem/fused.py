@@ -107,12 +107,13 @@ def _hat_and_integral(nodes, i, y):
 @njit(cache=True, inline="always")
 def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
     """``S_ip``, ``G_ip`` of one particle into ``row``, ``S``, ``G`` (length K); returns its cell and
-    the K it needs (GIMP: ``c_hi - c_lo + 2``; the caller reruns with that K if it differs)."""
+    the K it needs (GIMP: ``c_hi - c_lo + 2``; the caller reruns with that K if it differs). ``h``
+    holds the cell sizes ``h_c`` and ``1 / h_c`` (the numpy step's ``1 / h_c``, computed once)."""
     n_nodes = nodes.size
     K = row.size
     if basis == 0:  # point mass: S = (1 - xi, xi), G = (-1, 1)/h_c
         c, xi = _locate(nodes, inv_spacing, x)
-        inv_h = 1.0 / h[c]
+        inv_h = h[1, c]
         row[0], row[1] = c, c + 1
         S[0], S[1] = 1.0 - xi, xi
         G[0], G[1] = -inv_h, inv_h
@@ -131,7 +132,7 @@ def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
                 value, slope = 0.0, 0.0
             row[k] = min(max(c + k - 1, 0), n_nodes - 1)
             S[k] = value
-            G[k] = slope / h[0]
+            G[k] = slope / h[0, 0]
         return c, 4
     # GIMP: hats averaged over [x - V/2, x + V/2], cut at the ends of the grid
     a, b = nodes[0], nodes[n_nodes - 1]
@@ -379,7 +380,7 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
         for q in range(*_chunk(n, chunks, k)):
             c = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             L = _gather(Gl, v_i, r, K)
-            tally = _new_state(gas, q, L, dt, h[c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts,
+            tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts,
                                tally)
             if force:
                 _scatter(buf, k, r, Gl, V_new[q] * p_new[q] if gas else -(V_new[q] * (eps * L)), K)
@@ -414,7 +415,7 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
                 _scatter(buf, k, r, Sl, m[q] * v_new[q], K)
                 continue
             if usl:
-                tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[cq], V, m, rho, e, p,
+                tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[0, cq], V, m, rho, e, p,
                                    V_new, m_new, rho_new, e_new, p_new, consts, tally)
                 c = tally[6]
             else:
@@ -437,7 +438,7 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
         tally = _NO_TALLY
         for q in range(*_chunk(n, chunks, k)):
             cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[cq], V, m, rho, e, p,
+            tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[0, cq], V, m, rho, e, p,
                                V_new, m_new, rho_new, e_new, p_new, consts, tally)
             tally = _checked(gas, q, tally[6], x_new, v, rho_new, e_new, p_new, V_new, tally)
         speed[k] = _flags(k, tally, flags, values)
@@ -605,7 +606,7 @@ class FusedStep:
         if stages.basis == "bspline":
             make_shape(grid, grid.nodes[:1], basis="bspline")  # raises on a non-uniform grid
         self.nodes = np.ascontiguousarray(grid.nodes, dtype=float)
-        self.h = np.ascontiguousarray(grid.h, dtype=float)
+        self.h = np.ascontiguousarray([grid.h, 1.0 / grid.h], dtype=float)  # h_c and 1/h_c: read, not divided
         self.inv_spacing = 1.0 / grid.uniform_spacing if grid.uniform_spacing is not None else 0.0
         if self.kind == GAS:
             g = model.gamma
