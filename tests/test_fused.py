@@ -128,8 +128,8 @@ def test_fused_exact_acceleration_and_slides_force(model, acceleration):
                      run(slides, GRID, particles, progress=False, kernel="fused"))
 
 
-@pytest.mark.parametrize("basis", ["mpm", pytest.param("gimp", marks=pytest.mark.slow),
-                                   pytest.param("bspline", marks=pytest.mark.slow)])
+@pytest.mark.slow  # compiling the parallel passes takes about a minute on a fresh machine
+@pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline"])
 def test_threads_agree_to_round_off_and_repeat_exactly(basis):
     """Two threads sum the grid in two chunks: within 1e-12 of one thread, identical run to run.
     (The parallel passes compile in about 20 s per basis on a cold cache: GIMP and the B-spline
