@@ -46,18 +46,20 @@ from .particles import Particles, PositivityError
 from .shape import Shape, make_shape
 from .step import SCHEMES, GridState, Stages, Walls
 from .transfer import solve_consistent
+from .xpic import boundary_change_rule
 
 KERNELS = ("fused", "numpy")
 GAS, BURGERS = 0, 1
-_BASIS_CODE = {"mpm": 0, "gimp": 1, "bspline": 2}
+_BASIS_CODE = {"mpm": 0, "gimp": 1, "bspline": 2, "bspline_gimp": 3}
+_DOMAIN_BASES = (1, 3)  # the bases averaged over the particle domain: rows of varying width, stored
 
 
 def supported(model, stages: Stages) -> str | None:
     """``None`` if the fused step implements this model and these stages, else the reason."""
     if stages.uses_exact_fields:
         return "the exact projection, mass and interpolation stages run the numpy step"
-    if stages.uses_remedy:
-        return "the plateau remedies (flip, reconstruct, volume, bspline_gimp) run the numpy step"
+    if stages.reconstruct != "none" or stages.volume != "carried":
+        return "the plateau remedies reconstruct and volume run the numpy step"
     if not isinstance(model, (IdealGas, ViscousBurgers)):
         return f"the fused step has no kernel for the model {type(model).__name__}"
     return None
@@ -109,6 +111,53 @@ def _hat_and_integral(nodes, i, y):
 
 
 @njit(cache=True, inline="always")
+def _bspline_value(r):
+    """``N(r)`` of :func:`mpm_fem.shape._quadratic_bspline`."""
+    a = abs(r)
+    if a <= 0.5:
+        return 0.75 - r * r
+    if a < 1.5:
+        return 0.5 * ((1.5 - a) * (1.5 - a))
+    return 0.0
+
+
+@njit(cache=True, inline="always")
+def _bspline_antiderivative(r):
+    """``M(r) = int_{-inf}^r N`` of :func:`mpm_fem.shape._bspline_integral`, operation for operation."""
+    r = min(max(r, -1.5), 1.5)
+    u = min(max(r + 1.5, 0.0), 1.0)
+    m = min(max(r, -0.5), 0.5)
+    w = min(max(1.5 - r, 0.0), 1.0)
+    return u * u * u / 6.0 + (0.75 * (m + 0.5) - (m * m * m + 0.125) / 3.0) + (1.0 - w * w * w) / 6.0
+
+
+@njit(cache=True, inline="always")
+def _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G):
+    """:func:`mpm_fem.shape.bspline_gimp_shape` of one particle: the splines centred at
+    ``j = c_lo - 1 .. c_lo - 2 + K`` (ghosts folded into the end nodes) averaged over the domain
+    ``[x - V/2, x + V/2]`` cut at the grid's ends; returns its cell and the K it needs
+    (``c_hi - c_lo + 4``)."""
+    n_nodes = nodes.size
+    K = row.size
+    a, b = nodes[0], nodes[n_nodes - 1]
+    h0 = h[0, 0]
+    c, _ = _locate(nodes, inv_spacing, x)
+    lo = max(x - 0.5 * V, a)
+    hi = min(x + 0.5 * V, b)
+    c_lo, _ = _locate(nodes, inv_spacing, lo)
+    c_hi, _ = _locate(nodes, inv_spacing, hi)
+    y_lo, y_hi = (lo - a) / h0, (hi - a) / h0
+    length = hi - lo
+    for k in range(K):
+        j = c_lo - 1 + k
+        r_lo, r_hi = y_lo - j, y_hi - j
+        row[k] = min(max(j, 0), n_nodes - 1)
+        S[k] = h0 * (_bspline_antiderivative(r_hi) - _bspline_antiderivative(r_lo)) / length
+        G[k] = (_bspline_value(r_hi) - _bspline_value(r_lo)) / length
+    return c, c_hi - c_lo + 4
+
+
+@njit(cache=True, inline="always")
 def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
     """``S_ip``, ``G_ip`` of one particle into ``row``, ``S``, ``G`` (length K); returns its cell and
     the K it needs (GIMP: ``c_hi - c_lo + 2``; the caller reruns with that K if it differs). ``h``
@@ -138,6 +187,8 @@ def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
             S[k] = value
             G[k] = slope / h[0, 0]
         return c, 4
+    if basis == 3:
+        return _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G)
     # GIMP: hats averaged over [x - V/2, x + V/2], cut at the ends of the grid
     a, b = nodes[0], nodes[n_nodes - 1]
     c, _ = _locate(nodes, inv_spacing, x)
@@ -210,7 +261,7 @@ def _row(basis, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl):
     """Particle q's nodes and weights into ``r``, ``Sl``, ``Gl``, and its cell: recomputed from
     ``x_q^n`` (point mass, B-spline: the same numbers as pass 1, and cheaper than reading them back)
     or read from pass 1's rows (GIMP)."""
-    if basis == 1:
+    if basis == 1 or basis == 3:
         for j in range(r.size):
             r[j], Sl[j], Gl[j] = rows[q, j], S[q, j], G[q, j]
         return cell[q]
@@ -333,7 +384,7 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
                 if outside < 0:
                     outside = q
                 continue
-            if BASIS == 1 and not (V[q] > 0):
+            if (BASIS == 1 or BASIS == 3) and not (V[q] > 0):
                 if empty < 0:
                     empty = q
                 continue
@@ -402,6 +453,7 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
     n = x.size
     K = WIDTH  # nodes per particle
     gas, g_gm1 = MODEL == GAS, consts[1]
+    flip, pic = consts[5], consts[6] > 0  # the PIC/FLIP blend; XPIC: a_i holds v* + dt a (module docstring)
     buf = np.zeros((chunks if musl else 1, 1, P_i.size))
     for k in prange(chunks):
         tally = _NO_TALLY
@@ -413,7 +465,12 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
             for j in range(1, K):
                 acc += Sl[j] * a_i[r[j]]
                 vel += Sl[j] * v_n[r[j]]
-            v_new[q] = v[q] + dt * acc
+            if pic:
+                v_new[q] = acc
+            else:
+                v_new[q] = v[q] + dt * acc
+                if flip != 1.0:
+                    v_new[q] = flip * v_new[q] + (1.0 - flip) * vel
             x_new[q] = x[q] + dt * vel
             if musl:
                 _scatter(buf, k, r, Sl, m[q] * v_new[q], K)
@@ -428,6 +485,20 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
         speed[k] = _flags(k, tally, flags, values)
     if musl:
         _sum_chunks(buf, 0, P_i, 1.0)
+
+
+def _xpic_momentum(nodes, h, inv_spacing, x, rows, S, G, cell, m, u_i, chunks, P_i):
+    """XPIC's projection of an interpolated grid field: ``P_i = sum_p S_ip m_p (sum_j S_jp u_j)``
+    (:func:`mpm_fem.transfer.nodal_momentum` of ``shape.gather(u)``)."""
+    n = x.size
+    K = WIDTH  # nodes per particle
+    buf = np.zeros((chunks, 1, P_i.size))
+    for k in prange(chunks):
+        r, Sl, Gl = _one_row(K)
+        for q in range(*_chunk(n, chunks, k)):
+            _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            _scatter(buf, k, r, Sl, m[q] * _gather(Sl, u_i, r, K), K)
+    _sum_chunks(buf, 0, P_i, 1.0)
 
 
 def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p, dt, consts, chunks,
@@ -476,7 +547,7 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     n = cell.size
     gas = MODEL == GAS
     eps = consts[4]
-    store = BASIS == 1
+    store = BASIS == 1 or BASIS == 3
     m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[0], grid[1], grid[2], grid[3], grid[4], grid[5], grid[6]
     done, dt_min, dt_max = 0, np.inf, -np.inf
     while done < budget and t < T * (1 - 1e-12):
@@ -607,7 +678,7 @@ class FusedStep:
         self.kind = GAS if isinstance(model, IdealGas) else BURGERS
         self.basis = _BASIS_CODE[stages.basis]
         self._passes = passes
-        if stages.basis == "bspline":
+        if stages.basis in ("bspline", "bspline_gimp"):
             make_shape(grid, grid.nodes[:1], basis="bspline")  # raises on a non-uniform grid
         self.nodes = np.ascontiguousarray(grid.nodes, dtype=float)
         self.h = np.ascontiguousarray([grid.h, 1.0 / grid.h], dtype=float)  # h_c and 1/h_c: read, not divided
@@ -617,8 +688,9 @@ class FusedStep:
             self.consts = np.array([g - 1.0, g * (g - 1.0), model.av_linear, model.av_quadratic, 0.0])
         else:
             self.consts = np.array([0.0, 0.0, 0.0, 0.0, model.eps])
+        self.consts = np.append(self.consts, [float(stages.flip), float(stages.xpic)])  # the remedies' blend, XPIC
         self.slides = self.kind == BURGERS and getattr(model, "force", "weak") == "slides"
-        self._width({"mpm": 2, "bspline": 4, "gimp": 3}[stages.basis])
+        self._width({"mpm": 2, "bspline": 4, "gimp": 3, "bspline_gimp": 5}[stages.basis])
         self.speed, self.finite = np.nan, True
         self.reuse, self._pools, self._turn = reuse, ({}, {}), 0
         self._state = self._out = self._scratch = None  # advance's two sets of particle arrays, its last
@@ -663,7 +735,7 @@ class FusedStep:
         """Whether :meth:`advance` can take the steps of ``problem``: walls, the lumped mass, the
         calculated acceleration and the weak force (no particle boundary, no observer: the caller's)."""
         return (type(problem.boundary) is Walls and self.stages.mass == "lumped"
-                and self.stages.acceleration == "calculated" and not self.slides)
+                and self.stages.acceleration == "calculated" and not self.slides and not self.stages.xpic)
 
     def advance(self, particles: Particles, t: float, problem, steps: int, max_steps: int, budget: int):
         """Up to ``budget`` steps from ``t`` in one compiled loop (:func:`_advance`), each the step
@@ -677,7 +749,7 @@ class FusedStep:
             self._state[:, :, :n] = [getattr(particles, name) for name in _FIELDS]
             self._pools = ({}, {})  # the per-step arrays: refilled if a step falls back to step()
             self._cur = 0
-        rows_n = n if self.basis == 1 else 0
+        rows_n = n if self.basis in _DOMAIN_BASES else 0
         if (self._scratch is None or self._scratch[0].size != n or self._scratch[1].shape != (rows_n, self.K)
                 or self._scratch[5].shape[0] != chunks):
             self._scratch = (np.empty(n, np.intp), np.empty((rows_n, self.K), np.intp), np.empty((rows_n, self.K)),
@@ -698,6 +770,21 @@ class FusedStep:
             particles = self._out
         return particles, t, done, dt_min, dt_max
 
+    def _xpic_target(self, shape, shape_args, m, m_i, v_i, a_i, t, dt, chunks):
+        """XPIC(m)'s grid field ``v* + dt a_i`` whose interpolation is the particle velocity
+        (:func:`mpm_fem.xpic.xpic_grid_velocity`, the same operations): ``m - 1`` compiled passes
+        ``P_i = sum_p S_ip m_p (sum_j S_jp u_j)``, each solved with the step's mass and the
+        boundary rule of a velocity change applied."""
+        rule = boundary_change_rule(self.boundary, self.grid, t)
+        momentum = self._passes.get(_xpic_momentum, BASIS=self.basis, WIDTH=self.K)
+        P_x = self._empty("P_xpic", m_i.shape)
+        v_star, term = v_i.copy(), v_i
+        for _ in range(self.stages.xpic - 1):
+            momentum(*shape_args, m, term, chunks, P_x)
+            term = rule(term - self._solve(shape, m, m_i, P_x, "v_xpic"))
+            v_star += term
+        return v_star + dt * a_i
+
     def step(self, particles: Particles, t: float, dt: float) -> tuple[Particles, GridState]:
         grid = self.grid
         n, chunks = particles.n, max(1, min(self.threads, particles.n))
@@ -706,7 +793,7 @@ class FusedStep:
         gas = self.kind == GAS
         scheme, exact = self.stages.scheme, self.stages.acceleration == "exact"
         gas_force = gas and scheme != "usf" and not exact
-        store = self.basis == 1 or self.stages.mass == "consistent"
+        store = self.basis in _DOMAIN_BASES or self.stages.mass == "consistent"
         geometry = (self.nodes, self.h, self.inv_spacing)
         n_nodes = grid.n_nodes
         self._turn = 1 - self._turn
@@ -723,7 +810,7 @@ class FusedStep:
                 make_shape(grid, x, V, self.stages.basis)  # raises the numpy step's error
                 raise ValueError("a particle lies outside the grid or has no volume")  # not reached
             need = int(flags[:, 2].max(initial=2))
-            if self.basis != 1 or need == self.K or n == 0:
+            if self.basis not in _DOMAIN_BASES or need == self.K or n == 0:
                 break
             self._width(need)  # GIMP: a particle domain spans another cell; redo with the wider rows
         shape = Shape(rows, S, G, n_nodes, cell)
@@ -761,7 +848,8 @@ class FusedStep:
             V_m, m_m, rho_m, e_m, p_m = (V_new, m_new, rho_new, e_new, p_new) if scheme == "usf" else (V, m, rho, e, p)
             state = (V_m, m, rho_m, e_m, p_m, V_m, m_m, rho_m, e_m, p_m)
         P_musl = empty("P_musl", n_nodes)
-        self.move(*geometry, rows, S, G, cell, a_i, v_n, x, state[0], state[1], v, state[2], state[3], state[4],
+        target = self._xpic_target(shape, shape_args, m, m_i, v_i, a_i, t, dt, chunks) if self.stages.xpic else a_i
+        self.move(*geometry, rows, S, G, cell, target, v_n, x, state[0], state[1], v, state[2], state[3], state[4],
                   dt, self.consts, usl, musl, chunks, x_new, vel_new, *state[5:], P_musl, flags, values, speed)
         if musl:
             v_n = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_musl, "v_musl"), t + dt)
