@@ -26,10 +26,22 @@ The loop (``FusedStep.advance``, :func:`_advance`): between walls with the lumpe
 takes many steps in one compiled call, the grid stage, the wall conditions and the time step of
 :func:`mpm_fem.solve.run` included, in the same order as the per-step path (the same numbers).
 
-Supported: the three bases (``"mpm"``, ``"gimp"``, ``"bspline"``), USL, USF, MUSL, lumped and
-consistent mass, calculated or exact acceleration, the ideal gas and viscous Burgers (both its
-forces). Stages with an exact projection, mass or interpolation, or a plateau remedy, run the
-numpy step (:func:`supported` says which), as does any ``kernel="numpy"`` run.
+The plateau remedies of :class:`~mpm_fem.step.Stages`, with the numpy step's operations:
+
+    flip      pass 2 blends, ``v_p <- flip (v_p + dt sum S a) + (1 - flip) sum S v^{n+1}``
+              (``consts[5]``; per step and in the loop)
+    xpic      m - 1 compiled passes ``P_i = sum_p S_ip m_p sum_j S_jp u_j`` (:func:`_xpic_momentum`),
+              each solved with the step's mass and the boundary rule of a velocity change in numpy
+              (:mod:`mpm_fem.xpic`); pass 2 then sets ``v_p = sum_i S_ip (v*_i + dt a_i)``
+              (``consts[6] > 0``: its nodal field comes in place of ``a_i``). Per step only.
+    basis     ``"bspline_gimp"`` (code 3): the B-splines averaged over the particle domain
+              (:func:`_bspline_domain_row`); rows stored and widened as GIMP's (``c_hi - c_lo + 4``).
+
+Supported: the four bases (``"mpm"``, ``"gimp"``, ``"bspline"``, ``"bspline_gimp"``), USL, USF,
+MUSL, lumped and consistent mass, calculated or exact acceleration, the ideal gas and viscous
+Burgers (both its forces), the PIC/FLIP blend and XPIC(m). Stages with an exact projection, mass
+or interpolation, the Taylor reconstruction and the grid volume run the numpy step
+(:func:`supported` says which), as does any ``kernel="numpy"`` run.
 """
 
 from __future__ import annotations
@@ -447,7 +459,9 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
 def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
           x_new, v_new, V_new, m_new, rho_new, e_new, p_new, P_i, flags, values, speed):
     """Pass 2: ``v_p += dt sum S a``, ``x_p += dt sum S v^{n+1}``; USL: the state update from
-    ``L_p = sum G v^{n+1}``; MUSL: ``P_i = sum_p m_p v_p^{n+1} S_ip``. ``speed[k]``: max of
+    ``L_p = sum G v^{n+1}``; MUSL: ``P_i = sum_p m_p v_p^{n+1} S_ip``. The blend ``consts[5]``
+    (FLIP 1) mixes in ``sum S v^{n+1}``; with ``consts[6] > 0`` (XPIC) ``a_i`` holds ``v* + dt a``
+    and ``v_p = sum S a_i``. ``speed[k]``: max of
     ``c_p + |v_p|`` (gas) or ``|v_p|`` (Burgers) over chunk k; ``flags[k] = (first bad factor,
     first bad energy, first non-finite particle)``."""
     n = x.size
@@ -733,7 +747,8 @@ class FusedStep:
 
     def loops(self, problem) -> bool:
         """Whether :meth:`advance` can take the steps of ``problem``: walls, the lumped mass, the
-        calculated acceleration and the weak force (no particle boundary, no observer: the caller's)."""
+        calculated acceleration, the weak force and no XPIC (no particle boundary, no observer: the
+        caller's)."""
         return (type(problem.boundary) is Walls and self.stages.mass == "lumped"
                 and self.stages.acceleration == "calculated" and not self.slides and not self.stages.xpic)
 

@@ -1,0 +1,126 @@
+"""The plateau remedies in the fused step (mpm_fem.fused) against the numpy step (mpm_fem.step):
+the PIC/FLIP blend, XPIC(m) and the particle-domain B-spline ``"bspline_gimp"``, bit for bit,
+through the per-step path (Dirichlet ends with a reservoir, the consistent mass, XPIC) and the
+compiled loop (walls, lumped mass: the blend and the particle-domain B-spline)."""
+
+import numpy as np
+import pytest
+
+import mpm_fem.fused as fused_module
+from mpm_fem.fused import supported
+from mpm_fem.grid import uniform_grid
+from mpm_fem.models.burgers import ViscousBurgers
+from mpm_fem.models.euler import IdealGas
+from mpm_fem.particles import make_particles, seed_positions
+from mpm_fem.problems.burgers import Reservoir
+from mpm_fem.problems.sod import SodSettings, simulate
+from mpm_fem.solve import Problem, run
+from mpm_fem.step import Dirichlet, Stages, Walls
+
+FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
+GRID = uniform_grid(0.0, 1.0, 0.1)
+
+
+@pytest.fixture
+def loop_steps(monkeypatch):
+    """Counts the steps the compiled loop takes (the rest go through FusedStep.step)."""
+    taken = []
+    advance = fused_module.FusedStep.advance
+
+    def counting(self, *args, **kwargs):
+        out = advance(self, *args, **kwargs)
+        taken.append(out[2])
+        return out
+
+    monkeypatch.setattr(fused_module.FusedStep, "advance", counting)
+    return taken
+
+
+def _assert_same(a, b):
+    assert a.steps == b.steps and a.particles.n == b.particles.n
+    for name in FIELDS:
+        u, v = getattr(a.particles, name), getattr(b.particles, name)
+        assert np.array_equal(u, v), f"{name} differs by {float(np.max(np.abs(u - v))):.3g}"
+    assert np.array_equal(a.nodal_mass, b.nodal_mass) and np.array_equal(a.nodal_velocity, b.nodal_velocity)
+
+
+def _gas(boundary, steps):
+    """A smooth acoustic wave between walls, or driven by a small piston at both ends."""
+    x, V = seed_positions(GRID, 4, "regular")
+    rho = 1.0 + 0.1 * np.sin(2 * np.pi * x)
+    p = rho**1.4
+    particles = make_particles(x, V, rho, 0.05 * np.sin(np.pi * x), p / (0.4 * rho), p)
+    g = lambda x, t: 0.02 * np.sin(5.0 * t) + 0.0 * x  # noqa: E731
+    wall = Walls() if boundary == "walls" else Dirichlet(g)
+    return Problem(model=IdealGas(), boundary=wall, T=steps * 1e-3, cfl=1.0, dt=1e-3), particles
+
+
+def _burgers(steps):
+    """Viscous Burgers with Dirichlet inflow at both ends and a reservoir feeding particles in."""
+    x, V = seed_positions(GRID, 4, "jittered", seed=4)
+    particles = make_particles(x, V, 1.0, 0.3 + 0.2 * np.sin(2 * np.pi * x))
+    g = lambda x, t: 0.3 + 0.1 * np.sin(3.0 * t) + 0.0 * x  # noqa: E731
+    return Problem(model=ViscousBurgers(0.01), boundary=Dirichlet(g), particle_boundary=Reservoir(0.025, g),
+                   T=steps * 5e-4, cfl=1.0, dt=5e-4), particles
+
+
+def _compare(case, stages, steps):
+    problem, particles = _gas(case, steps) if case in ("walls", "piston") else _burgers(steps)
+    reference = run(problem, GRID, particles, stages, progress=False, kernel="numpy")
+    fused = run(problem, GRID, particles, stages, progress=False, kernel="fused")
+    assert reference.steps >= steps
+    _assert_same(reference, fused)
+    assert not np.array_equal(fused.particles.velocity, particles.velocity[:fused.particles.n])
+    return reference, fused
+
+
+@pytest.mark.parametrize(("remedy", "scheme", "mass", "case"), [
+    (dict(flip=0.99), "usl", "lumped", "walls"),
+    (dict(flip=0.0), "musl", "lumped", "piston"),
+    (dict(flip=0.5), "usf", "consistent", "burgers"),
+    (dict(xpic=3), "usl", "lumped", "walls"),
+    (dict(xpic=2), "musl", "consistent", "piston"),
+    (dict(xpic=5), "usl", "lumped", "burgers"),
+    (dict(basis="bspline_gimp"), "usl", "lumped", "walls"),
+    (dict(basis="bspline_gimp"), "usf", "consistent", "burgers"),
+    (dict(basis="bspline_gimp", xpic=5), "musl", "lumped", "piston"),
+    (dict(basis="bspline_gimp", flip=0.9), "usl", "lumped", "burgers"),
+])
+def test_remedy_in_the_fused_step_equals_the_numpy_step_bit_for_bit(remedy, scheme, mass, case):
+    """200 steps (the reservoir adds and removes particles on the Burgers case)."""
+    _compare(case, Stages(scheme=scheme, mass=mass, **remedy), 200)
+
+
+def test_the_blend_changes_the_step():
+    """The blend is not ignored: FLIP 0.5 and PIC differ from FLIP, and PIC equals XPIC(1)."""
+    runs = {k: _compare("walls", Stages(**kw), 50)[1].particles.velocity
+            for k, kw in (("flip", {}), ("half", dict(flip=0.5)), ("pic", dict(flip=0.0)), ("xpic1", dict(xpic=1)))}
+    assert not np.array_equal(runs["flip"], runs["half"]) and not np.array_equal(runs["half"], runs["pic"])
+    assert np.allclose(runs["pic"], runs["xpic1"], rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("remedy", [dict(flip=0.99), dict(basis="bspline_gimp"), dict(xpic=5)])
+def test_sod_through_the_compiled_loop_equals_the_numpy_step(remedy, loop_steps):
+    """Sod's tube with the CFL step: the blend and the particle-domain B-spline run in the compiled
+    loop (every step but the first); XPIC runs the per-step path (no loop step)."""
+    settings = dict(h=0.02, ppc=4, T=0.05, cfl=0.3, **remedy)
+    reference = simulate(SodSettings(**settings, kernel="numpy"), progress=False)
+    fused = simulate(SodSettings(**settings), progress=False)
+    _assert_same(reference, fused)
+    assert (reference.t, reference.dt_min, reference.dt_max) == (fused.t, fused.dt_min, fused.dt_max)
+    assert sum(loop_steps) == (0 if "xpic" in remedy else fused.steps - 1)
+
+
+def test_what_the_fused_step_runs_and_refuses():
+    for remedy in (dict(flip=0.5), dict(xpic=5), dict(basis="bspline_gimp"), dict(basis="bspline_gimp", xpic=5)):
+        assert supported(IdealGas(), Stages(**remedy)) is None
+    for remedy in (dict(reconstruct="taylor"), dict(volume="grid")):
+        assert "reconstruct and volume" in supported(IdealGas(), Stages(**remedy))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scheme", ["usl", "usf", "musl"])
+@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+@pytest.mark.parametrize("case", ["walls", "piston", "burgers"])
+def test_particle_domain_bspline_with_xpic_over_1000_steps(scheme, mass, case):
+    _compare(case, Stages(basis="bspline_gimp", xpic=5, scheme=scheme, mass=mass), 1000)
