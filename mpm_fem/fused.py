@@ -36,11 +36,14 @@ The plateau remedies of :class:`~mpm_fem.step.Stages`, with the numpy step's ope
               (``consts[6] > 0``: its nodal field comes in place of ``a_i``). Per step only.
     basis     ``"bspline_gimp"`` (code 3): the B-splines averaged over the particle domain
               (:func:`_bspline_domain_row`); rows stored and widened as GIMP's (``c_hi - c_lo + 4``).
+    volume    ``"grid"``: after pass 1 (without the gas force) the volume reset of the numpy step
+              (:func:`mpm_fem.volume.grid_volume_factor`, the model's ``with_volume``; numpy), then
+              the gas force of the reset state (:func:`_gas_force`). Per step only.
 
 Supported: the four bases (``"mpm"``, ``"gimp"``, ``"bspline"``, ``"bspline_gimp"``), USL, USF,
 MUSL, lumped and consistent mass, calculated or exact acceleration, the ideal gas and viscous
-Burgers (both its forces), the PIC/FLIP blend and XPIC(m). Stages with an exact projection, mass
-or interpolation, the Taylor reconstruction and the grid volume run the numpy step
+Burgers (both its forces), the PIC/FLIP blend, XPIC(m) and the grid volume. Stages with an exact
+projection, mass or interpolation, and the Taylor reconstruction, run the numpy step
 (:func:`supported` says which), as does any ``kernel="numpy"`` run.
 """
 
@@ -56,8 +59,9 @@ from .models.burgers import ViscousBurgers
 from .models.euler import IdealGas
 from .particles import Particles, PositivityError
 from .shape import Shape, make_shape
-from .step import SCHEMES, GridState, Stages, Walls
+from .step import SCHEMES, GridState, Stages, Walls, _reset_volume
 from .transfer import solve_consistent
+from .volume import grid_volume_factor
 from .xpic import boundary_change_rule
 
 KERNELS = ("fused", "numpy")
@@ -70,8 +74,8 @@ def supported(model, stages: Stages) -> str | None:
     """``None`` if the fused step implements this model and these stages, else the reason."""
     if stages.uses_exact_fields:
         return "the exact projection, mass and interpolation stages run the numpy step"
-    if stages.reconstruct != "none" or stages.volume != "carried":
-        return "the plateau remedies reconstruct and volume run the numpy step"
+    if stages.reconstruct != "none":
+        return "the plateau remedy reconstruct runs the numpy step"
     if not isinstance(model, (IdealGas, ViscousBurgers)):
         return f"the fused step has no kernel for the model {type(model).__name__}"
     return None
@@ -501,6 +505,19 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
         _sum_chunks(buf, 0, P_i, 1.0)
 
 
+def _gas_force(nodes, h, inv_spacing, x, rows, S, G, cell, V, p, chunks, F_i):
+    """The gas force of pass 1 alone (after the volume reset): ``F_i = sum_p V_p p_p G_ip``."""
+    n = x.size
+    K = WIDTH  # nodes per particle
+    buf = np.zeros((chunks, 1, F_i.size))
+    for k in prange(chunks):
+        r, Sl, Gl = _one_row(K)
+        for q in range(*_chunk(n, chunks, k)):
+            _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            _scatter(buf, k, r, Gl, V[q] * p[q], K)
+    _sum_chunks(buf, 0, F_i, 1.0)
+
+
 def _xpic_momentum(nodes, h, inv_spacing, x, rows, S, G, cell, m, u_i, chunks, P_i):
     """XPIC's projection of an interpolated grid field: ``P_i = sum_p S_ip m_p (sum_j S_jp u_j)``
     (:func:`mpm_fem.transfer.nodal_momentum` of ``shape.gather(u)``)."""
@@ -747,10 +764,11 @@ class FusedStep:
 
     def loops(self, problem) -> bool:
         """Whether :meth:`advance` can take the steps of ``problem``: walls, the lumped mass, the
-        calculated acceleration, the weak force and no XPIC (no particle boundary, no observer: the
-        caller's)."""
+        calculated acceleration, the weak force, no XPIC and no volume reset (no particle boundary,
+        no observer: the caller's)."""
         return (type(problem.boundary) is Walls and self.stages.mass == "lumped"
-                and self.stages.acceleration == "calculated" and not self.slides and not self.stages.xpic)
+                and self.stages.acceleration == "calculated" and not self.slides and not self.stages.xpic
+                and self.stages.volume == "carried")
 
     def advance(self, particles: Particles, t: float, problem, steps: int, max_steps: int, budget: int):
         """Up to ``budget`` steps from ``t`` in one compiled loop (:func:`_advance`), each the step
@@ -807,7 +825,8 @@ class FusedStep:
         rho, e, p = particles.density, particles.energy, particles.pressure
         gas = self.kind == GAS
         scheme, exact = self.stages.scheme, self.stages.acceleration == "exact"
-        gas_force = gas and scheme != "usf" and not exact
+        grid_volume = self.stages.volume == "grid"
+        gas_force = gas and scheme != "usf" and not exact and not grid_volume
         store = self.basis in _DOMAIN_BASES or self.stages.mass == "consistent"
         geometry = (self.nodes, self.h, self.inv_spacing)
         n_nodes = grid.n_nodes
@@ -831,6 +850,11 @@ class FusedStep:
         shape = Shape(rows, S, G, n_nodes, cell)
         v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
         shape_args = (*geometry, x, rows, S, G, cell)
+        if grid_volume:  # the volume reset, in numpy (mpm_fem.volume), then the force of the reset state
+            reset = _reset_volume(self.model, particles, grid_volume_factor(grid, x, V, self.stages.basis, shape))
+            V, rho, e, p = reset.volume, reset.density, reset.energy, reset.pressure
+            if gas and scheme != "usf" and not exact:
+                self._passes.get(_gas_force, BASIS=self.basis, WIDTH=self.K)(*shape_args, V, p, chunks, F_i)
 
         V_new, m_new = empty("V", n), (empty("m", n) if not gas else m)
         rho_new, e_new, p_new = (empty("rho", n), empty("e", n), empty("p", n)) if gas else (rho, e, p)

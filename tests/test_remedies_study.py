@@ -4,6 +4,9 @@ import pytest
 
 from claim_mutations import judge
 
+from mpm_fem.fused import supported
+from mpm_fem.models.euler import IdealGas
+from mpm_fem.step import Stages
 from mpm_fem.study import StudyOptions, read_table
 from mpm_fem.tables import load_tables
 from studies import remedies
@@ -11,13 +14,19 @@ from studies import remedies
 
 def test_plan_runs_every_remedy_on_the_stated_meshes():
     plan = remedies._plan(quick=False)
-    assert {h for _, h in plan["sod"]} == set(remedies.SOD_H) and len(remedies.SOD_H) == 4
+    assert {h for _, h in plan["sod"]} == set(remedies.SOD_H) and remedies.SOD_H[-1] == 0.0003125
+    assert set(plan["fv"]) == set(remedies.SOD_H)  # the FV reference on every mesh any remedy runs
     assert {n for n, _ in plan["burgers"]} == set(remedies.REMEDIES)
     sod_meshes = {n: {h for m, h in plan["sod"] if m == n} for n in remedies.REMEDIES}
     for name in ("XPIC(2)", "XPIC(5)", "B-spline domain + XPIC(2)"):  # stopped on the coarse meshes
         assert sod_meshes.pop(name) == set(remedies.SOD_H[:3]), name
-    assert all(hs == set(remedies.SOD_H) for hs in sod_meshes.values())
-    assert plan["sod"][("B-spline domain + XPIC(5)", 0.00125)]["xpic"] == 5
+    for name in ("MPM", "B-spline domain", "B-spline domain + XPIC(5)"):  # every mesh
+        assert sod_meshes.pop(name) == set(remedies.SOD_H), name
+    assert sod_meshes.pop("FLIP 0.99") == set(remedies.SOD_H[:5])
+    assert all(hs == set(remedies.SOD_H[:4]) for hs in sod_meshes.values())  # the numpy-only remedies
+    for name in sod_meshes:  # they are the ones the fused step refuses
+        assert supported(IdealGas(), Stages(**remedies.REMEDIES[name])) is not None, name
+    assert plan["sod"][("B-spline domain + XPIC(5)", 0.0003125)]["xpic"] == 5
     assert all(case["ppc"] == 16 and case["cfl"] == 0.05 for case in plan["sod"].values())
     assert all(case["ppc"] == 4 and case["acceleration"] == "calculated" for case in plan["burgers"].values())
 

@@ -23,7 +23,7 @@ from ..step import Stages, StageSwitches
 # B-spline and the consistent mass 7e-8 to 1.6e-7) plus 4 us (walls: the compiled loop) to
 # 0.13 ms (Burgers: one call per step, its inflow and Dirichlet data in Python).
 # The fused constants apply where the fused step runs (not the exact stages, not the Taylor
-# reconstruction or the grid volume: the blend, XPIC(m) and the particle-domain B-spline run fused).
+# reconstruction: the blend, XPIC(m), the particle-domain B-spline and the grid volume run fused).
 BYTES_PER_PARTICLE = 400
 BYTES_PER_NODE = 400
 BYTES_PER_STEP = 32
@@ -94,8 +94,7 @@ def run_cost(settings, domain: tuple[float, float], max_speed: float, dt_cap: fl
     dt = settings.cfl * min(settings.h / max_speed if max_speed > 0 else math.inf, dt_cap) / settings.refine
     steps = math.ceil(settings.T / dt) if settings.T > 0 else 0
     stages = settings.stages
-    fused = settings.kernel == "fused" and not (stages.uses_exact_fields or stages.reconstruct != "none"
-                                                or stages.volume != "carried")
+    fused = settings.kernel == "fused" and not (stages.uses_exact_fields or stages.reconstruct != "none")
     return Cost(particles=n_cells * settings.ppc, nodes=n_cells + 1, steps=steps, kernel="fused" if fused else "numpy")
 
 
