@@ -13,18 +13,28 @@ combinations that promise most, errors over grid nodes and over particles:
   time, for MPM with each remedy, fixed-mesh P1 FEM (lumped mass) and FV. Wall time is the last
   column: it varies from run to run and no verdict uses it.
 
-Meshes: Sod h = 0.01 ... 0.00125, the convergence study's meshes without its two finest (0.000625
-and 0.0003125): each halving costs 4x, the B-spline and volume remedies run 5-7x slower per step
-than point mass, and the two finest meshes would cost about 20x the four kept (some 10 CPU hours);
-the particle plateau of the study settings shows from h = 0.00125 on. Burgers h = 0.04 ... 0.005
-(the general time loop runs the remedies; the viscous step limit makes a halving of h cost 8x).
+Meshes: Sod h = 0.01 ... 0.0003125 (the convergence study's meshes but its finest, 0.00015625),
+each remedy on the first ``SOD_MESHES[name]`` of them. The blend, XPIC(m), the particle-domain
+B-spline and the grid volume run the fused compiled step (:mod:`mpm_fem.fused`, bit for bit the
+numpy step); the Taylor reconstruction runs the numpy step only, and its three remedies stop at
+h = 0.00125 (``SOD_NUMPY_MESHES``; the numpy step there costs some 10 CPU hours for the two finer
+meshes). Measured with the fused step (one run each, CPU seconds, compiled code warm, a shared
+2-core machine): B-spline domain + XPIC(5) 61 s at h = 0.000625 and 231 s at 0.0003125; B-spline
+domain 43 s and 211 s; point-mass MPM 11 s and 46 s; FLIP 0.99 11 s at 0.000625; grid volume
+GRIDVOL s at 0.000625. So MPM (the plateau's reference) and the two promising remedies, B-spline
+domain and B-spline domain + XPIC(5), run every mesh to 0.0003125; FLIP 0.99 and the grid volume
+stop at 0.000625 (their particle error already grows at 0.00125); together about ADDED CPU-min
+more than the coarse meshes (which now also run fused, faster than before). E5 counts a remedy as
+removing the plateau only if it ran on every Sod mesh of the table (to 0.0003125): those that stop
+earlier are reported, never credited. Burgers h = 0.04 ... 0.005 (the viscous step limit makes a
+halving of h cost 8x).
 
 XPIC(m) (:mod:`mpm_fem.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline. On Sod
-three of them stop at h = 0.0025 (``SOD_COARSE``), hopeless on the coarse meshes already (one run at
+three of them stop at h = 0.0025 (``SOD_MESHES``), hopeless on the coarse meshes already (one run at
 every mesh measured it): XPIC(2) and XPIC(5) alone keep point-mass MPM's particle order between
 h = 0.005 and 0.0025 (0.68 and 0.68 against MPM's 0.66; criterion 0.8) and stall at 0.00125 (0.27,
 0.21); the B-spline + XPIC(2) has 1.1-1.2x the nodal density L1 of the B-spline alone and 3.0-3.1x
-the FV error at every coarse h (goal 1.5x), and its finest mesh alone costs ~60 CPU-s. E5 counts a
+the FV error at every coarse h (goal 1.5x), and its finest mesh alone cost ~60 CPU-s with the numpy step. E5 counts a
 remedy as removing the plateau only over every Sod mesh. Burgers runs them all on every mesh.
 """
 
@@ -64,9 +74,9 @@ REMEDIES = {
     "B-spline domain + XPIC(2)": {"basis": "bspline_gimp", "xpic": 2},
     "B-spline domain + XPIC(5)": {"basis": "bspline_gimp", "xpic": 5},
 }
-SOD_MESHES = {"MPM": 6, "B-spline domain": 6, "B-spline domain + XPIC(5)": 6, "FLIP 0.99": 5,
+SOD_MESHES = {"MPM": 6, "B-spline domain": 6, "B-spline domain + XPIC(5)": 6, "FLIP 0.99": 5, "grid volume": 5,
               **{name: 3 for name in ("XPIC(2)", "XPIC(5)", "B-spline domain + XPIC(2)")}}  # the rest: 4 (docstring)
-SOD_NUMPY_MESHES = 4  # the remedies the fused step does not run (reconstruct, volume): to h = 0.00125
+SOD_NUMPY_MESHES = 4  # the remedies the fused step does not run (reconstruct): to h = 0.00125
 QUICK = dict(SOD_H=SOD_H[:2], BURGERS_H=BURGERS_H[:2],
              REMEDIES=("MPM", "Taylor LS", "grid volume", "FLIP 0.99", "Taylor + volume", "XPIC(5)"))
 
@@ -124,7 +134,8 @@ def _cost(case: dict) -> float:
     h = case["h"]
     if case["solver"] in ("fem", "fv"):
         return 1.0 / h**2
-    slow = (6.0 if case.get("basis") == "bspline_gimp" else 1.0) * (1.0 + 0.3 * case.get("xpic", 0))
+    numpy_only = 5.0 if case.get("reconstruct", "none") != "none" else 1.0  # the rest run the fused step
+    slow = numpy_only * (4.0 if case.get("basis") == "bspline_gimp" else 1.0) * (1.0 + 0.3 * case.get("xpic", 0))
     if case["solver"] == "burgers":
         return slow * 4 * 0.09 / h**3
     return slow * case["ppc"] / (h**2 * case["cfl"])
