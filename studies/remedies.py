@@ -17,14 +17,15 @@ Meshes: Sod h = 0.01 ... 0.0003125 (the convergence study's meshes but its fines
 each remedy on the first ``SOD_MESHES[name]`` of them. The blend, XPIC(m), the particle-domain
 B-spline and the grid volume run the fused compiled step (:mod:`mpm_fem.fused`, bit for bit the
 numpy step); the Taylor reconstruction runs the numpy step only, and its three remedies stop at
-h = 0.00125 (``SOD_NUMPY_MESHES``; the numpy step there costs some 10 CPU hours for the two finer
-meshes). Measured with the fused step (one run each, CPU seconds, compiled code warm, a shared
+h = 0.00125 (``SOD_NUMPY_MESHES``; in the numpy step each halving costs 4x, the two finer meshes
+about 20x the four kept). Measured with the fused step (one run each, CPU seconds, compiled code warm, a shared
 2-core machine): B-spline domain + XPIC(5) 61 s at h = 0.000625 and 231 s at 0.0003125; B-spline
-domain 43 s and 211 s; point-mass MPM 11 s and 46 s; FLIP 0.99 11 s at 0.000625; grid volume
-GRIDVOL s at 0.000625. So MPM (the plateau's reference) and the two promising remedies, B-spline
-domain and B-spline domain + XPIC(5), run every mesh to 0.0003125; FLIP 0.99 and the grid volume
-stop at 0.000625 (their particle error already grows at 0.00125); together about ADDED CPU-min
-more than the coarse meshes (which now also run fused, faster than before). E5 counts a remedy as
+domain 43 s and 211 s; point-mass MPM 14 s and 46 s; FLIP 0.99 11 s at 0.000625; the grid volume
+184 s at 0.000625 (its reset recomputes the GIMP rows in numpy every step). So MPM (the plateau's
+reference) and the two promising remedies, B-spline domain and B-spline domain + XPIC(5), run every
+mesh to 0.0003125; FLIP 0.99 (cheap) stops at 0.000625; the grid volume stays at 0.00125 (its
+particle order there is 0.42 already, and one more mesh costs 3 CPU-min): together about 10 CPU-min
+more than the four coarse meshes (which now run fused, faster than before). E5 counts a remedy as
 removing the plateau only if it ran on every Sod mesh of the table (to 0.0003125): those that stop
 earlier are reported, never credited. Burgers h = 0.04 ... 0.005 (the viscous step limit makes a
 halving of h cost 8x).
@@ -34,8 +35,8 @@ three of them stop at h = 0.0025 (``SOD_MESHES``), hopeless on the coarse meshes
 every mesh measured it): XPIC(2) and XPIC(5) alone keep point-mass MPM's particle order between
 h = 0.005 and 0.0025 (0.68 and 0.68 against MPM's 0.66; criterion 0.8) and stall at 0.00125 (0.27,
 0.21); the B-spline + XPIC(2) has 1.1-1.2x the nodal density L1 of the B-spline alone and 3.0-3.1x
-the FV error at every coarse h (goal 1.5x), and its finest mesh alone cost ~60 CPU-s with the numpy step. E5 counts a
-remedy as removing the plateau only over every Sod mesh. Burgers runs them all on every mesh.
+the FV error at every coarse h (goal 1.5x), and its finest mesh alone cost ~60 CPU-s with the
+numpy step. Burgers runs them all on every mesh.
 """
 
 from __future__ import annotations
@@ -74,7 +75,7 @@ REMEDIES = {
     "B-spline domain + XPIC(2)": {"basis": "bspline_gimp", "xpic": 2},
     "B-spline domain + XPIC(5)": {"basis": "bspline_gimp", "xpic": 5},
 }
-SOD_MESHES = {"MPM": 6, "B-spline domain": 6, "B-spline domain + XPIC(5)": 6, "FLIP 0.99": 5, "grid volume": 5,
+SOD_MESHES = {"MPM": 6, "B-spline domain": 6, "B-spline domain + XPIC(5)": 6, "FLIP 0.99": 5,
               **{name: 3 for name in ("XPIC(2)", "XPIC(5)", "B-spline domain + XPIC(2)")}}  # the rest: 4 (docstring)
 SOD_NUMPY_MESHES = 4  # the remedies the fused step does not run (reconstruct): to h = 0.00125
 QUICK = dict(SOD_H=SOD_H[:2], BURGERS_H=BURGERS_H[:2],
