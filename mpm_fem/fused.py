@@ -471,7 +471,8 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
     n = x.size
     K = WIDTH  # nodes per particle
     gas, g_gm1 = MODEL == GAS, consts[1]
-    flip, pic = consts[5], consts[6] > 0  # the PIC/FLIP blend; XPIC: a_i holds v* + dt a (module docstring)
+    flip = consts[5] if consts.size > 5 else 1.0  # the PIC/FLIP blend (a shorter consts: FLIP)
+    pic = consts.size > 6 and consts[6] > 0  # XPIC: a_i holds v* + dt a (module docstring)
     buf = np.zeros((chunks if musl else 1, 1, P_i.size))
     for k in prange(chunks):
         tally = _NO_TALLY

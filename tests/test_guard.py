@@ -15,11 +15,15 @@ def test_the_estimate_uses_the_constants_of_the_kernel_that_runs():
     assert fused.seconds < numpy.seconds / 2.5
 
 
-@pytest.mark.parametrize("changes", [dict(projection="exact"), dict(mass="exact"), dict(flip=0.5),
-                                     dict(basis="bspline_gimp"), dict(volume="grid")])
+@pytest.mark.parametrize("changes", [dict(projection="exact"), dict(mass="exact"), dict(reconstruct="taylor")])
 def test_stages_the_fused_step_does_not_run_are_estimated_as_numpy(changes):
     assert sod.cost(sod.SodSettings(h=0.01, **changes)).kernel == "numpy"
     assert burgers.cost(burgers.BurgersSettings(h=0.01, **changes)).kernel == "numpy"
+
+
+@pytest.mark.parametrize("changes", [dict(flip=0.5), dict(xpic=5), dict(basis="bspline_gimp"), dict(volume="grid")])
+def test_remedies_the_fused_step_runs_are_estimated_as_fused(changes):
+    assert sod.cost(sod.SodSettings(h=0.01, **changes)).kernel == "fused"
 
 
 def test_a_cost_without_a_kernel_is_the_numpy_estimate():
