@@ -1,6 +1,9 @@
 """The fused step's compiled loop (FusedStep.advance, taken by solve.run between walls with the
-lumped mass) against the numpy step: the same time steps (CFL from each step's max(c + |v|) or
-max |v| with the viscous limit, the last step landing on T) and the same particles, bit for bit."""
+lumped mass) against the fused step taken one step at a time and against the numpy step: the same
+time steps (CFL from each step's max(c + |v|) or max |v| with the viscous limit, the last step
+landing on T) and the same particles, bit for bit. The point mass on a uniform grid (uniform-grid
+arithmetic) equals the numpy step to ``TOLERANCE`` relative (tests/test_fused.py), and its loop
+the per-step path bit for bit."""
 
 import numpy as np
 import pytest
@@ -15,6 +18,13 @@ from mpm_fem.solve import Problem, run
 from mpm_fem.step import Stages, Walls
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
+TOLERANCE = 1e-12  # as tests/test_fused.py: max_p |u_fused - u_numpy| <= TOLERANCE max_p |u_numpy|, each field
+
+
+def _deviation(u, v):
+    scale = float(np.max(np.abs(u), initial=0.0))
+    gap = float(np.max(np.abs(u - v), initial=0.0))
+    return gap / scale if scale > 0 else gap
 
 
 @pytest.fixture
@@ -32,6 +42,12 @@ def loop_steps(monkeypatch):
     return taken
 
 
+@pytest.fixture
+def one_at_a_time(monkeypatch):
+    """Runs the fused step without its loop (every step through FusedStep.step), when called."""
+    return lambda: monkeypatch.setattr(fused_module.FusedStep, "loops", lambda self, problem: False)
+
+
 def _assert_same(a, b):
     assert (a.steps, a.t, a.dt_min, a.dt_max) == (b.steps, b.t, b.dt_min, b.dt_max)
     for name in FIELDS:
@@ -40,13 +56,26 @@ def _assert_same(a, b):
     assert np.array_equal(a.nodal_mass, b.nodal_mass) and np.array_equal(a.nodal_velocity, b.nodal_velocity)
 
 
+def _assert_close(a, b):
+    """The numpy step against the point mass's uniform-grid arithmetic: ``TOLERANCE`` relative."""
+    assert a.steps == b.steps and a.t == pytest.approx(b.t, rel=TOLERANCE)
+    for name in FIELDS:
+        u, v = getattr(a.particles, name), getattr(b.particles, name)
+        assert _deviation(u, v) <= TOLERANCE, f"{name} differs by {_deviation(u, v):.3g} relative"
+
+
 @pytest.mark.parametrize(("basis", "scheme"), [("mpm", "usl"), ("mpm", "usf"), ("mpm", "musl"), ("gimp", "usl"),
                                                ("bspline", "usl"), ("gimp", "musl")])
-def test_sod_with_the_cfl_step_equals_the_numpy_step_bit_for_bit(basis, scheme, loop_steps):
-    """Sod's tube to T = 0.1 (about 300 steps of dt = CFL h / max(c + |v|), the last one shortened)."""
+def test_sod_with_the_cfl_step_equals_the_numpy_step_bit_for_bit(basis, scheme, loop_steps, one_at_a_time):
+    """Sod's tube to T = 0.1 (about 300 steps of dt = CFL h / max(c + |v|), the last one shortened).
+    The point mass: the loop equals its per-step path bit for bit, and the numpy step to ``TOLERANCE``."""
     settings = dict(h=0.01, ppc=4, T=0.1, cfl=0.3, basis=basis, scheme=scheme)
     reference = simulate(SodSettings(**settings, kernel="numpy"), progress=False)
     fused = simulate(SodSettings(**settings), progress=False)
+    if basis == "mpm":
+        _assert_close(reference, fused)
+        one_at_a_time()
+        reference = simulate(SodSettings(**settings), progress=False)
     _assert_same(reference, fused)
     assert sum(loop_steps) == fused.steps - 1  # every step but the first ran in the loop
     assert fused.t == pytest.approx(0.1, rel=1e-12) and fused.dt_min < fused.dt_max
@@ -54,19 +83,23 @@ def test_sod_with_the_cfl_step_equals_the_numpy_step_bit_for_bit(basis, scheme, 
 
 @pytest.mark.parametrize("scheme", ["usl", "usf", "musl"])
 @pytest.mark.parametrize("refine", [1, 3])
-def test_burgers_between_walls_with_the_viscous_limit_equals_the_numpy_step(scheme, refine, loop_steps):
+def test_burgers_between_walls_with_the_viscous_limit_equals_the_numpy_step(scheme, refine, loop_steps,
+                                                                           one_at_a_time):
     """dt = CFL min(h / max|v|, h^2 / (2 eps)) / refine: the advective limit rules at eps = 0.001
-    early on, the viscous one at eps = 0.02."""
+    early on, the viscous one at eps = 0.02. The point mass on a uniform grid: the loop against its
+    per-step path bit for bit, against the numpy step to ``TOLERANCE``."""
     grid = uniform_grid(0.0, 1.0, 0.02)
     x, V = seed_positions(grid, 4)
     particles = make_particles(x, V, 1.0, np.sin(2 * np.pi * x))
-    for eps in (0.001, 0.02):
-        problem = Problem(model=ViscousBurgers(eps), boundary=Walls(), T=0.05, cfl=0.5)
-        stages = Stages(scheme=scheme, refine=refine)
-        reference = run(problem, grid, particles, stages, progress=False, kernel="numpy")
-        fused = run(problem, grid, particles, stages, progress=False, kernel="fused")
-        _assert_same(reference, fused)
+    stages = Stages(scheme=scheme, refine=refine)
+    cases = [(Problem(model=ViscousBurgers(eps), boundary=Walls(), T=0.05, cfl=0.5), stages) for eps in (0.001, 0.02)]
+    numpy_runs = [run(problem, grid, particles, stages, progress=False, kernel="numpy") for problem, stages in cases]
+    loops = [run(problem, grid, particles, stages, progress=False, kernel="fused") for problem, stages in cases]
     assert sum(loop_steps) > 0
+    one_at_a_time()
+    for (problem, stages), reference, fused in zip(cases, numpy_runs, loops):
+        _assert_close(reference, fused)
+        _assert_same(run(problem, grid, particles, stages, progress=False, kernel="fused"), fused)
 
 
 def test_the_loop_stops_where_the_run_must_fail(loop_steps):
