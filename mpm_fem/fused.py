@@ -721,6 +721,8 @@ class FusedStep:
         self._state = self._out = self._scratch = None  # advance's two sets of particle arrays, its last
         self._cur = 0  # particles, and its scratch arrays
         self._ends = np.ascontiguousarray(grid.boundary_nodes, dtype=np.intp)
+        # the stored cells and node indices (pass 1 -> the grid stage and pass 2): 4 bytes, not 8
+        self._index = np.int32 if grid.n_nodes <= np.iinfo(np.int32).max else np.intp
         self._h_min = float(grid.h.min())
 
     def _width(self, K):
@@ -777,8 +779,8 @@ class FusedStep:
         rows_n = n if self.basis == 1 else 0
         if (self._scratch is None or self._scratch[0].size != n or self._scratch[1].shape != (rows_n, self.K)
                 or self._scratch[5].shape[0] != chunks):
-            self._scratch = (np.empty(n, np.intp), np.empty((rows_n, self.K), np.intp), np.empty((rows_n, self.K)),
-                             np.empty((rows_n, self.K)), np.empty((7, self.grid.n_nodes)),
+            self._scratch = (np.empty(n, self._index), np.empty((rows_n, self.K), self._index),
+                             np.empty((rows_n, self.K)), np.empty((rows_n, self.K)), np.empty((7, self.grid.n_nodes)),
                              np.empty((chunks, 3), np.int64), np.empty((chunks, 2), np.int64), np.zeros((chunks, 2)),
                              np.empty(chunks))
         loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)
@@ -810,10 +812,10 @@ class FusedStep:
         empty = self._empty
         m_i, P_i, F_i = empty("m_i", n_nodes), empty("P_i", n_nodes), empty("F_i", n_nodes)
         flags = np.empty((chunks, 3), np.int64)
-        cell = empty("cell", n, np.intp)
+        cell = empty("cell", n, self._index)
         while True:
             rows_n = n if store else 0
-            rows, S, G = (empty("rows", (rows_n, self.K), np.intp), empty("S", (rows_n, self.K)),
+            rows, S, G = (empty("rows", (rows_n, self.K), self._index), empty("S", (rows_n, self.K)),
                           empty("G", (rows_n, self.K)))
             self.project(*geometry, x, V, m, v, p, gas_force, store, chunks, rows, S, G, cell, m_i, P_i, F_i, flags)
             if (flags[:, :2] >= 0).any():
