@@ -338,7 +338,6 @@ def _project_point(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, h
     Returns the first particle outside the grid (-1 if none)."""
     n_nodes = nodes.size
     a, b = nodes[0], nodes[n_nodes - 1]
-    r, Sl, Gl = _one_row(2)
     outside, held = -1, -1  # held: the cell whose node sums are in registers
     m0 = m1 = P0 = P1 = F0 = F1 = 0.0
     for q in range(lo, hi):
@@ -346,11 +345,12 @@ def _project_point(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, h
             if outside < 0:
                 outside = q
             continue
-        c, _ = _shape_row(0, nodes, h, inv_spacing, x[q], 0.0, r, Sl, Gl)
+        c, xi, inv_h = _point(nodes, h, inv_spacing, x[q])  # the row (c, c + 1), (1 - xi, xi), (-1, 1)/h_c
+        S0 = 1.0 - xi
         cell[q] = c
         if store:
-            for j in range(2):
-                rows[q, j], S[q, j], G[q, j] = r[j], Sl[j], Gl[j]
+            rows[q, 0], S[q, 0], G[q, 0] = c, S0, -inv_h
+            rows[q, 1], S[q, 1], G[q, 1] = c + 1, xi, inv_h
         if c != held:
             if held >= 0:
                 buf[0, held], buf[1, held], buf[2, held] = m0, P0, F0
@@ -359,14 +359,14 @@ def _project_point(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, h
             m1, P1, F1 = buf[0, c + 1], buf[1, c + 1], buf[2, c + 1]
             held = c
         mv = m[q] * v[q]
-        m0 += Sl[0] * m[q]
-        P0 += Sl[0] * mv
-        m1 += Sl[1] * m[q]
-        P1 += Sl[1] * mv
+        m0 += S0 * m[q]
+        P0 += S0 * mv
+        m1 += xi * m[q]
+        P1 += xi * mv
         if gas_force:
             Vp = V[q] * p[q]
-            F0 += Gl[0] * Vp
-            F1 += Gl[1] * Vp
+            F0 += -inv_h * Vp
+            F1 += inv_h * Vp
     if held >= 0:
         buf[0, held], buf[1, held], buf[2, held] = m0, P0, F0
         buf[0, held + 1], buf[1, held + 1], buf[2, held + 1] = m1, P1, F1
