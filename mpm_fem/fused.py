@@ -22,9 +22,12 @@ scatters into its own grid buffer and the buffers are summed in chunk order. The
 only on ``threads``, not on scheduling (deterministic), but the sums are grouped differently, so
 it equals the one-thread step to round-off, not bit for bit.
 
-The loop (``FusedStep.advance``, :func:`_advance`): between walls with the lumped mass, a run
-takes many steps in one compiled call, the grid stage, the wall conditions and the time step of
-:func:`mpm_fem.solve.run` included, in the same order as the per-step path (the same numbers).
+The loop (``FusedStep.advance``, :func:`_advance`): between walls or Dirichlet ends with the lumped
+mass, a run takes many steps in one compiled call, the grid stage, the end conditions and the time
+step of :func:`mpm_fem.solve.run` included, in the same order as the per-step path (the same
+numbers). The Dirichlet data come from the boundary's own function, called in object mode once per
+step (the same floats); a reservoir that says when it acts (Burgers') ends a loop after the step it
+acts on, and the run applies it and re-enters.
 
 Supported: the three bases (``"mpm"``, ``"gimp"``, ``"bspline"``), USL, USF, MUSL, lumped and
 consistent mass, calculated or exact acceleration, the ideal gas and viscous Burgers (both its

@@ -5,8 +5,9 @@ or the problem's fixed ``dt``, divided by ``stages.refine`` (the last step short
 ``T``). Every step is checked: lost positivity raises
 :class:`~mpm_fem.particles.PositivityError` naming the step, and a non-finite particle state raises
 :class:`FloatingPointError` naming the step and the particle: a run never returns NaN. Between
-walls with the lumped mass the fused step takes the steps in compiled loops
-(:meth:`~mpm_fem.fused.FusedStep.advance`), the same steps bit for bit.
+walls or Dirichlet ends with the lumped mass (and Burgers' reservoir, applied between loops) the
+fused step takes the steps in compiled loops (:meth:`~mpm_fem.fused.FusedStep.advance`), the same
+steps bit for bit.
 """
 
 from __future__ import annotations
