@@ -466,15 +466,22 @@ def _lumped_walls(rhs, m_i, ends, out):
         out[i] = 0.0
 
 
-_LOOP_ENDS = []  # (Dirichlet boundary, grid) of the running loop, read by _end_values
+_LOOP_CALLS = []  # (boundary, grid, exact acceleration) of the running loop, for its object-mode calls
 
 
 def _end_values(t):
     """The Dirichlet data ``g(x_b, t)`` at the end nodes, from the running loop's boundary object
     (:meth:`~mpm_fem.step.Dirichlet.end_values`: the same call, the same floats, the same cache as
     the per-step path). Called from the compiled loop in object mode, once per step."""
-    boundary, grid = _LOOP_ENDS[-1]
+    boundary, grid, _ = _LOOP_CALLS[-1]
     return np.ascontiguousarray(boundary.end_values(grid, t), dtype=float)
+
+
+def _exact_acceleration(t):
+    """The problem's exact nodal acceleration ``a*(x_i, t)``, the call the per-step path makes
+    (the same floats); from the compiled loop in object mode, once per step."""
+    _, grid, exact_acceleration = _LOOP_CALLS[-1]
+    return np.ascontiguousarray(exact_acceleration(grid.nodes, t), dtype=float)
 
 
 @njit(cache=True, inline="always")
@@ -503,7 +510,7 @@ def _reservoir_quiet(x, window):
 
 def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t, T, speed, fixed_dt, cfl, h_min,
              refine, viscous_limit, steps, max_steps, budget, cell, rows, S, G, grid, flags, upd, values, speeds,
-             dirichlet, window):
+             dirichlet, window, exact):
     """Up to ``budget`` steps of :meth:`FusedStep.step` between walls with the lumped mass, each with
     the time step :func:`mpm_fem.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL``
     from the previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between
@@ -516,6 +523,8 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     MUSL's re-projection ``g(t + dt)``), ``g`` evaluated in object mode once per step
     (:func:`_end_values`). A non-empty ``window = (a, b, spacing)`` stops the loop after the first
     step whose particles the reservoir would change (:func:`_reservoir_quiet`): the caller applies it.
+    With ``exact`` the nodal acceleration is the problem's exact one (:func:`_exact_acceleration`, in
+    object mode), and no viscous force is computed.
     Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     n = cell.size
     gas = MODEL == GAS
@@ -560,13 +569,20 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
                 g_next = _end_values(t_next)
             _set_ends(ends, g_t, v_i)
         if scheme == 1:  # USF: the state first, then its force
-            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, True, chunks,
+            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact, chunks,
                    V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
             if (upd >= 0).any():
                 break
-        elif not gas:
+        elif not gas and not exact:
             VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i)
-        _lumped_walls(F_i, m_i, ends, a_i)
+        if exact:
+            with objmode(a_exact="float64[::1]"):
+                a_exact = _exact_acceleration(t)
+            a_i[:] = a_exact
+            for i in ends:
+                a_i[i] = 0.0
+        else:
+            _lumped_walls(F_i, m_i, ends, a_i)
         if dirichlet:
             for k in range(ends.size):
                 a_i[ends[k]] = (g_next[k] - v_i[ends[k]]) / dt
@@ -723,11 +739,14 @@ class FusedStep:
 
     def loops(self, problem) -> bool:
         """Whether :meth:`advance` can take the steps of ``problem``: walls or Dirichlet ends (this
-        step's boundary), the lumped mass, the calculated acceleration and the weak force, and no
+        step's boundary), the lumped mass, the calculated acceleration and the weak force or the
+        exact acceleration (this step's), and no
         particle boundary or one that says when it acts (:meth:`_window`; no observer: the caller's)."""
         ends = type(problem.boundary) is Walls or (type(problem.boundary) is Dirichlet
                                                    and problem.boundary is self.boundary)
-        return (ends and self.stages.mass == "lumped" and self.stages.acceleration == "calculated"
+        exact = (self.stages.acceleration == "exact" and self.exact_acceleration is not None
+                 and problem.exact_acceleration is self.exact_acceleration)
+        return (ends and self.stages.mass == "lumped" and (self.stages.acceleration == "calculated" or exact)
                 and not self.slides and (problem.particle_boundary is None or self._window(problem) is not None))
 
     def _window(self, problem):
@@ -761,15 +780,16 @@ class FusedStep:
         viscous = bool(getattr(self.model, "viscous_limit", False))
         dirichlet = type(self.boundary) is Dirichlet
         window = np.empty(0) if problem.particle_boundary is None else np.array(self._window(problem), dtype=float)
-        _LOOP_ENDS.append((self.boundary, self.grid))
+        exact = self.stages.acceleration == "exact"
+        _LOOP_CALLS.append((self.boundary, self.grid, self.exact_acceleration))
         try:
             cur, t, done, speed, dt_min, dt_max = loop(
                 self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
                 chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
                 float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
-                *self._scratch, dirichlet, window)
+                *self._scratch, dirichlet, window, exact)
         finally:
-            _LOOP_ENDS.pop()
+            _LOOP_CALLS.pop()
         if done:
             self._cur, self.speed, self.finite = cur, float(speed), True
             self._out = Particles(**{name: self._state[cur, j, :n] for j, name in enumerate(_FIELDS)})
