@@ -763,18 +763,22 @@ class FusedStep:
         dt_min, dt_max)``; zero steps when the next step must go through :meth:`step` (it fails, or
         a GIMP particle's row changes width)."""
         n, chunks = particles.n, max(1, min(self.threads, particles.n))
-        if self._out is not particles or self._state.shape[2] != n + _PAD:  # particles from elsewhere: copied into both sets (the mass of
-            self._state = np.empty((2, len(_FIELDS), n + _PAD))  # the gas, rho, eps, p of Burgers stay there)
-            self._state[:, :, :n] = [getattr(particles, name) for name in _FIELDS]
+        if self._out is not particles or self._state.shape[2] < n + _PAD:  # particles from elsewhere: copied into both sets (the mass of
+            if self._state is None or self._state.shape[2] < n + _PAD:  # the gas, rho, eps, p of Burgers stay there), with room
+                self._state = np.empty((2, len(_FIELDS), n + n // 16 + _PAD))  # for a reservoir's inflow
+            for j, name in enumerate(_FIELDS):
+                self._state[:, j, :n] = getattr(particles, name)
             self._pools = ({}, {})  # the per-step arrays: refilled if a step falls back to step()
             self._cur = 0
         rows_n = n if self.basis == 1 else 0
-        if (self._scratch is None or self._scratch[0].size != n or self._scratch[1].shape != (rows_n, self.K)
-                or self._scratch[5].shape[0] != chunks):
-            self._scratch = (np.empty(n, np.intp), np.empty((rows_n, self.K), np.intp), np.empty((rows_n, self.K)),
-                             np.empty((rows_n, self.K)), np.empty((7, self.grid.n_nodes)),
+        if (self._scratch is None or self._scratch[0].size < n or self._scratch[1].shape[0] < rows_n
+                or self._scratch[1].shape[1] != self.K or self._scratch[5].shape[0] != chunks):
+            room, rows_room = n + n // 16, rows_n + rows_n // 16
+            self._scratch = (np.empty(room, np.intp), np.empty((rows_room, self.K), np.intp),
+                             np.empty((rows_room, self.K)), np.empty((rows_room, self.K)), np.empty((7, self.grid.n_nodes)),
                              np.empty((chunks, 3), np.int64), np.empty((chunks, 2), np.int64), np.zeros((chunks, 2)),
                              np.empty(chunks))
+        cell, rows, S, G = self._scratch[0][:n], self._scratch[1][:rows_n], self._scratch[2][:rows_n], self._scratch[3][:rows_n]
         loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)
         fixed = problem.dt if problem.dt is not None else 0.0
         viscous = bool(getattr(self.model, "viscous_limit", False))
@@ -787,7 +791,7 @@ class FusedStep:
                 self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
                 chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
                 float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
-                *self._scratch, dirichlet, window, exact)
+                cell, rows, S, G, *self._scratch[4:], dirichlet, window, exact)
         finally:
             _LOOP_CALLS.pop()
         if done:
