@@ -27,7 +27,9 @@ Meshes: Sod h = 0.01 ... 0.0025 (GIMP and both B-splines to 0.005), Burgers 0.04
 particle-domain B-spline: h = 0.01: 18 / 35 / 25 / 38; 0.005: 54 / 112 / 90 / 120; 0.0025: 134 (P1; the
 others ~300 / 225 / 360 from their measured time per step); 0.00125: ~445 / 1340 / 820 / 1370; 0.000625:
 P1 ~1840. The plan as it stands is ~13 CPU-minutes; every basis to 0.00125 would add ~1.4 CPU-hours.
-E2: Sod, each basis in MPM form.
+E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125, the Sod study's meshes but
+its single finest: each halving costs 4x; at 0.00125 the three bases took 2.8 / 8.9 / 7.0 s (P1 /
+GIMP / B-spline), so the two finest meshes add ~6 CPU-minutes.
 """
 
 from __future__ import annotations
@@ -60,7 +62,7 @@ BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025), "burgers": (0.04, 0.02, 0.01)}
 FINEST = {("sod", "gimp"): 0.005, ("sod", "bspline"): 0.005, ("sod", "bspline_gimp"): 0.005}
-BASES_H = (0.01, 0.005, 0.0025, 0.00125)  # E2: Sod with each basis, MPM stages only
+BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
 QUICK = {"h": {"sod": (0.02,), "burgers": (0.04, 0.02)}, "bases": ("mpm",), "bases_h": ()}
