@@ -28,9 +28,12 @@ scatters into its own grid buffer and the buffers are summed in chunk order. The
 only on ``threads``, not on scheduling (deterministic), but the sums are grouped differently, so
 it equals the one-thread step to round-off, not bit for bit.
 
-The loop (``FusedStep.advance``, :func:`_advance`): between walls with the lumped mass, a run
-takes many steps in one compiled call, the grid stage, the wall conditions and the time step of
-:func:`mpm_fem.solve.run` included, in the same order as the per-step path (the same numbers).
+The loop (``FusedStep.advance``, :func:`_advance`): between walls or Dirichlet ends with the lumped
+mass, a run takes many steps in one compiled call, the grid stage, the end conditions and the time
+step of :func:`mpm_fem.solve.run` included, in the same order as the per-step path (the same
+numbers). The Dirichlet data come from the boundary's own function, called in object mode once per
+step (the same floats); a reservoir that says when it acts (Burgers') ends a loop after the step it
+acts on, and the run applies it and re-enters.
 
 Supported: the three bases (``"mpm"``, ``"gimp"``, ``"bspline"``), USL, USF, MUSL, lumped and
 consistent mass, calculated or exact acceleration, the ideal gas and viscous Burgers (both its
@@ -43,14 +46,14 @@ from __future__ import annotations
 import types
 
 import numpy as np
-from numba import njit, prange
+from numba import njit, objmode, prange
 
 from .grid import Grid
 from .models.burgers import ViscousBurgers
 from .models.euler import IdealGas
 from .particles import Particles, PositivityError
 from .shape import Shape, make_shape
-from .step import SCHEMES, GridState, Stages, Walls
+from .step import SCHEMES, Dirichlet, GridState, Stages, Walls
 from .transfer import solve_consistent
 
 KERNELS = ("fused", "numpy")
@@ -554,8 +557,51 @@ def _lumped_walls(rhs, m_i, ends, out):
         out[i] = 0.0
 
 
+_LOOP_CALLS = []  # (boundary, grid, exact acceleration) of the running loop, for its object-mode calls
+
+
+def _end_values(t):
+    """The Dirichlet data ``g(x_b, t)`` at the end nodes, from the running loop's boundary object
+    (:meth:`~mpm_fem.step.Dirichlet.end_values`: the same call, the same floats, the same cache as
+    the per-step path). Called from the compiled loop in object mode, once per step."""
+    boundary, grid, _ = _LOOP_CALLS[-1]
+    return np.ascontiguousarray(boundary.end_values(grid, t), dtype=float)
+
+
+def _exact_acceleration(t):
+    """The problem's exact nodal acceleration ``a*(x_i, t)``, the call the per-step path makes
+    (the same floats); from the compiled loop in object mode, once per step."""
+    _, grid, exact_acceleration = _LOOP_CALLS[-1]
+    return np.ascontiguousarray(exact_acceleration(grid.nodes, t), dtype=float)
+
+
+@njit(cache=True, inline="always")
+def _set_ends(ends, values, out):
+    """``out[ends] = values`` (:meth:`~mpm_fem.step.Dirichlet.velocity`)."""
+    for k in range(ends.size):
+        out[ends[k]] = values[k]
+
+
+@njit(cache=True)
+def _reservoir_quiet(x, window):
+    """Whether the reservoir with ``window = (a, b, spacing)`` leaves the particles at ``x`` as they
+    are (:meth:`mpm_fem.problems.burgers.Reservoir.quiet`): every ``x_p`` in [a, b], and
+    ``floor((min x - a) / spacing) <= 0``, ``floor((b - max x) / spacing) <= 0`` (no gap to fill)."""
+    a, b, s = window[0], window[1], window[2]
+    if x.size == 0:
+        return False
+    lo, hi = x[0], x[0]
+    for q in range(x.size):
+        if not (x[q] >= a and x[q] <= b):
+            return False
+        lo = min(lo, x[q])
+        hi = max(hi, x[q])
+    return not (np.floor((lo - a) / s) > 0) and not (np.floor((b - hi) / s) > 0)
+
+
 def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t, T, speed, fixed_dt, cfl, h_min,
-             refine, viscous_limit, steps, max_steps, budget, cell, rows, S, G, grid, flags, upd, values, speeds):
+             refine, viscous_limit, steps, max_steps, budget, cell, rows, S, G, grid, flags, upd, values, speeds,
+             dirichlet, window, exact):
     """Up to ``budget`` steps of :meth:`FusedStep.step` between walls with the lumped mass, each with
     the time step :func:`mpm_fem.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL``
     from the previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between
@@ -563,6 +609,13 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     a step that would fail or leave this path (the time step not positive and finite, ``max_steps``,
     a particle outside the grid, a GIMP row of another width, lost positivity, a non-finite state):
     the caller takes that step with :meth:`FusedStep.step`, which raises as the numpy step does.
+    With ``dirichlet`` the ends take :class:`~mpm_fem.step.Dirichlet`'s data instead of the walls'
+    zeros (as its ``velocity`` and ``acceleration``: ``v_b = g(t)``, ``a_b = (g(t + dt) - v_b) / dt``,
+    MUSL's re-projection ``g(t + dt)``), ``g`` evaluated in object mode once per step
+    (:func:`_end_values`). A non-empty ``window = (a, b, spacing)`` stops the loop after the first
+    step whose particles the reservoir would change (:func:`_reservoir_quiet`): the caller applies it.
+    With ``exact`` the nodal acceleration is the problem's exact one (:func:`_exact_acceleration`, in
+    object mode), and no viscous force is computed.
     Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     n = cell.size
     gas = MODEL == GAS
@@ -570,6 +623,7 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     store = BASIS == 1
     m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[0], grid[1], grid[2], grid[3], grid[4], grid[5], grid[6]
     done, dt_min, dt_max = 0, np.inf, -np.inf
+    g_t, g_next, known = np.empty(0), np.empty(0), False  # Dirichlet data at t and t + dt
     while done < budget and t < T * (1 - 1e-12):
         if fixed_dt > 0:
             base = fixed_dt
@@ -596,14 +650,33 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
         if (flags[:, :2] >= 0).any() or (store and need != WIDTH and n > 0):
             break
         _lumped_walls(P_i, m_i, ends, v_i)
+        if dirichlet:
+            if not known:
+                with objmode(g_t="float64[::1]"):
+                    g_t = _end_values(t)
+                known = True
+            t_next = t + dt
+            with objmode(g_next="float64[::1]"):
+                g_next = _end_values(t_next)
+            _set_ends(ends, g_t, v_i)
         if scheme == 1:  # USF: the state first, then its force
-            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, True, chunks,
+            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact, chunks,
                    V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
             if (upd >= 0).any():
                 break
-        elif not gas:
+        elif not gas and not exact:
             VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i)
-        _lumped_walls(F_i, m_i, ends, a_i)
+        if exact:
+            with objmode(a_exact="float64[::1]"):
+                a_exact = _exact_acceleration(t)
+            a_i[:] = a_exact
+            for i in ends:
+                a_i[i] = 0.0
+        else:
+            _lumped_walls(F_i, m_i, ends, a_i)
+        if dirichlet:
+            for k in range(ends.size):
+                a_i[ends[k]] = (g_next[k] - v_i[ends[k]]) / dt
         for i in range(v_n.size):
             v_n[i] = v_i[i] + dt * a_i[i]
         if scheme == 0:
@@ -616,6 +689,8 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
             MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, False, True,
                  chunks, x_n, v_new, V, m, rho, e, p, P_musl, flags, values, speeds)
             _lumped_walls(P_musl, m_i, ends, v_n)
+            if dirichlet:
+                _set_ends(ends, g_next, v_n)
             FINISH(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v_new, rho, e, p, dt, consts, chunks,
                    V_n, m_n, rho_n, e_n, p_n, x_n, flags, values, speeds)
         if (flags >= 0).any():
@@ -625,6 +700,9 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
         t += dt
         done += 1
         dt_min, dt_max = min(dt_min, dt), max(dt_max, dt)
+        g_t = g_next
+        if window.size and not _reservoir_quiet(state[cur, 0, :n], window):
+            break  # the particle boundary acts on these particles: the caller's
     return cur, t, done, speed, dt_min, dt_max
 
 
@@ -765,10 +843,23 @@ class FusedStep:
                     raise PositivityError(quantity, q, float(x[q]), float(values[k, col]))
 
     def loops(self, problem) -> bool:
-        """Whether :meth:`advance` can take the steps of ``problem``: walls, the lumped mass, the
-        calculated acceleration and the weak force (no particle boundary, no observer: the caller's)."""
-        return (type(problem.boundary) is Walls and self.stages.mass == "lumped"
-                and self.stages.acceleration == "calculated" and not self.slides)
+        """Whether :meth:`advance` can take the steps of ``problem``: walls or Dirichlet ends (this
+        step's boundary), the lumped mass, the calculated acceleration and the weak force or the
+        exact acceleration (this step's), and no
+        particle boundary or one that says when it acts (:meth:`_window`; no observer: the caller's)."""
+        ends = type(problem.boundary) is Walls or (type(problem.boundary) is Dirichlet
+                                                   and problem.boundary is self.boundary)
+        exact = (self.stages.acceleration == "exact" and self.exact_acceleration is not None
+                 and problem.exact_acceleration is self.exact_acceleration)
+        return (ends and self.stages.mass == "lumped" and (self.stages.acceleration == "calculated" or exact)
+                and not self.slides and (problem.particle_boundary is None or self._window(problem) is not None))
+
+    def _window(self, problem):
+        """``(a, b, spacing)`` of a particle boundary that leaves the particles as they are while
+        they lie in [a, b] with no end gap of ``spacing`` (``particle_boundary.quiet(grid)``, as
+        :class:`~mpm_fem.problems.burgers.Reservoir` gives), else ``None`` (it may act every step)."""
+        quiet = getattr(problem.particle_boundary, "quiet", None)
+        return None if quiet is None else quiet(self.grid)
 
     def advance(self, particles: Particles, t: float, problem, steps: int, max_steps: int, budget: int):
         """Up to ``budget`` steps from ``t`` in one compiled loop (:func:`_advance`), each the step
@@ -777,26 +868,38 @@ class FusedStep:
         dt_min, dt_max)``; zero steps when the next step must go through :meth:`step` (it fails, or
         a GIMP particle's row changes width)."""
         n, chunks = particles.n, max(1, min(self.threads, particles.n))
-        if self._out is not particles or self._state.shape[2] != n + _PAD:  # particles from elsewhere: copied into both sets (the mass of
-            self._state = np.empty((2, len(_FIELDS), n + _PAD))  # the gas, rho, eps, p of Burgers stay there)
-            self._state[:, :, :n] = [getattr(particles, name) for name in _FIELDS]
+        spare = (lambda k: k // 16) if problem.particle_boundary is not None else (lambda k: 0)  # a reservoir's inflow
+        if self._out is not particles or self._state.shape[2] < n + _PAD:  # particles from elsewhere: copied into both sets (the mass of
+            if self._state is None or self._state.shape[2] < n + _PAD:  # the gas, rho, eps, p of Burgers stay there), with room
+                self._state = np.empty((2, len(_FIELDS), n + spare(n) + _PAD))  # for a reservoir's inflow
+            for j, name in enumerate(_FIELDS):
+                self._state[:, j, :n] = getattr(particles, name)
             self._pools = ({}, {})  # the per-step arrays: refilled if a step falls back to step()
             self._cur = 0
         rows_n = n if self.basis == 1 else 0
-        if (self._scratch is None or self._scratch[0].size != n or self._scratch[1].shape != (rows_n, self.K)
-                or self._scratch[5].shape[0] != chunks):
-            self._scratch = (np.empty(n, self._index), np.empty((rows_n, self.K), self._index),
-                             np.empty((rows_n, self.K)), np.empty((rows_n, self.K)), np.empty((7, self.grid.n_nodes)),
+        if (self._scratch is None or self._scratch[0].size < n or self._scratch[1].shape[0] < rows_n
+                or self._scratch[1].shape[1] != self.K or self._scratch[5].shape[0] != chunks):
+            room, rows_room = n + spare(n), rows_n + spare(rows_n)
+            self._scratch = (np.empty(room, self._index), np.empty((rows_room, self.K), self._index),
+                             np.empty((rows_room, self.K)), np.empty((rows_room, self.K)), np.empty((7, self.grid.n_nodes)),
                              np.empty((chunks, 3), np.int64), np.empty((chunks, 2), np.int64), np.zeros((chunks, 2)),
                              np.empty(chunks))
+        cell, rows, S, G = self._scratch[0][:n], self._scratch[1][:rows_n], self._scratch[2][:rows_n], self._scratch[3][:rows_n]
         loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)
         fixed = problem.dt if problem.dt is not None else 0.0
         viscous = bool(getattr(self.model, "viscous_limit", False))
-        cur, t, done, speed, dt_min, dt_max = loop(
-            self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
-            chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
-            float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
-            *self._scratch)
+        dirichlet = type(self.boundary) is Dirichlet
+        window = np.empty(0) if problem.particle_boundary is None else np.array(self._window(problem), dtype=float)
+        exact = self.stages.acceleration == "exact"
+        _LOOP_CALLS.append((self.boundary, self.grid, self.exact_acceleration))
+        try:
+            cur, t, done, speed, dt_min, dt_max = loop(
+                self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
+                chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
+                float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
+                cell, rows, S, G, *self._scratch[4:], dirichlet, window, exact)
+        finally:
+            _LOOP_CALLS.pop()
         if done:
             self._cur, self.speed, self.finite = cur, float(speed), True
             self._out = Particles(**{name: self._state[cur, j, :n] for j, name in enumerate(_FIELDS)})
