@@ -40,11 +40,11 @@ STATE_FIELDS = ("x", "volume", "mass", "velocity", "density", "energy", "pressur
 def bytes_moved(basis: str) -> int:
     """Bytes the fused USL gas step reads and writes per particle (write-allocate not counted).
 
-    Pass 1 reads x, V, m, v, p (40 B) and writes the cell (8 B); pass 2 reads x, v, rho, eps, p, m
-    (48 B) and writes x, v, rho, eps, p, V (48 B). GIMP also stores its rows (node index, S, G: 24 B
-    per node, 3 nodes) in pass 1 and reads them back in pass 2.
+    Pass 1 reads x, V, m, v, p (40 B) and writes the cell (a 4-byte index); pass 2 reads x, v, rho,
+    eps, p, m (48 B) and writes x, v, rho, eps, p, V (48 B). GIMP also stores its rows (node index,
+    S, G: 4 + 8 + 8 B per node, 3 nodes) in pass 1 and reads them back in pass 2.
     """
-    return 40 + 8 + 48 + 48 + (2 * 24 * 3 if basis == "gimp" else 0)
+    return 40 + 4 + 48 + 48 + (2 * 20 * 3 if basis == "gimp" else 0)
 
 
 def triad_bandwidth(n: int = 20_000_000, repeat: int = 5) -> float:

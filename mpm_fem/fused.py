@@ -17,14 +17,23 @@ index order, a particle's nodes left to right) with the same operations, so the 
 functions as the numpy step (``divide_by_lumped``, ``solve_consistent``, the boundary objects), so
 any :class:`~mpm_fem.step.Boundary` and both mass kinds are supported.
 
+Except for the point mass on a uniform grid: there a particle's cell, ``xi`` and ``1/h_c`` come from
+uniform-grid arithmetic (:func:`_point`: ``s = (x - x_0)/h``, ``c = floor(s)``, ``xi = s - c``),
+which equals the numpy step's node arithmetic to round-off (tested to 1e-12 relative over 1,000
+steps), not bit for bit; its passes keep the row and a cell's node sums in registers
+(:func:`_project_point`, :func:`_move_point`).
+
 Threads (``threads > 1``): the particles are cut into ``threads`` contiguous chunks; each chunk
 scatters into its own grid buffer and the buffers are summed in chunk order. The result depends
 only on ``threads``, not on scheduling (deterministic), but the sums are grouped differently, so
 it equals the one-thread step to round-off, not bit for bit.
 
-The loop (``FusedStep.advance``, :func:`_advance`): between walls with the lumped mass, a run
-takes many steps in one compiled call, the grid stage, the wall conditions and the time step of
-:func:`mpm_fem.solve.run` included, in the same order as the per-step path (the same numbers).
+The loop (``FusedStep.advance``, :func:`_advance`): between walls or Dirichlet ends with the lumped
+mass, a run takes many steps in one compiled call, the grid stage, the end conditions and the time
+step of :func:`mpm_fem.solve.run` included, in the same order as the per-step path (the same
+numbers). The Dirichlet data come from the boundary's own function, called in object mode once per
+step (the same floats); a reservoir that says when it acts (Burgers') ends a loop after the step it
+acts on, and the run applies it and re-enters.
 
 The plateau remedies of :class:`~mpm_fem.step.Stages`, with the numpy step's operations:
 
@@ -52,14 +61,14 @@ from __future__ import annotations
 import types
 
 import numpy as np
-from numba import njit, prange
+from numba import njit, objmode, prange
 
 from .grid import Grid
 from .models.burgers import ViscousBurgers
 from .models.euler import IdealGas
 from .particles import Particles, PositivityError
 from .shape import Shape, make_shape
-from .step import SCHEMES, GridState, Stages, Walls, _reset_volume
+from .step import SCHEMES, Dirichlet, GridState, Stages, Walls, _reset_volume
 from .transfer import solve_consistent
 from .volume import grid_volume_factor
 from .xpic import boundary_change_rule
@@ -105,6 +114,22 @@ def _locate(nodes, inv_spacing, x):
         c = min(np.searchsorted(nodes, x, side="right") - 1, last)
     x0 = nodes[c]
     return c, (x - x0) / (nodes[c + 1] - x0)
+
+
+@njit(cache=True, inline="always")
+def _point(nodes, h, inv_spacing, x):
+    """The point-mass row of one point: cell ``c``, ``xi`` and ``1/h_c``. On a uniform grid
+    (``inv_spacing = 1/h > 0``) from uniform-grid arithmetic, ``s = (x - x_0)/h``, ``c = floor(s)``,
+    ``xi = s - c``, ``1/h_c = 1/h`` (no node coordinates read, no division): equal to the numpy
+    step's node arithmetic to round-off (``xi`` to about ``eps |x| / h``), not bit for bit.
+    Otherwise as :func:`mpm_fem.shape.locate` and :func:`mpm_fem.shape.point_shape` (bit for bit)."""
+    last = nodes.size - 2
+    if inv_spacing > 0.0:
+        s = (x - nodes[0]) * inv_spacing
+        c = min(int(s), last)  # s >= 0 inside the grid; the last node belongs to the last cell
+        return c, s - c, inv_spacing
+    c, xi = _locate(nodes, inv_spacing, x)
+    return c, xi, h[1, c]
 
 
 @njit(cache=True, inline="always")
@@ -181,8 +206,7 @@ def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
     n_nodes = nodes.size
     K = row.size
     if basis == 0:  # point mass: S = (1 - xi, xi), G = (-1, 1)/h_c
-        c, xi = _locate(nodes, inv_spacing, x)
-        inv_h = h[1, c]
+        c, xi, inv_h = _point(nodes, h, inv_spacing, x)
         row[0], row[1] = c, c + 1
         S[0], S[1] = 1.0 - xi, xi
         G[0], G[1] = -inv_h, inv_h
@@ -243,8 +267,8 @@ def _gas_update(rho, e, p, m, L, dt, l, gm1, g_gm1, c_lin, c_quad):
 
 @njit(cache=True, inline="always")
 def _finite(a, b, c, d, e, f):
-    return (np.isfinite(a) and np.isfinite(b) and np.isfinite(c) and np.isfinite(d) and np.isfinite(e)
-            and np.isfinite(f))
+    """Whether all six are finite: ``0 a + ... + 0 f`` is 0 exactly then, NaN otherwise (no branch)."""
+    return a * 0.0 + b * 0.0 + c * 0.0 + d * 0.0 + e * 0.0 + f * 0.0 == 0.0
 
 
 @njit(cache=True)
@@ -380,6 +404,51 @@ def _flags(k, tally, flags, values):
 _NO_TALLY = (-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0)  # no bad particle yet, speed 0
 
 
+@njit(cache=True, inline="always")
+def _project_point(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi, rows, S, G, cell, buf):
+    """Pass 1 of the point mass over particles ``lo .. hi-1``: ``buf[0..2]`` += ``m_p S_ip``,
+    ``m_p v_p S_ip``, ``V_p p_p G_ip`` (the last if ``gas_force``). Each node's terms are added in
+    particle order, as in :func:`_project` (the same numbers), but a cell's two node sums stay in
+    registers while consecutive particles share the cell (sorted particles: ``ppc`` in a row), and
+    go back to ``buf`` when the cell changes: one load and store per cell instead of one per term.
+    Returns the first particle outside the grid (-1 if none)."""
+    n_nodes = nodes.size
+    a, b = nodes[0], nodes[n_nodes - 1]
+    outside, held = -1, -1  # held: the cell whose node sums are in registers
+    m0 = m1 = P0 = P1 = F0 = F1 = 0.0
+    for q in range(lo, hi):
+        if not (x[q] >= a and x[q] <= b):
+            if outside < 0:
+                outside = q
+            continue
+        c, xi, inv_h = _point(nodes, h, inv_spacing, x[q])  # the row (c, c + 1), (1 - xi, xi), (-1, 1)/h_c
+        S0 = 1.0 - xi
+        cell[q] = c
+        if store:
+            rows[q, 0], S[q, 0], G[q, 0] = c, S0, -inv_h
+            rows[q, 1], S[q, 1], G[q, 1] = c + 1, xi, inv_h
+        if c != held:
+            if held >= 0:
+                buf[0, held], buf[1, held], buf[2, held] = m0, P0, F0
+                buf[0, held + 1], buf[1, held + 1], buf[2, held + 1] = m1, P1, F1
+            m0, P0, F0 = buf[0, c], buf[1, c], buf[2, c]
+            m1, P1, F1 = buf[0, c + 1], buf[1, c + 1], buf[2, c + 1]
+            held = c
+        mv = m[q] * v[q]
+        m0 += S0 * m[q]
+        P0 += S0 * mv
+        m1 += xi * m[q]
+        P1 += xi * mv
+        if gas_force:
+            Vp = V[q] * p[q]
+            F0 += -inv_h * Vp
+            F1 += inv_h * Vp
+    if held >= 0:
+        buf[0, held], buf[1, held], buf[2, held] = m0, P0, F0
+        buf[0, held + 1], buf[1, held + 1], buf[2, held + 1] = m1, P1, F1
+    return outside
+
+
 def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
              rows, S, G, cell, m_i, P_i, F_i, flags):
     """Pass 1: the shape of every particle, ``m_i``, ``P_i`` and, if ``gas_force``, ``F_i = sum_p
@@ -395,6 +464,10 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
         lo, hi = _chunk(n, chunks, k)
         outside, empty, need = -1, -1, 0
         r, Sl, Gl = _one_row(K)
+        if BASIS == 0:  # point mass: its own loop, the sums held in registers (the loop below then skipped)
+            outside, need = _project_point(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi,
+                                           rows, S, G, cell, buf[k]), 2
+            lo = hi
         for q in range(lo, hi):
             if not (x[q] >= a and x[q] <= b):
                 if outside < 0:
@@ -460,6 +533,22 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
         _sum_chunks(buf, 0, F_i, 1.0)
 
 
+@njit(cache=True, inline="always")
+def _move_point(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, gas, lo, hi,
+                x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally):
+    """Pass 2 of the point mass, USL, over particles ``lo .. hi-1``: :func:`_move`'s arithmetic with
+    the row ``(c, c + 1)``, ``(1 - xi, xi)``, ``(-1, 1)/h_c`` held in registers. Returns the tally."""
+    for q in range(lo, hi):
+        c, xi, inv_h = _point(nodes, h, inv_spacing, x[q])
+        S0 = 1.0 - xi
+        v_new[q] = v[q] + dt * (S0 * a_i[c] + xi * a_i[c + 1])
+        x_new[q] = x[q] + dt * (S0 * v_n[c] + xi * v_n[c + 1])
+        L = -inv_h * v_n[c] + inv_h * v_n[c + 1]
+        tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, tally)
+        tally = _checked(gas, q, tally[6], x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+    return tally
+
+
 def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
           x_new, v_new, V_new, m_new, rho_new, e_new, p_new, P_i, flags, values, speed):
     """Pass 2: ``v_p += dt sum S a``, ``x_p += dt sum S v^{n+1}``; USL: the state update from
@@ -477,7 +566,13 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
     for k in prange(chunks):
         tally = _NO_TALLY
         r, Sl, Gl = _one_row(K)
-        for q in range(*_chunk(n, chunks, k)):
+        lo, hi = _chunk(n, chunks, k)
+        if BASIS == 0 and usl and flip == 1.0 and not pic:  # point mass, USL, FLIP: its own loop, the row in
+            # registers (the loop below then skipped)
+            tally = _move_point(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, gas, lo, hi,
+                                x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally)
+            lo = hi
+        for q in range(lo, hi):
             cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             acc = Sl[0] * a_i[r[0]]
             vel = Sl[0] * v_n[r[0]]
@@ -566,8 +661,51 @@ def _lumped_walls(rhs, m_i, ends, out):
         out[i] = 0.0
 
 
+_LOOP_CALLS = []  # (boundary, grid, exact acceleration) of the running loop, for its object-mode calls
+
+
+def _end_values(t):
+    """The Dirichlet data ``g(x_b, t)`` at the end nodes, from the running loop's boundary object
+    (:meth:`~mpm_fem.step.Dirichlet.end_values`: the same call, the same floats, the same cache as
+    the per-step path). Called from the compiled loop in object mode, once per step."""
+    boundary, grid, _ = _LOOP_CALLS[-1]
+    return np.ascontiguousarray(boundary.end_values(grid, t), dtype=float)
+
+
+def _exact_acceleration(t):
+    """The problem's exact nodal acceleration ``a*(x_i, t)``, the call the per-step path makes
+    (the same floats); from the compiled loop in object mode, once per step."""
+    _, grid, exact_acceleration = _LOOP_CALLS[-1]
+    return np.ascontiguousarray(exact_acceleration(grid.nodes, t), dtype=float)
+
+
+@njit(cache=True, inline="always")
+def _set_ends(ends, values, out):
+    """``out[ends] = values`` (:meth:`~mpm_fem.step.Dirichlet.velocity`)."""
+    for k in range(ends.size):
+        out[ends[k]] = values[k]
+
+
+@njit(cache=True)
+def _reservoir_quiet(x, window):
+    """Whether the reservoir with ``window = (a, b, spacing)`` leaves the particles at ``x`` as they
+    are (:meth:`mpm_fem.problems.burgers.Reservoir.quiet`): every ``x_p`` in [a, b], and
+    ``floor((min x - a) / spacing) <= 0``, ``floor((b - max x) / spacing) <= 0`` (no gap to fill)."""
+    a, b, s = window[0], window[1], window[2]
+    if x.size == 0:
+        return False
+    lo, hi = x[0], x[0]
+    for q in range(x.size):
+        if not (x[q] >= a and x[q] <= b):
+            return False
+        lo = min(lo, x[q])
+        hi = max(hi, x[q])
+    return not (np.floor((lo - a) / s) > 0) and not (np.floor((b - hi) / s) > 0)
+
+
 def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t, T, speed, fixed_dt, cfl, h_min,
-             refine, viscous_limit, steps, max_steps, budget, cell, rows, S, G, grid, flags, upd, values, speeds):
+             refine, viscous_limit, steps, max_steps, budget, cell, rows, S, G, grid, flags, upd, values, speeds,
+             dirichlet, window, exact):
     """Up to ``budget`` steps of :meth:`FusedStep.step` between walls with the lumped mass, each with
     the time step :func:`mpm_fem.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL``
     from the previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between
@@ -575,6 +713,13 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     a step that would fail or leave this path (the time step not positive and finite, ``max_steps``,
     a particle outside the grid, a GIMP row of another width, lost positivity, a non-finite state):
     the caller takes that step with :meth:`FusedStep.step`, which raises as the numpy step does.
+    With ``dirichlet`` the ends take :class:`~mpm_fem.step.Dirichlet`'s data instead of the walls'
+    zeros (as its ``velocity`` and ``acceleration``: ``v_b = g(t)``, ``a_b = (g(t + dt) - v_b) / dt``,
+    MUSL's re-projection ``g(t + dt)``), ``g`` evaluated in object mode once per step
+    (:func:`_end_values`). A non-empty ``window = (a, b, spacing)`` stops the loop after the first
+    step whose particles the reservoir would change (:func:`_reservoir_quiet`): the caller applies it.
+    With ``exact`` the nodal acceleration is the problem's exact one (:func:`_exact_acceleration`, in
+    object mode), and no viscous force is computed.
     Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     n = cell.size
     gas = MODEL == GAS
@@ -582,6 +727,7 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     store = BASIS == 1 or BASIS == 3
     m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[0], grid[1], grid[2], grid[3], grid[4], grid[5], grid[6]
     done, dt_min, dt_max = 0, np.inf, -np.inf
+    g_t, g_next, known = np.empty(0), np.empty(0), False  # Dirichlet data at t and t + dt
     while done < budget and t < T * (1 - 1e-12):
         if fixed_dt > 0:
             base = fixed_dt
@@ -608,14 +754,33 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
         if (flags[:, :2] >= 0).any() or (store and need != WIDTH and n > 0):
             break
         _lumped_walls(P_i, m_i, ends, v_i)
+        if dirichlet:
+            if not known:
+                with objmode(g_t="float64[::1]"):
+                    g_t = _end_values(t)
+                known = True
+            t_next = t + dt
+            with objmode(g_next="float64[::1]"):
+                g_next = _end_values(t_next)
+            _set_ends(ends, g_t, v_i)
         if scheme == 1:  # USF: the state first, then its force
-            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, True, chunks,
+            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact, chunks,
                    V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
             if (upd >= 0).any():
                 break
-        elif not gas:
+        elif not gas and not exact:
             VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i)
-        _lumped_walls(F_i, m_i, ends, a_i)
+        if exact:
+            with objmode(a_exact="float64[::1]"):
+                a_exact = _exact_acceleration(t)
+            a_i[:] = a_exact
+            for i in ends:
+                a_i[i] = 0.0
+        else:
+            _lumped_walls(F_i, m_i, ends, a_i)
+        if dirichlet:
+            for k in range(ends.size):
+                a_i[ends[k]] = (g_next[k] - v_i[ends[k]]) / dt
         for i in range(v_n.size):
             v_n[i] = v_i[i] + dt * a_i[i]
         if scheme == 0:
@@ -628,6 +793,8 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
             MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, False, True,
                  chunks, x_n, v_new, V, m, rho, e, p, P_musl, flags, values, speeds)
             _lumped_walls(P_musl, m_i, ends, v_n)
+            if dirichlet:
+                _set_ends(ends, g_next, v_n)
             FINISH(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v_new, rho, e, p, dt, consts, chunks,
                    V_n, m_n, rho_n, e_n, p_n, x_n, flags, values, speeds)
         if (flags >= 0).any():
@@ -637,6 +804,9 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
         t += dt
         done += 1
         dt_min, dt_max = min(dt_min, dt), max(dt_max, dt)
+        g_t = g_next
+        if window.size and not _reservoir_quiet(state[cur, 0, :n], window):
+            break  # the particle boundary acts on these particles: the caller's
     return cur, t, done, speed, dt_min, dt_max
 
 
@@ -658,6 +828,18 @@ _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a 
 _FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")  # Particles' names, same order
 _SCHEME_CODE = {"usl": 0, "usf": 1, "musl": 2}
 _PAD = 40  # doubles between advance's particle arrays: 5 cache lines, so that they do not share cache sets
+
+
+def _uniform_to_round_off(grid: Grid) -> bool:
+    """Whether the grid is uniform (``grid.uniform_spacing``) and its nodes lie within ``1e-9 h`` of
+    ``x_0 + i h`` (a ``linspace``): then the point mass's uniform-grid arithmetic (:func:`_point`)
+    agrees with the node arithmetic to round-off. A grid uniform only to ``grid.uniform_spacing``'s
+    1e-6 takes the node arithmetic (and bisection to locate the particles, in every basis)."""
+    h = grid.uniform_spacing
+    if h is None:
+        return False
+    nodes = grid.nodes
+    return bool(np.abs(nodes - (nodes[0] + h * np.arange(nodes.size))).max() <= 1e-9 * h)
 
 
 class _Passes:
@@ -714,7 +896,7 @@ class FusedStep:
             make_shape(grid, grid.nodes[:1], basis="bspline")  # raises on a non-uniform grid
         self.nodes = np.ascontiguousarray(grid.nodes, dtype=float)
         self.h = np.ascontiguousarray([grid.h, 1.0 / grid.h], dtype=float)  # h_c and 1/h_c: read, not divided
-        self.inv_spacing = 1.0 / grid.uniform_spacing if grid.uniform_spacing is not None else 0.0
+        self.inv_spacing = 1.0 / grid.uniform_spacing if _uniform_to_round_off(grid) else 0.0
         if self.kind == GAS:
             g = model.gamma
             self.consts = np.array([g - 1.0, g * (g - 1.0), model.av_linear, model.av_quadratic, 0.0])
@@ -728,6 +910,8 @@ class FusedStep:
         self._state = self._out = self._scratch = None  # advance's two sets of particle arrays, its last
         self._cur = 0  # particles, and its scratch arrays
         self._ends = np.ascontiguousarray(grid.boundary_nodes, dtype=np.intp)
+        # the stored cells and node indices (pass 1 -> the grid stage and pass 2): 4 bytes, not 8
+        self._index = np.int32 if grid.n_nodes <= np.iinfo(np.int32).max else np.intp
         self._h_min = float(grid.h.min())
 
     def _width(self, K):
@@ -764,12 +948,24 @@ class FusedStep:
                     raise PositivityError(quantity, q, float(x[q]), float(values[k, col]))
 
     def loops(self, problem) -> bool:
-        """Whether :meth:`advance` can take the steps of ``problem``: walls, the lumped mass, the
-        calculated acceleration, the weak force, no XPIC and no volume reset (no particle boundary,
-        no observer: the caller's)."""
-        return (type(problem.boundary) is Walls and self.stages.mass == "lumped"
-                and self.stages.acceleration == "calculated" and not self.slides and not self.stages.xpic
-                and self.stages.volume == "carried")
+        """Whether :meth:`advance` can take the steps of ``problem``: walls or Dirichlet ends (this
+        step's boundary), the lumped mass, the calculated acceleration and the weak force or the
+        exact acceleration (this step's), no XPIC and no volume reset, and no
+        particle boundary or one that says when it acts (:meth:`_window`; no observer: the caller's)."""
+        ends = type(problem.boundary) is Walls or (type(problem.boundary) is Dirichlet
+                                                   and problem.boundary is self.boundary)
+        exact = (self.stages.acceleration == "exact" and self.exact_acceleration is not None
+                 and problem.exact_acceleration is self.exact_acceleration)
+        return (ends and self.stages.mass == "lumped" and (self.stages.acceleration == "calculated" or exact)
+                and not self.slides and not self.stages.xpic and self.stages.volume == "carried"
+                and (problem.particle_boundary is None or self._window(problem) is not None))
+
+    def _window(self, problem):
+        """``(a, b, spacing)`` of a particle boundary that leaves the particles as they are while
+        they lie in [a, b] with no end gap of ``spacing`` (``particle_boundary.quiet(grid)``, as
+        :class:`~mpm_fem.problems.burgers.Reservoir` gives), else ``None`` (it may act every step)."""
+        quiet = getattr(problem.particle_boundary, "quiet", None)
+        return None if quiet is None else quiet(self.grid)
 
     def advance(self, particles: Particles, t: float, problem, steps: int, max_steps: int, budget: int):
         """Up to ``budget`` steps from ``t`` in one compiled loop (:func:`_advance`), each the step
@@ -778,26 +974,38 @@ class FusedStep:
         dt_min, dt_max)``; zero steps when the next step must go through :meth:`step` (it fails, or
         a GIMP particle's row changes width)."""
         n, chunks = particles.n, max(1, min(self.threads, particles.n))
-        if self._out is not particles or self._state.shape[2] != n + _PAD:  # particles from elsewhere: copied into both sets (the mass of
-            self._state = np.empty((2, len(_FIELDS), n + _PAD))  # the gas, rho, eps, p of Burgers stay there)
-            self._state[:, :, :n] = [getattr(particles, name) for name in _FIELDS]
+        spare = (lambda k: k // 16) if problem.particle_boundary is not None else (lambda k: 0)  # a reservoir's inflow
+        if self._out is not particles or self._state.shape[2] < n + _PAD:  # particles from elsewhere: copied into both sets (the mass of
+            if self._state is None or self._state.shape[2] < n + _PAD:  # the gas, rho, eps, p of Burgers stay there), with room
+                self._state = np.empty((2, len(_FIELDS), n + spare(n) + _PAD))  # for a reservoir's inflow
+            for j, name in enumerate(_FIELDS):
+                self._state[:, j, :n] = getattr(particles, name)
             self._pools = ({}, {})  # the per-step arrays: refilled if a step falls back to step()
             self._cur = 0
         rows_n = n if self.basis in _DOMAIN_BASES else 0
-        if (self._scratch is None or self._scratch[0].size != n or self._scratch[1].shape != (rows_n, self.K)
-                or self._scratch[5].shape[0] != chunks):
-            self._scratch = (np.empty(n, np.intp), np.empty((rows_n, self.K), np.intp), np.empty((rows_n, self.K)),
-                             np.empty((rows_n, self.K)), np.empty((7, self.grid.n_nodes)),
+        if (self._scratch is None or self._scratch[0].size < n or self._scratch[1].shape[0] < rows_n
+                or self._scratch[1].shape[1] != self.K or self._scratch[5].shape[0] != chunks):
+            room, rows_room = n + spare(n), rows_n + spare(rows_n)
+            self._scratch = (np.empty(room, self._index), np.empty((rows_room, self.K), self._index),
+                             np.empty((rows_room, self.K)), np.empty((rows_room, self.K)), np.empty((7, self.grid.n_nodes)),
                              np.empty((chunks, 3), np.int64), np.empty((chunks, 2), np.int64), np.zeros((chunks, 2)),
                              np.empty(chunks))
+        cell, rows, S, G = self._scratch[0][:n], self._scratch[1][:rows_n], self._scratch[2][:rows_n], self._scratch[3][:rows_n]
         loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)
         fixed = problem.dt if problem.dt is not None else 0.0
         viscous = bool(getattr(self.model, "viscous_limit", False))
-        cur, t, done, speed, dt_min, dt_max = loop(
-            self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
-            chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
-            float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
-            *self._scratch)
+        dirichlet = type(self.boundary) is Dirichlet
+        window = np.empty(0) if problem.particle_boundary is None else np.array(self._window(problem), dtype=float)
+        exact = self.stages.acceleration == "exact"
+        _LOOP_CALLS.append((self.boundary, self.grid, self.exact_acceleration))
+        try:
+            cur, t, done, speed, dt_min, dt_max = loop(
+                self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
+                chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
+                float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
+                cell, rows, S, G, *self._scratch[4:], dirichlet, window, exact)
+        finally:
+            _LOOP_CALLS.pop()
         if done:
             self._cur, self.speed, self.finite = cur, float(speed), True
             self._out = Particles(**{name: self._state[cur, j, :n] for j, name in enumerate(_FIELDS)})
@@ -835,10 +1043,10 @@ class FusedStep:
         empty = self._empty
         m_i, P_i, F_i = empty("m_i", n_nodes), empty("P_i", n_nodes), empty("F_i", n_nodes)
         flags = np.empty((chunks, 3), np.int64)
-        cell = empty("cell", n, np.intp)
+        cell = empty("cell", n, self._index)
         while True:
             rows_n = n if store else 0
-            rows, S, G = (empty("rows", (rows_n, self.K), np.intp), empty("S", (rows_n, self.K)),
+            rows, S, G = (empty("rows", (rows_n, self.K), self._index), empty("S", (rows_n, self.K)),
                           empty("G", (rows_n, self.K)))
             self.project(*geometry, x, V, m, v, p, gas_force, store, chunks, rows, S, G, cell, m_i, P_i, F_i, flags)
             if (flags[:, :2] >= 0).any():

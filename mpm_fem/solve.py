@@ -5,8 +5,9 @@ or the problem's fixed ``dt``, divided by ``stages.refine`` (the last step short
 ``T``). Every step is checked: lost positivity raises
 :class:`~mpm_fem.particles.PositivityError` naming the step, and a non-finite particle state raises
 :class:`FloatingPointError` naming the step and the particle: a run never returns NaN. Between
-walls with the lumped mass the fused step takes the steps in compiled loops
-(:meth:`~mpm_fem.fused.FusedStep.advance`), the same steps bit for bit.
+walls or Dirichlet ends with the lumped mass (and Burgers' reservoir, applied between loops) the
+fused step takes the steps in compiled loops (:meth:`~mpm_fem.fused.FusedStep.advance`), the same
+steps bit for bit.
 """
 
 from __future__ import annotations
@@ -100,6 +101,19 @@ def _check_finite(particles: Particles, step: int, t: float) -> None:
             raise FloatingPointError(f"non-finite {name} at step {step} (t={t:.6g}) in particle {p}")
 
 
+def _particle_boundary(problem: Problem, grid: Grid, particles: Particles, t: float, fused: FusedStep | None,
+                       step: int | None = None) -> Particles:
+    """The particle boundary applied at ``t``. If it changed the particles, the fused step's speed
+    (the next time step's) is theirs; with ``step`` (after a compiled loop) they are checked finite."""
+    new = problem.particle_boundary(particles, grid, t)
+    if new is not particles:
+        if step is not None:
+            _check_finite(new, step, t)
+        if fused is not None:
+            fused.speed = problem.model.max_speed(new)
+    return new
+
+
 def run(
     problem: Problem,
     grid: Grid,
@@ -122,9 +136,10 @@ def run(
     if kernel == "fused" and supported(problem.model, stages) is None:
         fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads,
                           reuse=observer is None)  # an observer may keep the particles of every step
-    # walls, lumped mass, no particle boundary and no observer: steps in compiled loops of about
-    # LOOP_WORK particle-steps each (the bar and Ctrl-C are served between them)
-    loop = fused is not None and observer is None and problem.particle_boundary is None and fused.loops(problem)
+    # walls or Dirichlet ends, lumped mass, no observer, and no particle boundary or one that says
+    # when it acts: steps in compiled loops of about LOOP_WORK particle-steps each (the bar and
+    # Ctrl-C are served between them); a loop stops after a step the particle boundary acts on
+    loop = fused is not None and observer is None and fused.loops(problem)
     start = time.perf_counter()
     t, steps = 0.0, 0
     dt_min, dt_max = np.inf, -np.inf
@@ -141,6 +156,8 @@ def run(
                     steps += done
                     dt_min, dt_max = min(dt_min, low), max(dt_max, high)
                     bar.update(t - t_old)
+                    if problem.particle_boundary is not None:
+                        particles = _particle_boundary(problem, grid, particles, t, fused, steps - 1)
                     continue
             if problem.dt is not None:
                 base = problem.dt
@@ -162,7 +179,7 @@ def run(
             except PositivityError as err:
                 raise err.at(steps, t) from None
             if problem.particle_boundary is not None:
-                new = problem.particle_boundary(new, grid, t + dt)
+                new = _particle_boundary(problem, grid, new, t + dt, fused)
             if fused is None or problem.particle_boundary is not None or not fused.finite:
                 _check_finite(new, steps, t)
             if observer is not None:

@@ -164,6 +164,10 @@ class Dirichlet:
             self._last.update(key=key, value=self.g(grid.nodes[b], t))
         return b, self._last["value"]
 
+    def end_values(self, grid, t):
+        """``g`` at the boundary nodes at ``t``, the evaluation the step uses (kept per ``t``)."""
+        return self._values(grid, t)[1]
+
     def velocity(self, grid, v, t):
         v = v.copy()
         b, g = self._values(grid, t)

@@ -31,14 +31,16 @@ def _by_position(result):
     {"weights": "cell", "force": "slides"},
 ])
 def test_fused_run_is_the_numpy_step(changes):
-    """The fused kernel and ``run(explicit_step)`` take the same steps: the same particles bit for bit."""
+    """The fused kernel and ``run(explicit_step)`` take the same steps: the same particles to 1e-12
+    relative (max norm, each field: the point mass's uniform-grid arithmetic, tests/test_fused.py)."""
     settings = burgers.BurgersSettings(h=0.02, **changes)
     numpy_run = burgers.simulate(replace(settings, kernel="numpy"), progress=False)
     fused = burgers.simulate(settings, progress=False)
     assert fused.steps == numpy_run.steps and fused.particles.n == numpy_run.particles.n
-    for a, b, name in zip(_by_position(numpy_run), _by_position(fused), ("x", "v", "V")):
-        assert np.array_equal(a, b), f"{name}: fused and numpy runs differ by {float(np.max(np.abs(a - b))):.3g}"
-    assert np.array_equal(numpy_run.nodal_velocity, fused.nodal_velocity)
+    pairs = zip(_by_position(numpy_run) + (numpy_run.nodal_velocity,), _by_position(fused) + (fused.nodal_velocity,))
+    for (a, b), name in zip(pairs, ("x", "v", "V", "v_i")):
+        gap = float(np.max(np.abs(a - b)) / np.max(np.abs(a)))
+        assert gap <= 1e-12, f"{name}: fused and numpy runs differ by {gap:.3g} relative"
 
 
 def test_slides_weights_are_h_over_the_cell_count():

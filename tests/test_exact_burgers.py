@@ -182,3 +182,16 @@ def test_parameters_outside_their_range_raise():
         ColeHopfWave(0.01, A=1.0)
     with pytest.raises(ValueError, match="t0 must be > 0"):
         Rarefaction(0.01, t0=0.0)
+
+
+@pytest.mark.parametrize("name", sorted(SOLUTIONS))
+def test_the_velocity_alone_is_the_first_field_bit_for_bit(name):
+    """``v`` skips the derivatives (the runs call it for the Dirichlet data every step) and gives
+    the same floats as ``fields(x, t)[0]``: at the ends, inside, outside the domain, scalars, t = 0."""
+    rng = np.random.default_rng(3)
+    for eps in (0.045, 0.01):
+        solution = make_solution(name, eps)
+        for t in (0.0, *rng.uniform(0.0, 0.5, 20)):
+            for x in (np.array([0.0, 2.0]), rng.uniform(-0.5, 2.5, 33), 1.0):
+                v, first = solution.v(x, t), solution.fields(x, t)[0]
+                assert np.shape(v) == np.shape(first) and np.array_equal(v, first)

@@ -2,9 +2,11 @@
 
 Every combination of basis, scheme, mass, model and boundary runs 1,000 steps through
 ``solve.run`` twice, ``kernel="numpy"`` and ``kernel="fused"``: the particle states must agree bit
-for bit (the kernel keeps the numpy step's arithmetic order). Threads group the sums differently:
-equal to round-off, and the same on every run. The checks of a run (positivity, finiteness,
-particles outside the grid) raise the same errors from both paths.
+for bit where the kernel keeps the numpy step's arithmetic order (GIMP, the B-spline, the point mass
+on a non-uniform grid), and to ``TOLERANCE`` where it does not (the point mass on a uniform grid:
+uniform-grid arithmetic), on smooth data and on Sod's shocked tube. Threads group the sums
+differently: equal to round-off, and the same on every run. The checks of a run (positivity,
+finiteness, particles outside the grid) raise the same errors from both paths.
 """
 
 from dataclasses import dataclass
@@ -13,7 +15,7 @@ import numpy as np
 import pytest
 
 from mpm_fem.fused import FusedStep, supported
-from mpm_fem.grid import uniform_grid
+from mpm_fem.grid import grid_from_nodes, uniform_grid
 from mpm_fem.models.burgers import ViscousBurgers
 from mpm_fem.models.euler import IdealGas
 from mpm_fem.particles import PositivityError, make_particles, seed_positions
@@ -68,12 +70,33 @@ def _case(model, boundary, steps=STEPS, basis="mpm"):
     return Problem(boundary=Dirichlet(g), particle_boundary=inflow, **problem), particles
 
 
-def _assert_same(a, b):
+# The point mass on a uniform grid (uniform-grid arithmetic) against the numpy step: each field of
+# the particles and the grid, max_p |u_fused - u_numpy| <= TOLERANCE max_p |u_numpy| (measured: 6e-14).
+TOLERANCE = 1e-12
+
+
+def _deviation(u, v):
+    """``max |u - v| / max |u|`` (0 where both are 0): the relative deviation in the max norm."""
+    scale = float(np.max(np.abs(u), initial=0.0))
+    gap = float(np.max(np.abs(u - v), initial=0.0))
+    return gap / scale if scale > 0 else gap
+
+
+def _assert_same(a, b, tolerance=0.0):
+    """The same run: bit for bit, or (``tolerance > 0``) each field to ``tolerance`` relative."""
     assert a.steps == b.steps and a.particles.n == b.particles.n
-    for name in FIELDS:
-        u, v = getattr(a.particles, name), getattr(b.particles, name)
-        assert np.array_equal(u, v), f"{name} differs by {float(np.max(np.abs(u - v))):.3g}"
-    assert np.array_equal(a.nodal_mass, b.nodal_mass) and np.array_equal(a.nodal_velocity, b.nodal_velocity)
+    pairs = [(name, getattr(a.particles, name), getattr(b.particles, name)) for name in FIELDS]
+    pairs += [("m_i", a.nodal_mass, b.nodal_mass), ("v_i", a.nodal_velocity, b.nodal_velocity)]
+    for name, u, v in pairs:
+        if tolerance:
+            assert _deviation(u, v) <= tolerance, f"{name} differs by {_deviation(u, v):.3g} relative"
+        else:
+            assert np.array_equal(u, v), f"{name} differs by {float(np.max(np.abs(u - v))):.3g}"
+
+
+def _bitwise(basis, grid=GRID):
+    """Whether the fused step keeps the numpy step's arithmetic (all but the point mass on a uniform grid)."""
+    return basis != "mpm" or grid.uniform_spacing is None
 
 
 def _compare(basis, scheme, mass, model, boundary, steps):
@@ -82,7 +105,7 @@ def _compare(basis, scheme, mass, model, boundary, steps):
     reference = run(problem, GRID, particles, stages, progress=False, kernel="numpy")
     fused = run(problem, GRID, particles, stages, progress=False, kernel="fused")
     assert reference.steps >= steps
-    _assert_same(reference, fused)
+    _assert_same(reference, fused, 0.0 if _bitwise(basis) else TOLERANCE)
     assert not np.array_equal(fused.particles.x[:10], particles.x[:10])  # the particles did move
     return reference, fused
 
@@ -94,20 +117,49 @@ COMBINATIONS = pytest.mark.parametrize(("basis", "scheme", "model", "boundary"),
 
 @COMBINATIONS
 @pytest.mark.parametrize("mass", ["lumped", "consistent"])
-def test_fused_equals_the_numpy_step_bit_for_bit(basis, scheme, mass, model, boundary):
+def test_fused_equals_the_numpy_step(basis, scheme, mass, model, boundary):
     """1,000 steps with the lumped mass; 100 with the consistent mass (its sparse solve is slow in
-    both paths: the 1,000-step runs are the slow test below)."""
-    reference, fused = _compare(basis, scheme, mass, model, boundary, STEPS if mass == "lumped" else 100)
-    assert np.array_equal(reference.particles.x, fused.particles.x)
-    assert np.array_equal(reference.particles.velocity, fused.particles.velocity)
+    both paths: the 1,000-step runs are the slow test below). Bit for bit, or to ``TOLERANCE``."""
+    _compare(basis, scheme, mass, model, boundary, STEPS if mass == "lumped" else 100)
 
 
 @pytest.mark.slow
 @COMBINATIONS
 def test_fused_equals_the_numpy_step_over_1000_steps_with_the_consistent_mass(basis, scheme, model, boundary):
-    reference, fused = _compare(basis, scheme, "consistent", model, boundary, STEPS)
-    assert np.array_equal(reference.particles.x, fused.particles.x)
-    assert np.array_equal(reference.particles.velocity, fused.particles.velocity)
+    _compare(basis, scheme, "consistent", model, boundary, STEPS)
+
+
+@pytest.mark.parametrize("scheme", ["usl", "usf", "musl"])
+@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+def test_point_mass_on_sods_shocked_tube_within_the_tolerance(scheme, mass):
+    """Sod's tube, 1,000 CFL steps (to T = 0.2: the shock, contact and rarefaction formed): the
+    uniform-grid arithmetic stays within ``TOLERANCE`` of the numpy step through the shock."""
+    settings = dict(h=0.01, ppc=4, T=0.2, cfl=0.045, scheme=scheme, mass=mass)
+    reference = simulate(SodSettings(**settings, kernel="numpy"), progress=False)
+    fused = simulate(SodSettings(**settings), progress=False)
+    assert reference.steps >= 1000
+    _assert_same(reference, fused, TOLERANCE)
+    assert np.ptp(fused.particles.pressure) > 0.5  # the shocked tube, not a quiet one
+
+
+@pytest.mark.parametrize("scheme", ["usl", "usf", "musl"])
+@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+def test_point_mass_on_a_non_uniform_grid_is_the_numpy_step_bit_for_bit(scheme, mass):
+    """Off a uniform grid the point mass keeps the node arithmetic: bit for bit, 200 steps. A grid
+    uniform only to 1e-8 (``uniform_spacing`` accepts it) takes that path too."""
+    stretched = grid_from_nodes(np.linspace(0.0, 1.0, 11) ** 1.2)
+    nearly = grid_from_nodes(np.linspace(0.0, 1.0, 11) * (1 + 1e-8 * np.sin(np.arange(11.0))))
+    assert stretched.uniform_spacing is None and nearly.uniform_spacing is not None
+    for grid in (stretched, nearly):
+        x, V = seed_positions(grid, 4, "jittered", seed=3)
+        rho = 1.0 + 0.1 * np.sin(2 * np.pi * x)
+        particles = make_particles(x, V, rho, 0.05 * np.sin(np.pi * x), rho**0.4 / 0.4, rho**1.4)
+        problem = Problem(model=IdealGas(), boundary=Walls(), T=0.2, cfl=1.0, dt=1e-3)
+        stages = Stages(scheme=scheme, mass=mass)
+        _assert_same(run(problem, grid, particles, stages, progress=False, kernel="numpy"),
+                     run(problem, grid, particles, stages, progress=False, kernel="fused"))
+    assert FusedStep(nearly, IdealGas(), Walls()).inv_spacing == 0.0  # the node arithmetic
+    assert FusedStep(GRID, IdealGas(), Walls()).inv_spacing > 0.0  # the uniform-grid arithmetic
 
 
 @pytest.mark.parametrize("model", ["gas", "burgers"])
@@ -120,12 +172,12 @@ def test_fused_exact_acceleration_and_slides_force(model, acceleration):
     problem = Problem(model=problem.model, boundary=problem.boundary, T=problem.T, cfl=1.0, dt=problem.dt,
                       exact_acceleration=exact)
     _assert_same(run(problem, GRID, particles, stages, progress=False, kernel="numpy"),
-                 run(problem, GRID, particles, stages, progress=False, kernel="fused"))
+                 run(problem, GRID, particles, stages, progress=False, kernel="fused"), TOLERANCE)
     if model == "burgers":
         slides = Problem(model=ViscousBurgers(0.01, force="slides"), boundary=Walls(), T=problem.T, cfl=1.0,
                          dt=problem.dt)
         _assert_same(run(slides, GRID, particles, progress=False, kernel="numpy"),
-                     run(slides, GRID, particles, progress=False, kernel="fused"))
+                     run(slides, GRID, particles, progress=False, kernel="fused"), TOLERANCE)
 
 
 @pytest.mark.slow  # compiling the parallel passes takes about a minute on a fresh machine

@@ -1,6 +1,9 @@
-"""The fused step's compiled loop (FusedStep.advance, taken by solve.run between walls with the
-lumped mass) against the numpy step: the same time steps (CFL from each step's max(c + |v|) or
-max |v| with the viscous limit, the last step landing on T) and the same particles, bit for bit."""
+"""The fused step's compiled loop (FusedStep.advance, taken by solve.run between walls or Dirichlet
+ends with the lumped mass, with or without a reservoir) against the fused step taken one step at a
+time and against the numpy step: the same time steps (CFL from each step's max(c + |v|) or max |v|
+with the viscous limit, the last step landing on T) and the same particles, bit for bit. The point
+mass on a uniform grid (uniform-grid arithmetic) equals the numpy step to ``TOLERANCE`` relative
+(tests/test_fused.py), and its loop the per-step path bit for bit."""
 
 import numpy as np
 import pytest
@@ -10,11 +13,19 @@ from mpm_fem.grid import uniform_grid
 from mpm_fem.models.burgers import ViscousBurgers
 from mpm_fem.particles import make_particles, seed_positions
 from mpm_fem.models.euler import IdealGas
+from mpm_fem.problems import burgers
 from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
 from mpm_fem.solve import Problem, run
 from mpm_fem.step import Stages, Walls
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
+TOLERANCE = 1e-12  # as tests/test_fused.py: max_p |u_fused - u_numpy| <= TOLERANCE max_p |u_numpy|, each field
+
+
+def _deviation(u, v):
+    scale = float(np.max(np.abs(u), initial=0.0))
+    gap = float(np.max(np.abs(u - v), initial=0.0))
+    return gap / scale if scale > 0 else gap
 
 
 @pytest.fixture
@@ -32,6 +43,12 @@ def loop_steps(monkeypatch):
     return taken
 
 
+@pytest.fixture
+def one_at_a_time(monkeypatch):
+    """Runs the fused step without its loop (every step through FusedStep.step), when called."""
+    return lambda: monkeypatch.setattr(fused_module.FusedStep, "loops", lambda self, problem: False)
+
+
 def _assert_same(a, b):
     assert (a.steps, a.t, a.dt_min, a.dt_max) == (b.steps, b.t, b.dt_min, b.dt_max)
     for name in FIELDS:
@@ -40,13 +57,26 @@ def _assert_same(a, b):
     assert np.array_equal(a.nodal_mass, b.nodal_mass) and np.array_equal(a.nodal_velocity, b.nodal_velocity)
 
 
+def _assert_close(a, b):
+    """The numpy step against the point mass's uniform-grid arithmetic: ``TOLERANCE`` relative."""
+    assert a.steps == b.steps and a.t == pytest.approx(b.t, rel=TOLERANCE)
+    for name in FIELDS:
+        u, v = getattr(a.particles, name), getattr(b.particles, name)
+        assert _deviation(u, v) <= TOLERANCE, f"{name} differs by {_deviation(u, v):.3g} relative"
+
+
 @pytest.mark.parametrize(("basis", "scheme"), [("mpm", "usl"), ("mpm", "usf"), ("mpm", "musl"), ("gimp", "usl"),
                                                ("bspline", "usl"), ("gimp", "musl")])
-def test_sod_with_the_cfl_step_equals_the_numpy_step_bit_for_bit(basis, scheme, loop_steps):
-    """Sod's tube to T = 0.1 (about 300 steps of dt = CFL h / max(c + |v|), the last one shortened)."""
+def test_sod_with_the_cfl_step_equals_the_numpy_step_bit_for_bit(basis, scheme, loop_steps, one_at_a_time):
+    """Sod's tube to T = 0.1 (about 300 steps of dt = CFL h / max(c + |v|), the last one shortened).
+    The point mass: the loop equals its per-step path bit for bit, and the numpy step to ``TOLERANCE``."""
     settings = dict(h=0.01, ppc=4, T=0.1, cfl=0.3, basis=basis, scheme=scheme)
     reference = simulate(SodSettings(**settings, kernel="numpy"), progress=False)
     fused = simulate(SodSettings(**settings), progress=False)
+    if basis == "mpm":
+        _assert_close(reference, fused)
+        one_at_a_time()
+        reference = simulate(SodSettings(**settings), progress=False)
     _assert_same(reference, fused)
     assert sum(loop_steps) == fused.steps - 1  # every step but the first ran in the loop
     assert fused.t == pytest.approx(0.1, rel=1e-12) and fused.dt_min < fused.dt_max
@@ -54,19 +84,23 @@ def test_sod_with_the_cfl_step_equals_the_numpy_step_bit_for_bit(basis, scheme, 
 
 @pytest.mark.parametrize("scheme", ["usl", "usf", "musl"])
 @pytest.mark.parametrize("refine", [1, 3])
-def test_burgers_between_walls_with_the_viscous_limit_equals_the_numpy_step(scheme, refine, loop_steps):
+def test_burgers_between_walls_with_the_viscous_limit_equals_the_numpy_step(scheme, refine, loop_steps,
+                                                                           one_at_a_time):
     """dt = CFL min(h / max|v|, h^2 / (2 eps)) / refine: the advective limit rules at eps = 0.001
-    early on, the viscous one at eps = 0.02."""
+    early on, the viscous one at eps = 0.02. The point mass on a uniform grid: the loop against its
+    per-step path bit for bit, against the numpy step to ``TOLERANCE``."""
     grid = uniform_grid(0.0, 1.0, 0.02)
     x, V = seed_positions(grid, 4)
     particles = make_particles(x, V, 1.0, np.sin(2 * np.pi * x))
-    for eps in (0.001, 0.02):
-        problem = Problem(model=ViscousBurgers(eps), boundary=Walls(), T=0.05, cfl=0.5)
-        stages = Stages(scheme=scheme, refine=refine)
-        reference = run(problem, grid, particles, stages, progress=False, kernel="numpy")
-        fused = run(problem, grid, particles, stages, progress=False, kernel="fused")
-        _assert_same(reference, fused)
+    stages = Stages(scheme=scheme, refine=refine)
+    cases = [(Problem(model=ViscousBurgers(eps), boundary=Walls(), T=0.05, cfl=0.5), stages) for eps in (0.001, 0.02)]
+    numpy_runs = [run(problem, grid, particles, stages, progress=False, kernel="numpy") for problem, stages in cases]
+    loops = [run(problem, grid, particles, stages, progress=False, kernel="fused") for problem, stages in cases]
     assert sum(loop_steps) > 0
+    one_at_a_time()
+    for (problem, stages), reference, fused in zip(cases, numpy_runs, loops):
+        _assert_close(reference, fused)
+        _assert_same(run(problem, grid, particles, stages, progress=False, kernel="fused"), fused)
 
 
 def test_the_loop_stops_where_the_run_must_fail(loop_steps):
@@ -81,3 +115,75 @@ def test_the_loop_stops_where_the_run_must_fail(loop_steps):
         errors.append(str(err.value))
     assert errors[0] == errors[1] and "50 steps did not reach T=0.1" in errors[1]
     assert sum(loop_steps) == 49
+
+
+def _counting_reservoir(monkeypatch):
+    """Counts the reservoir's calls that changed the particles."""
+    acted = []
+    call = burgers.Reservoir.__call__
+
+    def counting(self, particles, grid, t):
+        new = call(self, particles, grid, t)
+        acted.append(new is not particles)
+        return new
+
+    monkeypatch.setattr(burgers.Reservoir, "__call__", counting)
+    return acted
+
+
+@pytest.mark.parametrize(("basis", "scheme", "solution", "changes"), [
+    ("mpm", "usl", "rarefaction", {}), ("mpm", "usf", "rarefaction", {}), ("mpm", "musl", "rarefaction", {}),
+    ("gimp", "usl", "front", {}), ("bspline", "usl", "three_exp", {}),
+    ("mpm", "usl", "rarefaction", {"acceleration": "exact"}), ("mpm", "usf", "rarefaction", {"acceleration": "exact"}),
+    ("gimp", "musl", "rarefaction", {"acceleration": "exact", "dt_rule": "advective", "refine": 4})])
+def test_burgers_with_dirichlet_ends_and_the_reservoir_equals_the_numpy_step(basis, scheme, solution, changes,
+                                                                            loop_steps, monkeypatch,
+                                                                            one_at_a_time):
+    """Viscous Burgers with the exact data at both ends and the reservoir (particles leave at one end
+    and are fed in at the other), the calculated or the exact acceleration: the loop stops after
+    each step the reservoir acts on and the run re-enters it after the reservoir; the same steps
+    and particles as the numpy step, bit for bit."""
+    acted = _counting_reservoir(monkeypatch)
+    settings = dict(h=0.02, T=0.1, basis=basis, scheme=scheme, solution=solution, **changes)
+    reference = burgers.simulate(burgers.BurgersSettings(**settings, kernel="numpy"), progress=False)
+    n_numpy = sum(acted)
+    fused = burgers.simulate(burgers.BurgersSettings(**settings), progress=False)
+    n_fused = sum(acted) - n_numpy
+    if basis == "mpm":  # to TOLERANCE of the numpy step; bit for bit of the per-step path
+        _assert_close(reference, fused)
+        one_at_a_time()
+        reference = burgers.simulate(burgers.BurgersSettings(**settings), progress=False)
+    _assert_same(reference, fused)
+    assert n_numpy >= 2 and n_fused == n_numpy  # the reservoir acted, as often on both paths
+    assert sum(loop_steps) == fused.steps - 1 and len(loop_steps) >= n_numpy  # every step but the first in loops
+
+
+def test_burgers_whose_reservoir_acts_every_step_stays_on_the_per_step_path(loop_steps):
+    """The slides' weights ``h / N_p^i`` are reset by the reservoir after every step: no loop."""
+    settings = dict(h=0.02, T=0.02, weights="cell")
+    reference = burgers.simulate(burgers.BurgersSettings(**settings, kernel="numpy"), progress=False)
+    fused = burgers.simulate(burgers.BurgersSettings(**settings), progress=False)
+    _assert_close(reference, fused)  # the point mass on a uniform grid
+    assert loop_steps == [] and fused.steps > 5
+
+
+def test_the_reservoir_is_quiet_exactly_where_it_returns_the_particles_unchanged():
+    """``Reservoir.quiet`` and the loop's compiled test agree with the call on the edge cases: a
+    particle on an end, just outside it, and an end gap of just below and exactly one spacing."""
+    grid = uniform_grid(0.0, 1.0, 0.1)
+    reservoir = burgers.Reservoir(0.025, lambda x, t: np.zeros_like(x))
+    window = np.array(reservoir.quiet(grid))
+    s = 0.025
+    inner = np.linspace(0.5 * s, 1.0 - 0.5 * s, 40)
+    cases = {"inner": inner, "on both ends": np.r_[0.0, inner, 1.0], "left of a": np.r_[-1e-17, inner],
+             "right of b": np.r_[inner, np.nextafter(1.0, 2.0)], "gap below s": inner[1:] - inner[1] + np.nextafter(s, 0.0),
+             "gap of s": inner[1:] - inner[1] + s}
+    verdicts = {}
+    for name, x in cases.items():
+        particles = make_particles(x, s, 1.0, np.zeros_like(x))
+        unchanged = reservoir(particles, grid, 0.0) is particles
+        assert fused_module._reservoir_quiet(x, window) == unchanged, name
+        verdicts[name] = unchanged
+    assert verdicts == {"inner": True, "on both ends": True, "left of a": False, "right of b": False,
+                        "gap below s": True, "gap of s": False}
+    assert burgers.Reservoir(s, None, weights="cell").quiet(grid) is None

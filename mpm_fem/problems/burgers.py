@@ -100,6 +100,16 @@ class Reservoir:
     velocity: object  # callable (x, t) -> v
     weights: str = "volume"
 
+    def quiet(self, grid: Grid) -> tuple[float, float, float] | None:
+        """``(a, b, spacing)``: the call returns the particles as they are while every ``x_p`` lies
+        in [a, b] and ``floor((min x_p - a) / spacing)``, ``floor((b - max x_p) / spacing)`` are
+        <= 0 (no gap to fill), so a compiled loop may run until then; ``None`` with
+        ``weights="cell"``, which re-weights every step."""
+        if self.weights == "cell":
+            return None
+        a, b = grid.domain
+        return float(a), float(b), float(self.spacing)
+
     def __call__(self, particles: Particles, grid: Grid, t: float) -> Particles:
         a, b = grid.domain
         inside = (particles.x >= a) & (particles.x <= b)
