@@ -15,7 +15,7 @@ combinations that promise most, errors over grid nodes and over particles:
 
 Meshes: Sod h = 0.01 ... 0.0003125 (the convergence study's meshes but its finest, 0.00015625),
 each remedy on the first ``SOD_MESHES[name]`` of them. The blend, XPIC(m), the particle-domain
-B-spline and the grid volume run the fused compiled step (:mod:`mpm_fem.fused`, bit for bit the
+B-spline and the grid volume run the fused compiled step (:mod:`mpm_fem.fused`, equal to the
 numpy step); the Taylor reconstruction runs the numpy step only, and its three remedies stop at
 h = 0.00125 (``SOD_NUMPY_MESHES``; in the numpy step each halving costs 4x, the two finer meshes
 about 20x the four kept). Measured with the fused step (one run each, CPU seconds, compiled code warm, a shared
