@@ -7,7 +7,6 @@ compiled loop (walls, lumped mass: the blend and the particle-domain B-spline)."
 import numpy as np
 import pytest
 
-import mpm_fem.fused as fused_module
 from mpm_fem.fused import supported
 from mpm_fem.grid import uniform_grid
 from mpm_fem.models.burgers import ViscousBurgers
@@ -20,21 +19,6 @@ from mpm_fem.step import Dirichlet, Stages, Walls
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 GRID = uniform_grid(0.0, 1.0, 0.1)
-
-
-@pytest.fixture
-def loop_steps(monkeypatch):
-    """Counts the steps the compiled loop takes (the rest go through FusedStep.step)."""
-    taken = []
-    advance = fused_module.FusedStep.advance
-
-    def counting(self, *args, **kwargs):
-        out = advance(self, *args, **kwargs)
-        taken.append(out[2])
-        return out
-
-    monkeypatch.setattr(fused_module.FusedStep, "advance", counting)
-    return taken
 
 
 TOLERANCE = 1e-12  # the point mass on a uniform grid: the fused step's uniform-grid arithmetic (test_fused.py)

@@ -1,0 +1,20 @@
+"""Fixtures shared by the test modules."""
+
+import pytest
+
+import mpm_fem.fused as fused_module
+
+
+@pytest.fixture
+def loop_steps(monkeypatch):
+    """Counts the steps the compiled loop takes (the rest go through FusedStep.step)."""
+    taken = []
+    advance = fused_module.FusedStep.advance
+
+    def counting(self, *args, **kwargs):
+        out = advance(self, *args, **kwargs)
+        taken.append(out[2])
+        return out
+
+    monkeypatch.setattr(fused_module.FusedStep, "advance", counting)
+    return taken
