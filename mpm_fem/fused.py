@@ -133,6 +133,72 @@ def _point(nodes, h, inv_spacing, x):
 
 
 @njit(cache=True, inline="always")
+def _scaled(nodes, inv_spacing, y):
+    """Uniform-grid arithmetic for one point ``y`` in the grid: ``s = (y - x_0)/h`` and its cell
+    ``c = floor(s)`` (the last node in the last cell)."""
+    s = (y - nodes[0]) * inv_spacing
+    return s, min(int(s), nodes.size - 2)
+
+
+@njit(cache=True, inline="always")
+def _bspline_nearest(s, top):
+    """The quadratic B-spline row on a uniform grid from ``s = (x - x_0)/h``: the nearest node
+    ``n = floor(s + 1/2)`` and ``t = s - n`` in [-1/2, 1/2]; the splines of nodes ``n - 1, n, n + 1``
+    are ``N(t + 1) = (1/2 - t)^2 / 2``, ``N(t) = 3/4 - t^2``, ``N(t - 1) = (1/2 + t)^2 / 2``, their
+    slopes ``t - 1/2``, ``-2 t``, ``t + 1/2`` (per unit ``s``); every other spline is 0 at ``x``."""
+    n = min(int(s + 0.5), top)
+    t = s - n
+    u, w = 0.5 - t, 0.5 + t
+    return n, t, 0.5 * (u * u), 0.75 - t * t, 0.5 * (w * w)
+
+
+@njit(cache=True, inline="always")
+def _hat_antiderivative(r):
+    """``Psi(r) = int_{-inf}^r max(0, 1 - |r'|) dr'`` of the unit hat, without a branch:
+    ``(u^2 + 1 - w^2) / 2`` with ``u = clip(r + 1, 0, 1)``, ``w = clip(1 - r, 0, 1)``."""
+    u = min(max(r + 1.0, 0.0), 1.0)
+    w = min(max(1.0 - r, 0.0), 1.0)
+    return 0.5 * (u * u + (1.0 - w * w))
+
+
+@njit(cache=True, inline="always")
+def _gimp_uniform(nodes, inv_spacing, x, V, row, S, G):
+    """GIMP's row on a uniform grid (:func:`mpm_fem.shape.gimp_shape` to round-off), in the scaled
+    coordinate ``s``: the domain ``[s_-, s_+]`` (cut at the grid's ends), ``S_i = (Psi(s_+ - i) -
+    Psi(s_- - i)) / (s_+ - s_-)``, ``G_i = (N(s_+ - i) - N(s_- - i)) / (x_+ - x_-)`` at the nodes
+    ``i = c_- .. c_- + K - 1`` (clipped at the last node, repeats zeroed). A domain inside one cell
+    has the hats' values at its midpoint, ``S = (1 - xi_m, xi_m)``, and ``G = (-1, 1)/h``: no
+    division. Returns the cell and the K it needs (``c_+ - c_- + 2``)."""
+    n_nodes = nodes.size
+    K = row.size
+    a, b = nodes[0], nodes[n_nodes - 1]
+    _, c = _scaled(nodes, inv_spacing, x)
+    s_lo, c_lo = _scaled(nodes, inv_spacing, max(x - 0.5 * V, a))
+    s_hi, c_hi = _scaled(nodes, inv_spacing, min(x + 0.5 * V, b))
+    if c_hi == c_lo:
+        xi = 0.5 * (s_lo + s_hi) - c_lo
+        row[0], S[0], G[0] = c_lo, 1.0 - xi, -inv_spacing
+        row[1], S[1], G[1] = c_lo + 1, xi, inv_spacing
+        for k in range(2, K):
+            row[k], S[k], G[k] = min(c_lo + k, n_nodes - 1), 0.0, 0.0
+        return c, 2
+    inv_w = 1.0 / (s_hi - s_lo)
+    inv_len = inv_w * inv_spacing
+    previous = -1
+    for k in range(K):
+        i = min(c_lo + k, n_nodes - 1)
+        row[k] = i
+        if i == previous:
+            S[k], G[k] = 0.0, 0.0
+        else:
+            r_lo, r_hi = s_lo - i, s_hi - i
+            S[k] = (_hat_antiderivative(r_hi) - _hat_antiderivative(r_lo)) * inv_w
+            G[k] = (max(1.0 - abs(r_hi), 0.0) - max(1.0 - abs(r_lo), 0.0)) * inv_len
+        previous = i
+    return c, c_hi - c_lo + 2
+
+
+@njit(cache=True, inline="always")
 def _hat_and_integral(nodes, i, y):
     """:func:`mpm_fem.shape._hat_and_integral` for node ``i`` at ``y``: ``S_i(y)``, ``int^y S_i``."""
     n = nodes.size
@@ -182,6 +248,19 @@ def _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G):
     K = row.size
     a, b = nodes[0], nodes[n_nodes - 1]
     h0 = h[0, 0]
+    if inv_spacing > 0.0:  # uniform-grid arithmetic: s = (y - x_0)/h, c = floor(s); one division
+        _, c = _scaled(nodes, inv_spacing, x)
+        y_lo, c_lo = _scaled(nodes, inv_spacing, max(x - 0.5 * V, a))
+        y_hi, c_hi = _scaled(nodes, inv_spacing, min(x + 0.5 * V, b))
+        inv_w = 1.0 / (y_hi - y_lo)
+        inv_len = inv_w * inv_spacing
+        for k in range(K):
+            j = c_lo - 1 + k
+            r_lo, r_hi = y_lo - j, y_hi - j
+            row[k] = min(max(j, 0), n_nodes - 1)
+            S[k] = (_bspline_antiderivative(r_hi) - _bspline_antiderivative(r_lo)) * inv_w
+            G[k] = (_bspline_value(r_hi) - _bspline_value(r_lo)) * inv_len
+        return c, c_hi - c_lo + 4
     c, _ = _locate(nodes, inv_spacing, x)
     lo = max(x - 0.5 * V, a)
     hi = min(x + 0.5 * V, b)
@@ -211,6 +290,17 @@ def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
         S[0], S[1] = 1.0 - xi, xi
         G[0], G[1] = -inv_h, inv_h
         return c, 2
+    if basis == 2 and inv_spacing > 0.0:  # uniform grid: the three splines around the nearest node n,
+        # stored as the row c-1 .. c+2 (n = c: its last entry 0; n = c + 1: its first)
+        s, c = _scaled(nodes, inv_spacing, x)
+        n, t, w_l, w_0, w_r = _bspline_nearest(s, n_nodes - 1)
+        first = n - c  # 0 or 1
+        for k in range(4):
+            row[k] = min(max(c + k - 1, 0), n_nodes - 1)
+            S[k], G[k] = 0.0, 0.0
+        S[first], S[first + 1], S[first + 2] = w_l, w_0, w_r
+        G[first], G[first + 1], G[first + 2] = (t - 0.5) * inv_spacing, (-2.0 * t) * inv_spacing, (t + 0.5) * inv_spacing
+        return c, 4
     if basis == 2:  # quadratic B-spline at the nodes c-1 .. c+2, ghosts folded into the ends
         c, xi = _locate(nodes, inv_spacing, x)
         for k in range(4):
@@ -230,6 +320,8 @@ def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
     if basis == 3:
         return _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G)
     # GIMP: hats averaged over [x - V/2, x + V/2], cut at the ends of the grid
+    if inv_spacing > 0.0:
+        return _gimp_uniform(nodes, inv_spacing, x, V, row, S, G)
     a, b = nodes[0], nodes[n_nodes - 1]
     c, _ = _locate(nodes, inv_spacing, x)
     lo = max(x - 0.5 * V, a)
@@ -449,6 +541,81 @@ def _project_point(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, h
     return outside
 
 
+@njit(cache=True, inline="always")
+def _project_bspline(nodes, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi, rows, S, G, cell, buf):
+    """Pass 1 of the B-spline on a uniform grid over particles ``lo .. hi-1``, as
+    :func:`_project_point`: the row from :func:`_bspline_nearest` (three nodes around the nearest
+    node ``n``), and the three nodes' sums held in registers while consecutive particles share ``n``
+    (each node's terms still added in particle order). A particle whose nearest node is an end node
+    (its ghost spline folded into it) adds into ``buf`` directly. Returns the first particle outside
+    the grid (-1 if none)."""
+    n_nodes = nodes.size
+    top = n_nodes - 1
+    a, b = nodes[0], nodes[top]
+    outside, held = -1, -1  # held: the nearest node whose three node sums are in registers
+    m0 = m1 = m2 = P0 = P1 = P2 = F0 = F1 = F2 = 0.0
+    for q in range(lo, hi):
+        if not (x[q] >= a and x[q] <= b):
+            if outside < 0:
+                outside = q
+            continue
+        s, c = _scaled(nodes, inv_spacing, x[q])
+        n, t, w_l, w_0, w_r = _bspline_nearest(s, top)
+        g_l, g_0, g_r = (t - 0.5) * inv_spacing, (-2.0 * t) * inv_spacing, (t + 0.5) * inv_spacing
+        cell[q] = c
+        if store:  # the row c-1 .. c+2, as _shape_row stores it
+            first = n - c
+            for k in range(4):
+                rows[q, k], S[q, k], G[q, k] = min(max(c + k - 1, 0), top), 0.0, 0.0
+            S[q, first], S[q, first + 1], S[q, first + 2] = w_l, w_0, w_r
+            G[q, first], G[q, first + 1], G[q, first + 2] = g_l, g_0, g_r
+        mq = m[q]
+        mv = mq * v[q]
+        Vp = V[q] * p[q] if gas_force else 0.0
+        if n == 0 or n == top:  # a ghost folded into the end node: straight into buf
+            if held >= 0:
+                buf[0, held - 1], buf[1, held - 1], buf[2, held - 1] = m0, P0, F0
+                buf[0, held], buf[1, held], buf[2, held] = m1, P1, F1
+                buf[0, held + 1], buf[1, held + 1], buf[2, held + 1] = m2, P2, F2
+                held = -1
+            i_l, i_r = max(n - 1, 0), min(n + 1, top)
+            buf[0, i_l] += w_l * mq
+            buf[1, i_l] += w_l * mv
+            buf[0, n] += w_0 * mq
+            buf[1, n] += w_0 * mv
+            buf[0, i_r] += w_r * mq
+            buf[1, i_r] += w_r * mv
+            if gas_force:
+                buf[2, i_l] += g_l * Vp
+                buf[2, n] += g_0 * Vp
+                buf[2, i_r] += g_r * Vp
+            continue
+        if n != held:
+            if held >= 0:
+                buf[0, held - 1], buf[1, held - 1], buf[2, held - 1] = m0, P0, F0
+                buf[0, held], buf[1, held], buf[2, held] = m1, P1, F1
+                buf[0, held + 1], buf[1, held + 1], buf[2, held + 1] = m2, P2, F2
+            m0, P0, F0 = buf[0, n - 1], buf[1, n - 1], buf[2, n - 1]
+            m1, P1, F1 = buf[0, n], buf[1, n], buf[2, n]
+            m2, P2, F2 = buf[0, n + 1], buf[1, n + 1], buf[2, n + 1]
+            held = n
+        m0 += w_l * mq
+        P0 += w_l * mv
+        m1 += w_0 * mq
+        P1 += w_0 * mv
+        m2 += w_r * mq
+        P2 += w_r * mv
+        if gas_force:
+            F0 += g_l * Vp
+            F1 += g_0 * Vp
+            F2 += g_r * Vp
+    if held >= 0:
+        buf[0, held - 1], buf[1, held - 1], buf[2, held - 1] = m0, P0, F0
+        buf[0, held], buf[1, held], buf[2, held] = m1, P1, F1
+        buf[0, held + 1], buf[1, held + 1], buf[2, held + 1] = m2, P2, F2
+    return outside
+
+
 def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
              rows, S, G, cell, m_i, P_i, F_i, flags):
     """Pass 1: the shape of every particle, ``m_i``, ``P_i`` and, if ``gas_force``, ``F_i = sum_p
@@ -467,6 +634,10 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
         if BASIS == 0:  # point mass: its own loop, the sums held in registers (the loop below then skipped)
             outside, need = _project_point(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi,
                                            rows, S, G, cell, buf[k]), 2
+            lo = hi
+        if BASIS == 2 and inv_spacing > 0.0:  # the B-spline on a uniform grid: likewise
+            outside, need = _project_bspline(nodes, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi,
+                                             rows, S, G, cell, buf[k]), 4
             lo = hi
         for q in range(lo, hi):
             if not (x[q] >= a and x[q] <= b):
@@ -549,6 +720,25 @@ def _move_point(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, cons
     return tally
 
 
+@njit(cache=True, inline="always")
+def _move_bspline(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, gas, lo, hi,
+                  x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally):
+    """Pass 2 of the B-spline on a uniform grid, USL, over particles ``lo .. hi-1``: :func:`_move`'s
+    arithmetic with the row of :func:`_bspline_nearest` in registers. Returns the tally."""
+    top = nodes.size - 1
+    for q in range(lo, hi):
+        s, c = _scaled(nodes, inv_spacing, x[q])
+        n, t, w_l, w_0, w_r = _bspline_nearest(s, top)
+        i_l, i_r = max(n - 1, 0), min(n + 1, top)
+        v_new[q] = v[q] + dt * (w_l * a_i[i_l] + w_0 * a_i[n] + w_r * a_i[i_r])
+        x_new[q] = x[q] + dt * (w_l * v_n[i_l] + w_0 * v_n[n] + w_r * v_n[i_r])
+        L = ((t - 0.5) * inv_spacing) * v_n[i_l] + ((-2.0 * t) * inv_spacing) * v_n[n] \
+            + ((t + 0.5) * inv_spacing) * v_n[i_r]
+        tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, tally)
+        tally = _checked(gas, q, tally[6], x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+    return tally
+
+
 def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
           x_new, v_new, V_new, m_new, rho_new, e_new, p_new, P_i, flags, values, speed):
     """Pass 2: ``v_p += dt sum S a``, ``x_p += dt sum S v^{n+1}``; USL: the state update from
@@ -571,6 +761,11 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
             # registers (the loop below then skipped)
             tally = _move_point(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, gas, lo, hi,
                                 x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally)
+            lo = hi
+        if BASIS == 2 and inv_spacing > 0.0 and usl and flip == 1.0 and not pic:  # the B-spline on a uniform
+            # grid, likewise
+            tally = _move_bspline(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, gas, lo, hi,
+                                  x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally)
             lo = hi
         for q in range(lo, hi):
             cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)

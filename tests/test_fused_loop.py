@@ -1,8 +1,8 @@
 """The fused step's compiled loop (FusedStep.advance, taken by solve.run between walls or Dirichlet
 ends with the lumped mass, with or without a reservoir) against the fused step taken one step at a
 time and against the numpy step: the same time steps (CFL from each step's max(c + |v|) or max |v|
-with the viscous limit, the last step landing on T) and the same particles, bit for bit. The point
-mass on a uniform grid (uniform-grid arithmetic) equals the numpy step to ``TOLERANCE`` relative
+with the viscous limit, the last step landing on T) and the same particles, bit for bit. On a uniform
+grid every basis takes uniform-grid arithmetic: it equals the numpy step to ``TOLERANCE`` relative
 (tests/test_fused.py), and its loop the per-step path bit for bit."""
 
 import numpy as np
@@ -43,26 +43,27 @@ def _assert_same(a, b):
 
 
 def _assert_close(a, b):
-    """The numpy step against the point mass's uniform-grid arithmetic: ``TOLERANCE`` relative."""
+    """The numpy step against the uniform-grid arithmetic: ``TOLERANCE`` relative, each particle and
+    nodal field; returns the worst relative deviation."""
     assert a.steps == b.steps and a.t == pytest.approx(b.t, rel=TOLERANCE)
-    for name in FIELDS:
-        u, v = getattr(a.particles, name), getattr(b.particles, name)
+    pairs = [(name, getattr(a.particles, name), getattr(b.particles, name)) for name in FIELDS]
+    pairs += [("m_i", a.nodal_mass, b.nodal_mass), ("v_i", a.nodal_velocity, b.nodal_velocity)]
+    for name, u, v in pairs:
         assert _deviation(u, v) <= TOLERANCE, f"{name} differs by {_deviation(u, v):.3g} relative"
+    return max(_deviation(u, v) for _, u, v in pairs)
 
 
 @pytest.mark.parametrize(("basis", "scheme"), [("mpm", "usl"), ("mpm", "usf"), ("mpm", "musl"), ("gimp", "usl"),
                                                ("bspline", "usl"), ("gimp", "musl")])
 def test_sod_with_the_cfl_step_equals_the_numpy_step_bit_for_bit(basis, scheme, loop_steps, one_at_a_time):
     """Sod's tube to T = 0.1 (about 300 steps of dt = CFL h / max(c + |v|), the last one shortened).
-    The point mass: the loop equals its per-step path bit for bit, and the numpy step to ``TOLERANCE``."""
+    The loop equals its per-step path bit for bit, and the numpy step to ``TOLERANCE`` (uniform grid)."""
     settings = dict(h=0.01, ppc=4, T=0.1, cfl=0.3, basis=basis, scheme=scheme)
     reference = simulate(SodSettings(**settings, kernel="numpy"), progress=False)
     fused = simulate(SodSettings(**settings), progress=False)
-    if basis == "mpm":
-        _assert_close(reference, fused)
-        one_at_a_time()
-        reference = simulate(SodSettings(**settings), progress=False)
-    _assert_same(reference, fused)
+    assert _assert_close(reference, fused) <= TOLERANCE
+    one_at_a_time()
+    _assert_same(simulate(SodSettings(**settings), progress=False), fused)
     assert sum(loop_steps) == fused.steps - 1  # every step but the first ran in the loop
     assert fused.t == pytest.approx(0.1, rel=1e-12) and fused.dt_min < fused.dt_max
 
@@ -127,18 +128,16 @@ def test_burgers_with_dirichlet_ends_and_the_reservoir_equals_the_numpy_step(bas
     """Viscous Burgers with the exact data at both ends and the reservoir (particles leave at one end
     and are fed in at the other), the calculated or the exact acceleration: the loop stops after
     each step the reservoir acts on and the run re-enters it after the reservoir; the same steps
-    and particles as the numpy step, bit for bit."""
+    as the numpy step and its particles to ``TOLERANCE``, the per-step path's bit for bit."""
     acted = _counting_reservoir(monkeypatch)
     settings = dict(h=0.02, T=0.1, basis=basis, scheme=scheme, solution=solution, **changes)
     reference = burgers.simulate(burgers.BurgersSettings(**settings, kernel="numpy"), progress=False)
     n_numpy = sum(acted)
     fused = burgers.simulate(burgers.BurgersSettings(**settings), progress=False)
     n_fused = sum(acted) - n_numpy
-    if basis == "mpm":  # to TOLERANCE of the numpy step; bit for bit of the per-step path
-        _assert_close(reference, fused)
-        one_at_a_time()
-        reference = burgers.simulate(burgers.BurgersSettings(**settings), progress=False)
-    _assert_same(reference, fused)
+    assert _assert_close(reference, fused) <= TOLERANCE  # uniform grid: to TOLERANCE of the numpy step,
+    one_at_a_time()  # bit for bit of the per-step path
+    _assert_same(burgers.simulate(burgers.BurgersSettings(**settings), progress=False), fused)
     assert n_numpy >= 2 and n_fused == n_numpy  # the reservoir acted, as often on both paths
     assert sum(loop_steps) == fused.steps - 1 and len(loop_steps) >= n_numpy  # every step but the first in loops
 
