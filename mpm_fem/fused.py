@@ -17,11 +17,16 @@ index order, a particle's nodes left to right) with the same operations, so the 
 functions as the numpy step (``divide_by_lumped``, ``solve_consistent``, the boundary objects), so
 any :class:`~mpm_fem.step.Boundary` and both mass kinds are supported.
 
-Except for the point mass on a uniform grid: there a particle's cell, ``xi`` and ``1/h_c`` come from
-uniform-grid arithmetic (:func:`_point`: ``s = (x - x_0)/h``, ``c = floor(s)``, ``xi = s - c``),
-which equals the numpy step's node arithmetic to round-off (tested to 1e-12 relative over 1,000
-steps), not bit for bit; its passes keep the row and a cell's node sums in registers
-(:func:`_project_point`, :func:`_move_point`).
+Except on a grid uniform to round-off (nodes within ``1e-9 h`` of ``x_0 + i h``): there every basis
+takes uniform-grid arithmetic, ``s = (x - x_0)/h``, ``c = floor(s)``, ``xi = s - c``, its row in
+closed form from ``s`` with no node coordinate read and no division per node (:func:`_point`;
+GIMP :func:`_gimp_uniform`, one division per particle whose domain crosses a node; the B-spline
+:func:`_bspline_nearest`, the three splines around the nearest node; the particle-domain B-spline
+in :func:`_bspline_domain_row`, one division per particle). That equals the numpy step's node
+arithmetic to round-off (tested to 1e-12 relative over 1,000 steps), not bit for bit. The point
+mass and the B-spline keep the row and the node sums of consecutive particles in registers
+(:func:`_project_point`, :func:`_move_point`, :func:`_project_bspline`, :func:`_move_bspline`).
+A grid not uniform to round-off keeps the node arithmetic, bit for bit, in every basis.
 
 Threads (``threads > 1``): the particles are cut into ``threads`` contiguous chunks; each chunk
 scatters into its own grid buffer and the buffers are summed in chunk order. The result depends
@@ -243,7 +248,8 @@ def _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G):
     """:func:`mpm_fem.shape.bspline_gimp_shape` of one particle: the splines centred at
     ``j = c_lo - 1 .. c_lo - 2 + K`` (ghosts folded into the end nodes) averaged over the domain
     ``[x - V/2, x + V/2]`` cut at the grid's ends; returns its cell and the K it needs
-    (``c_hi - c_lo + 4``)."""
+    (``c_hi - c_lo + 4``). On a uniform grid (``inv_spacing > 0``) from uniform-grid arithmetic
+    (:func:`_scaled`; ``1 / (s_+ - s_-)`` the particle's one division), else bit for bit."""
     n_nodes = nodes.size
     K = row.size
     a, b = nodes[0], nodes[n_nodes - 1]
@@ -1027,8 +1033,8 @@ _PAD = 40  # doubles between advance's particle arrays: 5 cache lines, so that t
 
 def _uniform_to_round_off(grid: Grid) -> bool:
     """Whether the grid is uniform (``grid.uniform_spacing``) and its nodes lie within ``1e-9 h`` of
-    ``x_0 + i h`` (a ``linspace``): then the point mass's uniform-grid arithmetic (:func:`_point`)
-    agrees with the node arithmetic to round-off. A grid uniform only to ``grid.uniform_spacing``'s
+    ``x_0 + i h`` (a ``linspace``): then the uniform-grid arithmetic of every basis (:func:`_point`,
+    :func:`_scaled`) agrees with the node arithmetic to round-off. A grid uniform only to ``grid.uniform_spacing``'s
     1e-6 takes the node arithmetic (and bisection to locate the particles, in every basis)."""
     h = grid.uniform_spacing
     if h is None:
