@@ -28,7 +28,7 @@ are compiled, :mod:`mpm_fem.exact_kernels`, and whose quadrature rows are cached
 all-MPM runs take the fused step) measured in CPU seconds on the shared 2-core machine: P1 at
 h = 0.0025 110 (164 before the compiled exact fields, the same numbers bit for bit); GIMP at 0.005
 83 (91 before: the GIMP rows at the particles dominate). A halving costs about 4x (twice the
-particles, twice the steps): P1 at 0.00125 ~440, at 0.000625 ~1700; GIMP and the B-splines at
+particles, twice the steps): P1 at 0.00125 359 (measured), at 0.000625 ~1450; GIMP and the B-splines at
 0.0025 ~200-330 each. The study (E1 with E2) already takes ~20 CPU-minutes, so no mesh is added.
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125, the Sod study's meshes but
 its single finest: each halving costs 4x; at 0.00125 the three bases took 2.8 / 8.9 / 7.0 s (P1 /
