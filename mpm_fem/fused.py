@@ -67,10 +67,10 @@ from .grid import Grid
 from .models.burgers import ViscousBurgers
 from .models.euler import IdealGas
 from .particles import Particles, PositivityError
-from .shape import Shape, make_shape
-from .step import SCHEMES, Dirichlet, GridState, Stages, Walls, _reset_volume
+from .reconstruction import OFFSETS, force_quadrature
+from .shape import Shape, basis_integrals, make_shape
+from .step import SCHEMES, Dirichlet, GridState, Stages, Walls
 from .transfer import solve_consistent
-from .volume import grid_volume_factor
 from .xpic import boundary_change_rule
 
 KERNELS = ("fused", "numpy")
@@ -83,8 +83,6 @@ def supported(model, stages: Stages) -> str | None:
     """``None`` if the fused step implements this model and these stages, else the reason."""
     if stages.uses_exact_fields:
         return "the exact projection, mass and interpolation stages run the numpy step"
-    if stages.reconstruct != "none":
-        return "the plateau remedy reconstruct runs the numpy step"
     if not isinstance(model, (IdealGas, ViscousBurgers)):
         return f"the fused step has no kernel for the model {type(model).__name__}"
     return None
@@ -628,6 +626,107 @@ def _xpic_momentum(nodes, h, inv_spacing, x, rows, S, G, cell, m, u_i, chunks, P
     _sum_chunks(buf, 0, P_i, 1.0)
 
 
+@njit(cache=True, inline="always")
+def _domain_row(basis, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl):
+    """Particle q's row ``Sbar_ip`` of the volume reset (:mod:`mpm_fem.volume`) into ``r``, ``Sl``:
+    the step's own stored row (GIMP, particle-domain B-spline), or the domain average of the point
+    basis' grid functions at ``x_q``, ``V_q`` (point mass: GIMP; B-spline: the particle-domain
+    B-spline), in ``r.size`` columns (columns past a domain's nodes have zero weight). Returns the
+    width the row needs (more than ``r.size``: the caller retries wider)."""
+    if basis == 1 or basis == 3:
+        for j in range(r.size):
+            r[j], Sl[j] = rows[q, j], S[q, j]
+        return r.size
+    _, need = _shape_row(1 if basis == 0 else 3, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
+    return need
+
+
+def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks, width,
+                  V_i, ratio, V_r, rho_r, p_r, flags, values):
+    """The grid volume reset (:func:`mpm_fem.volume.grid_volume_factor`, then the model's
+    ``with_volume``): ``V_i = sum_p V_p Sbar_ip``, ``f_p = sum_i Sbar_ip (int S_i / V_i)`` (0 where
+    ``V_i = 0``; ``integrals`` holds ``int S_i``), ``V_p <- V_p f_p`` into ``V_r``; the gas at the same
+    mass and specific energy, ``rho_p = m_p / V_p``, ``p_p = (gamma - 1) rho_p eps_p + q_p rho_p /
+    rho_p^old`` (``q_p`` its viscosity) into ``rho_r``, ``p_r`` (Burgers: ``m_p = V_p``, which its
+    update sets anyway). The domain rows take ``width`` columns. ``flags[k] = (first particle of
+    chunk k whose new density (gas) or volume (Burgers) is not > 0, the width its rows need)``,
+    ``values[k, 0]`` that density or volume."""
+    n = x.size
+    gas = MODEL == GAS
+    buf = np.zeros((chunks, 1, V_i.size))
+    for k in prange(chunks):
+        r, Sl, Gl = _one_row(width)
+        need = 0
+        for q in range(*_chunk(n, chunks, k)):
+            need = max(need, _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl))
+            _scatter(buf, k, r, Sl, V[q], width)
+        flags[k, 1] = need
+    _sum_chunks(buf, 0, V_i, 1.0)
+    _divide_by_lumped(integrals, V_i, ratio)
+    gm1 = consts[0]
+    for k in prange(chunks):
+        r, Sl, Gl = _one_row(width)
+        bad, value = -1.0, 0.0
+        for q in range(*_chunk(n, chunks, k)):
+            _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl)
+            V_r[q] = V[q] * _gather(Sl, ratio, r, width)
+            if gas:
+                rho_r[q] = m[q] / V_r[q]
+                viscosity = p[q] - gm1 * rho[q] * e[q]
+                p_r[q] = gm1 * rho_r[q] * e[q] + viscosity * rho_r[q] / rho[q]
+                bad, value = _first(bad, value, q, rho_r[q])
+            else:
+                bad, value = _first(bad, value, q, V_r[q])
+        flags[k, 0], values[k, 0] = int(bad), value
+
+
+def _taylor_force(nodes, h, inv_spacing, x, rows, S, G, cell, p, v_i, eps, points, G_q, weights, offsets, chunks,
+                  sums, F_i):
+    """The reconstructed force (:func:`mpm_fem.reconstruction.reconstructed_force`, the same
+    operations): the stress ``sigma_p`` (gas ``-p_p``; Burgers ``eps sum_i G_ip v_i``) fitted cell by
+    cell by ``s0_c + s1_c (xi - 1/2)`` (:func:`~mpm_fem.reconstruction.taylor_fit`: the sums of 1,
+    ``d``, ``d^2``, ``sigma``, ``sigma d`` over a cell's particles in index order, ``d = xi_p - 1/2``,
+    into ``sums``), then ``F_i = - sum_g w_g sigma_h(x_g) S_i'(x_g)`` over the four points ``x_g`` of
+    every cell (:func:`~mpm_fem.reconstruction.force_quadrature`: their nodes ``points``, ``S_i'`` in
+    ``G_q``, ``w_g = h_c / 4``; ``offsets``: ``xi_g - 1/2``), point by point."""
+    n = x.size
+    K = WIDTH  # nodes per particle
+    gas = MODEL == GAS
+    n_cells = sums.shape[1]
+    buf = np.zeros((chunks, 5, n_cells))
+    for k in prange(chunks):
+        r, Sl, Gl = _one_row(K)
+        for q in range(*_chunk(n, chunks, k)):
+            if gas:
+                sigma = -p[q]
+            else:
+                _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+                sigma = eps * _gather(Gl, v_i, r, K)
+            c, xi = _locate(nodes, inv_spacing, x[q])
+            d = xi - 0.5
+            buf[k, 0, c] += 1.0
+            buf[k, 1, c] += d
+            buf[k, 2, c] += d * d
+            buf[k, 3, c] += sigma
+            buf[k, 4, c] += sigma * d
+    for j in range(5):
+        _sum_chunks(buf, j, sums[j], 1.0)
+    F_i[:] = 0.0
+    per_cell = offsets.size
+    for c in range(n_cells):
+        count, sd, sdd, sq, sqd = sums[0, c], sums[1, c], sums[2, c], sums[3, c], sums[4, c]
+        det = count * sdd - sd * sd
+        least = max(count, 1.0)
+        s1 = (count * sqd - sd * sq) / det if det > 1e-12 * (least * least) else 0.0
+        s0 = (sq - s1 * sd) / count if count > 0 else 0.0
+        for g in range(c * per_cell, (c + 1) * per_cell):
+            w_sigma = weights[g] * (s0 + s1 * offsets[g - c * per_cell])
+            for j in range(points.shape[1]):
+                F_i[points[g, j]] += G_q[g, j] * w_sigma
+    for i in range(F_i.size):
+        F_i[i] = -F_i[i]
+
+
 def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p, dt, consts, chunks,
             V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed):
     """MUSL's last pass: the state update from ``L_p = sum_i G_ip v_i^{n+1}`` (re-projected; the
@@ -705,7 +804,8 @@ def _reservoir_quiet(x, window):
 
 def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t, T, speed, fixed_dt, cfl, h_min,
              refine, viscous_limit, steps, max_steps, budget, cell, rows, S, G, grid, flags, upd, values, speeds,
-             dirichlet, window, exact):
+             dirichlet, window, exact, xpic, volume_width, integrals, reset, taylor, points, G_q, weights, offsets,
+             sums):
     """Up to ``budget`` steps of :meth:`FusedStep.step` between walls with the lumped mass, each with
     the time step :func:`mpm_fem.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL``
     from the previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between
@@ -720,6 +820,13 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     step whose particles the reservoir would change (:func:`_reservoir_quiet`): the caller applies it.
     With ``exact`` the nodal acceleration is the problem's exact one (:func:`_exact_acceleration`, in
     object mode), and no viscous force is computed.
+    The remedies: ``xpic = m > 0``, XPIC(m) as :meth:`FusedStep._xpic_target` with the lumped mass
+    (``m - 1`` passes :func:`_xpic_momentum`, each divided by ``m_i``, the change zero at the end
+    nodes); ``volume_width > 0``, the grid volume reset (:func:`_volume_reset`, domain rows that wide,
+    ``integrals = int S_i``, the reset state in ``reset[0]``) and then the force of the reset state.
+    ``taylor``: the reconstructed force (:func:`_taylor_force`, its quadrature ``points``, ``G_q``,
+    ``weights``, ``offsets``, scratch ``sums``) in place of the particles' force. ``grid`` holds 13
+    nodal arrays (7 without a remedy).
     Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     n = cell.size
     gas = MODEL == GAS
@@ -746,8 +853,8 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
         o = 1 - cur
         x_n, v_new, V_n, m_n, rho_n, e_n, p_n = state[o, 0, :n], state[o, 1, :n], state[o, 2, :n], state[o, 3, :n], \
             state[o, 4, :n], state[o, 5, :n], state[o, 6, :n]
-        PROJECT(nodes, h, inv_spacing, x, V, m, v, p, gas and scheme != 1, store, chunks, rows, S, G, cell,
-                m_i, P_i, F_i, flags)
+        PROJECT(nodes, h, inv_spacing, x, V, m, v, p, gas and scheme != 1 and volume_width == 0 and not taylor,
+                store, chunks, rows, S, G, cell, m_i, P_i, F_i, flags)
         need = 2
         for k in range(chunks):
             need = max(need, flags[k, 2])
@@ -763,13 +870,30 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
             with objmode(g_next="float64[::1]"):
                 g_next = _end_values(t_next)
             _set_ends(ends, g_t, v_i)
+        if volume_width > 0:  # the volume reset, then the force of the reset state
+            VOLUME(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks,
+                   WIDTH if store else volume_width, grid[11], grid[12], reset[0, 0, :n], reset[0, 1, :n],
+                   reset[0, 2, :n], upd, values)
+            wide = 0
+            for k in range(chunks):
+                wide = max(wide, upd[k, 1])
+            if (upd[:, 0] >= 0).any() or (not store and wide > volume_width):
+                break
+            V = reset[0, 0, :n]
+            if gas:
+                rho, p = reset[0, 1, :n], reset[0, 2, :n]
+                if scheme != 1 and not exact and not taylor:
+                    GAS_FORCE(nodes, h, inv_spacing, x, rows, S, G, cell, V, p, chunks, F_i)
         if scheme == 1:  # USF: the state first, then its force
-            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact, chunks,
-                   V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
+            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact and not taylor,
+                   chunks, V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
             if (upd >= 0).any():
                 break
-        elif not gas and not exact:
+        elif not gas and not exact and not taylor:
             VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i)
+        if taylor and not exact:
+            TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if scheme == 1 else p, v_i, eps, points, G_q,
+                   weights, offsets, chunks, sums, F_i)
         if exact:
             with objmode(a_exact="float64[::1]"):
                 a_exact = _exact_acceleration(t)
@@ -783,14 +907,30 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
                 a_i[ends[k]] = (g_next[k] - v_i[ends[k]]) / dt
         for i in range(v_n.size):
             v_n[i] = v_i[i] + dt * a_i[i]
+        target = a_i
+        if xpic > 0:  # XPIC(m): v* = sum_k [P (I - B)]^k v_i, and pass 2 interpolates v* + dt a_i
+            P_x, term, v_star, target = grid[7], grid[8], grid[9], grid[10]
+            term[:] = v_i
+            v_star[:] = v_i
+            for _ in range(xpic - 1):
+                XPIC(nodes, h, inv_spacing, x, rows, S, G, cell, m, term, chunks, P_x)
+                _divide_by_lumped(P_x, m_i, P_x)
+                for i in range(term.size):
+                    term[i] = term[i] - P_x[i]
+                for i in ends:
+                    term[i] = 0.0
+                for i in range(term.size):
+                    v_star[i] += term[i]
+            for i in range(target.size):
+                target[i] = v_star[i] + dt * a_i[i]
         if scheme == 0:
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, True, False,
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, True, False,
                  chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
         elif scheme == 1:
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V_n, m, v, rho_n, e_n, p_n, dt, consts, False,
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V_n, m, v, rho_n, e_n, p_n, dt, consts, False,
                  False, chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
         else:  # MUSL: move, re-project the momentum, then the state
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, False, True,
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, False, True,
                  chunks, x_n, v_new, V, m, rho, e, p, P_musl, flags, values, speeds)
             _lumped_walls(P_musl, m_i, ends, v_n)
             if dirichlet:
@@ -823,7 +963,7 @@ def _compile(fn, parallel, passes=None, **constants):
 
 
 BASIS, MODEL, WIDTH = 0, 0, 3  # replaced per compiled variant
-PROJECT = VISCOUS = UPDATE = MOVE = FINISH = None  # the passes a compiled _advance calls
+PROJECT = VISCOUS = UPDATE = MOVE = FINISH = GAS_FORCE = XPIC = VOLUME = TAYLOR = None  # the passes a compiled _advance calls
 _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
 _FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")  # Particles' names, same order
 _SCHEME_CODE = {"usl": 0, "usf": 1, "musl": 2}
@@ -856,6 +996,9 @@ class _Passes:
             if fn is _advance:  # the loop calls this variant's passes, compiled into it
                 shape = dict(BASIS=constants["BASIS"], WIDTH=constants["WIDTH"])
                 passes = dict(PROJECT=self.get(_project, **shape), VISCOUS=self.get(_viscous_force, **shape),
+                              GAS_FORCE=self.get(_gas_force, **shape), XPIC=self.get(_xpic_momentum, **shape),
+                              VOLUME=self.get(_volume_reset, BASIS=constants["BASIS"], MODEL=constants["MODEL"]),
+                              TAYLOR=self.get(_taylor_force, **constants),
                               **{name: self.get(f, **constants) for name, f in
                                  (("UPDATE", _update), ("MOVE", _move), ("FINISH", _finish))})
                 constants = dict(constants, THREADED=int(self.parallel))  # a name per variant
@@ -913,6 +1056,14 @@ class FusedStep:
         # the stored cells and node indices (pass 1 -> the grid stage and pass 2): 4 bytes, not 8
         self._index = np.int32 if grid.n_nodes <= np.iinfo(np.int32).max else np.intp
         self._h_min = float(grid.h.min())
+        self.integrals = (np.ascontiguousarray(basis_integrals(grid, stages.basis), dtype=float)
+                          if stages.volume == "grid" else np.empty(0))  # the volume reset: int S_i
+        self.volume_width = 3 if self.basis in (0, 1) else 5
+        self.quadrature = (np.empty((0, 2), np.intp), np.empty((0, 2)), np.empty(0), np.empty(0))
+        if stages.reconstruct == "taylor":  # the reconstructed force's points: their nodes, S_i', weights
+            points, weights = force_quadrature(grid, stages.basis)
+            self.quadrature = (np.ascontiguousarray(points.nodes, dtype=np.intp), np.ascontiguousarray(points.G),
+                               np.ascontiguousarray(weights), np.ascontiguousarray(OFFSETS))
 
     def _width(self, K):
         """Use the passes compiled for K nodes per particle (GIMP: 2 + the cells a domain spans)."""
@@ -950,15 +1101,14 @@ class FusedStep:
     def loops(self, problem) -> bool:
         """Whether :meth:`advance` can take the steps of ``problem``: walls or Dirichlet ends (this
         step's boundary), the lumped mass, the calculated acceleration and the weak force or the
-        exact acceleration (this step's), no XPIC and no volume reset, and no
+        exact acceleration (this step's), and no
         particle boundary or one that says when it acts (:meth:`_window`; no observer: the caller's)."""
         ends = type(problem.boundary) is Walls or (type(problem.boundary) is Dirichlet
                                                    and problem.boundary is self.boundary)
         exact = (self.stages.acceleration == "exact" and self.exact_acceleration is not None
                  and problem.exact_acceleration is self.exact_acceleration)
         return (ends and self.stages.mass == "lumped" and (self.stages.acceleration == "calculated" or exact)
-                and not self.slides and not self.stages.xpic and self.stages.volume == "carried"
-                and (problem.particle_boundary is None or self._window(problem) is not None))
+                and not self.slides and (problem.particle_boundary is None or self._window(problem) is not None))
 
     def _window(self, problem):
         """``(a, b, spacing)`` of a particle boundary that leaves the particles as they are while
@@ -984,12 +1134,14 @@ class FusedStep:
             self._cur = 0
         rows_n = n if self.basis in _DOMAIN_BASES else 0
         if (self._scratch is None or self._scratch[0].size < n or self._scratch[1].shape[0] < rows_n
-                or self._scratch[1].shape[1] != self.K or self._scratch[5].shape[0] != chunks):
+                or self._scratch[1].shape[1] != self.K or self._scratch[5].shape[0] != chunks
+                or (self.stages.volume == "grid" and self._scratch[9].shape[2] < n)):
             room, rows_room = n + spare(n), rows_n + spare(rows_n)
             self._scratch = (np.empty(room, self._index), np.empty((rows_room, self.K), self._index),
-                             np.empty((rows_room, self.K)), np.empty((rows_room, self.K)), np.empty((7, self.grid.n_nodes)),
+                             np.empty((rows_room, self.K)), np.empty((rows_room, self.K)), np.empty((13, self.grid.n_nodes)),
                              np.empty((chunks, 3), np.int64), np.empty((chunks, 2), np.int64), np.zeros((chunks, 2)),
-                             np.empty(chunks))
+                             np.empty(chunks), np.empty((1, 3, room if self.stages.volume == "grid" else 0)),
+                             np.empty((5, self.grid.n_cells)))
         cell, rows, S, G = self._scratch[0][:n], self._scratch[1][:rows_n], self._scratch[2][:rows_n], self._scratch[3][:rows_n]
         loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)
         fixed = problem.dt if problem.dt is not None else 0.0
@@ -1003,7 +1155,9 @@ class FusedStep:
                 self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
                 chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
                 float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
-                cell, rows, S, G, *self._scratch[4:], dirichlet, window, exact)
+                cell, rows, S, G, *self._scratch[4:9], dirichlet, window, exact, int(self.stages.xpic),
+                self.volume_width if self.stages.volume == "grid" else 0, self.integrals, self._scratch[9],
+                self.stages.reconstruct == "taylor", *self.quadrature, self._scratch[10])
         finally:
             _LOOP_CALLS.pop()
         if done:
@@ -1011,6 +1165,28 @@ class FusedStep:
             self._out = Particles(**{name: self._state[cur, j, :n] for j, name in enumerate(_FIELDS)})
             particles = self._out
         return particles, t, done, dt_min, dt_max
+
+    def _grid_volume(self, geometry, x, rows, S, V, m, rho, e, p, chunks):
+        """The grid volume reset (:func:`_volume_reset`): ``(V, rho, p)`` of the reset state (Burgers:
+        ``rho``, ``p`` as they are); raises :class:`PositivityError` as the model's ``with_volume``."""
+        reset = self._passes.get(_volume_reset, BASIS=self.basis, MODEL=self.kind)
+        n, n_nodes = x.size, self.grid.n_nodes
+        V_r, rho_r, p_r = (self._empty(name, n) for name in ("V_reset", "rho_reset", "p_reset"))
+        V_i, ratio = self._empty("V_i", n_nodes), self._empty("ratio", n_nodes)
+        flags, values = np.empty((chunks, 2), np.int64), np.zeros((chunks, 2))
+        while True:
+            width = self.K if self.basis in _DOMAIN_BASES else self.volume_width
+            reset(*geometry, x, rows, S, V, m, rho, e, p, self.integrals, self.consts, chunks, width,
+                  V_i, ratio, V_r, rho_r, p_r, flags, values)
+            need = int(flags[:, 1].max(initial=0))
+            if need <= width:
+                break
+            self.volume_width = need  # a particle domain spans another cell: redo with wider rows
+        for k in range(chunks):
+            if flags[k, 0] >= 0:
+                q = int(flags[k, 0])
+                raise PositivityError("density" if self.kind == GAS else "volume", q, float(x[q]), float(values[k, 0]))
+        return (V_r, rho_r, p_r) if self.kind == GAS else (V_r, rho, p)
 
     def _xpic_target(self, shape, shape_args, m, m_i, v_i, a_i, t, dt, chunks):
         """XPIC(m)'s grid field ``v* + dt a_i`` whose interpolation is the particle velocity
@@ -1034,8 +1210,8 @@ class FusedStep:
         rho, e, p = particles.density, particles.energy, particles.pressure
         gas = self.kind == GAS
         scheme, exact = self.stages.scheme, self.stages.acceleration == "exact"
-        grid_volume = self.stages.volume == "grid"
-        gas_force = gas and scheme != "usf" and not exact and not grid_volume
+        grid_volume, taylor = self.stages.volume == "grid", self.stages.reconstruct == "taylor"
+        gas_force = gas and scheme != "usf" and not exact and not grid_volume and not taylor
         store = self.basis in _DOMAIN_BASES or self.stages.mass == "consistent"
         geometry = (self.nodes, self.h, self.inv_spacing)
         n_nodes = grid.n_nodes
@@ -1059,10 +1235,9 @@ class FusedStep:
         shape = Shape(rows, S, G, n_nodes, cell)
         v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
         shape_args = (*geometry, x, rows, S, G, cell)
-        if grid_volume:  # the volume reset, in numpy (mpm_fem.volume), then the force of the reset state
-            reset = _reset_volume(self.model, particles, grid_volume_factor(grid, x, V, self.stages.basis, shape))
-            V, rho, e, p = reset.volume, reset.density, reset.energy, reset.pressure
-            if gas and scheme != "usf" and not exact:
+        if grid_volume:  # the volume reset (mpm_fem.volume), then the force of the reset state
+            V, rho, p = self._grid_volume(geometry, x, rows, S, V, m, rho, e, p, chunks)
+            if gas and scheme != "usf" and not exact and not taylor:
                 self._passes.get(_gas_force, BASIS=self.basis, WIDTH=self.K)(*shape_args, V, p, chunks, F_i)
 
         V_new, m_new = empty("V", n), (empty("m", n) if not gas else m)
@@ -1070,12 +1245,16 @@ class FusedStep:
         values = np.zeros((chunks, 2))
         if scheme == "usf":
             upd = np.empty((chunks, 2), np.int64)
-            self.update(*shape_args, v_i, V, m, rho, e, p, dt, self.consts, not exact and not self.slides, chunks,
-                        V_new, m_new, rho_new, e_new, p_new, F_i, upd, values)
+            self.update(*shape_args, v_i, V, m, rho, e, p, dt, self.consts, not exact and not self.slides and not taylor,
+                        chunks, V_new, m_new, rho_new, e_new, p_new, F_i, upd, values)
             if (upd >= 0).any():
                 self._positivity(upd, values, x)
-        elif not gas and not exact and not self.slides:
+        elif not gas and not exact and not self.slides and not taylor:
             self.viscous_force(*shape_args, v_i, V, self.consts[4], chunks, F_i)
+        if taylor and not exact and not self.slides:  # the reconstructed force of the (updated) stress
+            self._passes.get(_taylor_force, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)(
+                *shape_args, p_new if scheme == "usf" else p, v_i, self.consts[4], *self.quadrature, chunks,
+                empty("sums", (5, grid.n_cells)), F_i)
         if exact:
             if self.exact_acceleration is None:
                 raise ValueError("this problem has no exact acceleration to use")
