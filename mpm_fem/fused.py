@@ -39,20 +39,26 @@ The plateau remedies of :class:`~mpm_fem.step.Stages`, with the numpy step's ope
 
     flip      pass 2 blends, ``v_p <- flip (v_p + dt sum S a) + (1 - flip) sum S v^{n+1}``
               (``consts[5]``; per step and in the loop)
-    xpic      m - 1 compiled passes ``P_i = sum_p S_ip m_p sum_j S_jp u_j`` (:func:`_xpic_momentum`),
-              each solved with the step's mass and the boundary rule of a velocity change in numpy
-              (:mod:`mpm_fem.xpic`); pass 2 then sets ``v_p = sum_i S_ip (v*_i + dt a_i)``
-              (``consts[6] > 0``: its nodal field comes in place of ``a_i``). Per step only.
+    xpic      m - 1 compiled passes ``P_i = sum_p S_ip m_p sum_j S_jp u_j`` (:func:`_scatter_pass`),
+              each solved with the step's mass and the boundary rule of a velocity change
+              (:mod:`mpm_fem.xpic`; per step in numpy, in the loop compiled: the lumped mass, zero
+              change at the end nodes); pass 2 then sets ``v_p = sum_i S_ip (v*_i + dt a_i)``
+              (``consts[6] > 0``: its nodal field comes in place of ``a_i``). Per step and in the loop.
     basis     ``"bspline_gimp"`` (code 3): the B-splines averaged over the particle domain
               (:func:`_bspline_domain_row`); rows stored and widened as GIMP's (``c_hi - c_lo + 4``).
     volume    ``"grid"``: after pass 1 (without the gas force) the volume reset of the numpy step
-              (:func:`mpm_fem.volume.grid_volume_factor`, the model's ``with_volume``; numpy), then
-              the gas force of the reset state (:func:`_gas_force`). Per step only.
+              (:func:`mpm_fem.volume.grid_volume_factor`, the model's ``with_volume``), compiled in
+              two passes (:func:`_volume_reset`), then the gas force of the reset state
+              (:func:`_scatter_pass`). Per step and in the loop.
+    reconstruct  ``"taylor"``: the force of the Taylor least-squares stress
+              (:func:`mpm_fem.reconstruction.reconstructed_force`) in place of the particles' force,
+              compiled (:func:`_taylor_force`: one pass for the cell sums, one over the cells'
+              quadrature points, in the numpy order). Per step and in the loop.
 
 Supported: the four bases (``"mpm"``, ``"gimp"``, ``"bspline"``, ``"bspline_gimp"``), USL, USF,
 MUSL, lumped and consistent mass, calculated or exact acceleration, the ideal gas and viscous
-Burgers (both its forces), the PIC/FLIP blend, XPIC(m) and the grid volume. Stages with an exact
-projection, mass or interpolation, and the Taylor reconstruction, run the numpy step
+Burgers (both its forces), and every remedy: the PIC/FLIP blend, XPIC(m), the grid volume and the
+Taylor reconstruction. Stages with an exact projection, mass or interpolation run the numpy step
 (:func:`supported` says which), as does any ``kernel="numpy"`` run.
 """
 
@@ -494,17 +500,35 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
         _sum_chunks(buf, j, out, 1.0)
 
 
-def _viscous_force(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i):
-    """Burgers' stress before the force: ``F_i = - sum_p V_p eps (sum_j G_jp v_j) G_ip``."""
+PRESSURE, VISCOUS_STRESS, MOMENTUM = 0, 1, 2  # the weights of _scatter_pass
+
+
+def _scatter_pass(nodes, h, inv_spacing, x, rows, S, G, cell, f_i, a, b, coef, chunks, out):
+    """One scatter over the particles, ``out_i = sum_p w_p W_ip`` (each particle's row recomputed or
+    read as in pass 2), with the weight the compile-time ``WEIGHT`` picks:
+
+        PRESSURE         W = G_ip, w_p = a_p b_p:                  the gas force ``F_i = sum_p V_p p_p G_ip``
+                                                                   (after the volume reset)
+        VISCOUS_STRESS   W = G_ip, w_p = a_p (coef sum_j G_jp f_j), ``out = -sum``: Burgers' force
+                         ``F_i = - sum_p V_p eps (dv/dx)_p G_ip`` (its stress before the force)
+        MOMENTUM         W = S_ip, w_p = a_p sum_j S_jp f_j:        XPIC's ``P_i = sum_p S_ip m_p (sum_j S_jp u_j)``
+                         (:func:`mpm_fem.transfer.nodal_momentum` of ``shape.gather(u)``)
+
+    (``b``, ``coef``, ``f_i``: unused where the weight does not name them)."""
     n = x.size
     K = WIDTH  # nodes per particle
-    buf = np.zeros((chunks, 1, F_i.size))
+    buf = np.zeros((chunks, 1, out.size))
     for k in prange(chunks):
         r, Sl, Gl = _one_row(K)
         for q in range(*_chunk(n, chunks, k)):
             _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            _scatter(buf, k, r, Gl, V[q] * (eps * _gather(Gl, v_i, r, K)), K)
-    _sum_chunks(buf, 0, F_i, -1.0)
+            if WEIGHT == PRESSURE:
+                _scatter(buf, k, r, Gl, a[q] * b[q], K)
+            elif WEIGHT == VISCOUS_STRESS:
+                _scatter(buf, k, r, Gl, a[q] * (coef * _gather(Gl, f_i, r, K)), K)
+            else:
+                _scatter(buf, k, r, Sl, a[q] * _gather(Sl, f_i, r, K), K)
+    _sum_chunks(buf, 0, out, -1.0 if WEIGHT == VISCOUS_STRESS else 1.0)
 
 
 def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, force, chunks,
@@ -597,33 +621,6 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
         speed[k] = _flags(k, tally, flags, values)
     if musl:
         _sum_chunks(buf, 0, P_i, 1.0)
-
-
-def _gas_force(nodes, h, inv_spacing, x, rows, S, G, cell, V, p, chunks, F_i):
-    """The gas force of pass 1 alone (after the volume reset): ``F_i = sum_p V_p p_p G_ip``."""
-    n = x.size
-    K = WIDTH  # nodes per particle
-    buf = np.zeros((chunks, 1, F_i.size))
-    for k in prange(chunks):
-        r, Sl, Gl = _one_row(K)
-        for q in range(*_chunk(n, chunks, k)):
-            _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            _scatter(buf, k, r, Gl, V[q] * p[q], K)
-    _sum_chunks(buf, 0, F_i, 1.0)
-
-
-def _xpic_momentum(nodes, h, inv_spacing, x, rows, S, G, cell, m, u_i, chunks, P_i):
-    """XPIC's projection of an interpolated grid field: ``P_i = sum_p S_ip m_p (sum_j S_jp u_j)``
-    (:func:`mpm_fem.transfer.nodal_momentum` of ``shape.gather(u)``)."""
-    n = x.size
-    K = WIDTH  # nodes per particle
-    buf = np.zeros((chunks, 1, P_i.size))
-    for k in prange(chunks):
-        r, Sl, Gl = _one_row(K)
-        for q in range(*_chunk(n, chunks, k)):
-            _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            _scatter(buf, k, r, Sl, m[q] * _gather(Sl, u_i, r, K), K)
-    _sum_chunks(buf, 0, P_i, 1.0)
 
 
 @njit(cache=True, inline="always")
@@ -821,7 +818,7 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     With ``exact`` the nodal acceleration is the problem's exact one (:func:`_exact_acceleration`, in
     object mode), and no viscous force is computed.
     The remedies: ``xpic = m > 0``, XPIC(m) as :meth:`FusedStep._xpic_target` with the lumped mass
-    (``m - 1`` passes :func:`_xpic_momentum`, each divided by ``m_i``, the change zero at the end
+    (``m - 1`` passes :func:`_scatter_pass`, each divided by ``m_i``, the change zero at the end
     nodes); ``volume_width > 0``, the grid volume reset (:func:`_volume_reset`, domain rows that wide,
     ``integrals = int S_i``, the reset state in ``reset[0]``) and then the force of the reset state.
     ``taylor``: the reconstructed force (:func:`_taylor_force`, its quadrature ``points``, ``G_q``,
@@ -883,14 +880,14 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
             if gas:
                 rho, p = reset[0, 1, :n], reset[0, 2, :n]
                 if scheme != 1 and not exact and not taylor:
-                    GAS_FORCE(nodes, h, inv_spacing, x, rows, S, G, cell, V, p, chunks, F_i)
+                    GAS_FORCE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, p, 0.0, chunks, F_i)
         if scheme == 1:  # USF: the state first, then its force
             UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact and not taylor,
                    chunks, V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
             if (upd >= 0).any():
                 break
         elif not gas and not exact and not taylor:
-            VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i)
+            VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, V, eps, chunks, F_i)
         if taylor and not exact:
             TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if scheme == 1 else p, v_i, eps, points, G_q,
                    weights, offsets, chunks, sums, F_i)
@@ -913,7 +910,7 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
             term[:] = v_i
             v_star[:] = v_i
             for _ in range(xpic - 1):
-                XPIC(nodes, h, inv_spacing, x, rows, S, G, cell, m, term, chunks, P_x)
+                XPIC(nodes, h, inv_spacing, x, rows, S, G, cell, term, m, m, 0.0, chunks, P_x)
                 _divide_by_lumped(P_x, m_i, P_x)
                 for i in range(term.size):
                     term[i] = term[i] - P_x[i]
@@ -962,7 +959,7 @@ def _compile(fn, parallel, passes=None, **constants):
     return njit(cache=True, parallel=parallel)(variant)
 
 
-BASIS, MODEL, WIDTH = 0, 0, 3  # replaced per compiled variant
+BASIS, MODEL, WIDTH, WEIGHT = 0, 0, 3, 0  # replaced per compiled variant
 PROJECT = VISCOUS = UPDATE = MOVE = FINISH = GAS_FORCE = XPIC = VOLUME = TAYLOR = None  # the passes a compiled _advance calls
 _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
 _FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")  # Particles' names, same order
@@ -995,8 +992,9 @@ class _Passes:
             passes = None
             if fn is _advance:  # the loop calls this variant's passes, compiled into it
                 shape = dict(BASIS=constants["BASIS"], WIDTH=constants["WIDTH"])
-                passes = dict(PROJECT=self.get(_project, **shape), VISCOUS=self.get(_viscous_force, **shape),
-                              GAS_FORCE=self.get(_gas_force, **shape), XPIC=self.get(_xpic_momentum, **shape),
+                passes = dict(PROJECT=self.get(_project, **shape),
+                              **{name: self.get(_scatter_pass, **shape, WEIGHT=weight) for name, weight in
+                                 (("VISCOUS", VISCOUS_STRESS), ("GAS_FORCE", PRESSURE), ("XPIC", MOMENTUM))},
                               VOLUME=self.get(_volume_reset, BASIS=constants["BASIS"], MODEL=constants["MODEL"]),
                               TAYLOR=self.get(_taylor_force, **constants),
                               **{name: self.get(f, **constants) for name, f in
@@ -1071,7 +1069,7 @@ class FusedStep:
         constants = dict(BASIS=self.basis, MODEL=self.kind, WIDTH=K)
         self.project = self._passes.get(_project, BASIS=self.basis, WIDTH=K)
         self.update, self.move, self.finish = (self._passes.get(fn, **constants) for fn in (_update, _move, _finish))
-        self.viscous_force = self._passes.get(_viscous_force, BASIS=self.basis, WIDTH=K)
+        self.viscous_force = self._passes.get(_scatter_pass, BASIS=self.basis, WIDTH=K, WEIGHT=VISCOUS_STRESS)
 
     def _empty(self, name, shape, dtype=float):
         """A fresh array, or with ``reuse`` one of two alternating sets: a step never writes the
@@ -1194,11 +1192,11 @@ class FusedStep:
         ``P_i = sum_p S_ip m_p (sum_j S_jp u_j)``, each solved with the step's mass and the
         boundary rule of a velocity change applied."""
         rule = boundary_change_rule(self.boundary, self.grid, t)
-        momentum = self._passes.get(_xpic_momentum, BASIS=self.basis, WIDTH=self.K)
+        momentum = self._passes.get(_scatter_pass, BASIS=self.basis, WIDTH=self.K, WEIGHT=MOMENTUM)
         P_x = self._empty("P_xpic", m_i.shape)
         v_star, term = v_i.copy(), v_i
         for _ in range(self.stages.xpic - 1):
-            momentum(*shape_args, m, term, chunks, P_x)
+            momentum(*shape_args, term, m, m, 0.0, chunks, P_x)
             term = rule(term - self._solve(shape, m, m_i, P_x, "v_xpic"))
             v_star += term
         return v_star + dt * a_i
@@ -1238,7 +1236,8 @@ class FusedStep:
         if grid_volume:  # the volume reset (mpm_fem.volume), then the force of the reset state
             V, rho, p = self._grid_volume(geometry, x, rows, S, V, m, rho, e, p, chunks)
             if gas and scheme != "usf" and not exact and not taylor:
-                self._passes.get(_gas_force, BASIS=self.basis, WIDTH=self.K)(*shape_args, V, p, chunks, F_i)
+                self._passes.get(_scatter_pass, BASIS=self.basis, WIDTH=self.K, WEIGHT=PRESSURE)(
+                    *shape_args, v_i, V, p, 0.0, chunks, F_i)
 
         V_new, m_new = empty("V", n), (empty("m", n) if not gas else m)
         rho_new, e_new, p_new = (empty("rho", n), empty("e", n), empty("p", n)) if gas else (rho, e, p)
@@ -1250,7 +1249,7 @@ class FusedStep:
             if (upd >= 0).any():
                 self._positivity(upd, values, x)
         elif not gas and not exact and not self.slides and not taylor:
-            self.viscous_force(*shape_args, v_i, V, self.consts[4], chunks, F_i)
+            self.viscous_force(*shape_args, v_i, V, V, self.consts[4], chunks, F_i)
         if taylor and not exact and not self.slides:  # the reconstructed force of the (updated) stress
             self._passes.get(_taylor_force, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)(
                 *shape_args, p_new if scheme == "usf" else p, v_i, self.consts[4], *self.quadrature, chunks,
