@@ -54,6 +54,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 from skfem import Basis, ElementLineP1, ElementLineP2, MeshLine
 
+from . import exact_kernels
 from .grid import Grid
 from .shape import Shape, grid_functions, make_shape
 from .transfer import divide_by_lumped, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
@@ -130,6 +131,73 @@ def _gauss(left: np.ndarray, width: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     x = (left + 0.5 * width)[:, None] + 0.5 * width[:, None] * _XI
     w = 0.5 * width[:, None] * _W
     return x.ravel(), w.ravel()
+
+
+@dataclass(frozen=True, eq=False)
+class QuadratureRule:
+    """:func:`quadrature` with the grid functions at its points, for one grid: the points, weights
+    and rows ``S_qi``, ``S_i'(x_q)`` of the fixed pieces (nodes and half cells) are evaluated once
+    (:func:`quadrature_rule`); per step only the pieces that a breakpoint cuts are evaluated again,
+    on their sub-pieces, and spliced in at their place. The points, weights and rows are those of
+    ``quadrature(grid, breakpoints)`` and ``make_shape(grid, x, w, functions)`` bit for bit (each
+    row depends on its own point only)."""
+
+    grid: Grid
+    functions: str
+    edges: np.ndarray  # (n_pieces + 1,) the fixed pieces
+    x: np.ndarray  # (n_pieces, GAUSS_POINTS)
+    w: np.ndarray  # (n_pieces, GAUSS_POINTS)
+    rows: Shape  # rows of the points x, as (n_pieces, GAUSS_POINTS, k) arrays
+
+    def __call__(self, breakpoints) -> tuple[np.ndarray, np.ndarray, Shape]:
+        """``(x, w, shape)`` of the rule split at ``breakpoints`` (those inside the domain)."""
+        bp = np.asarray(breakpoints, dtype=float).ravel()
+        n = self.x.shape[0]
+        piece = np.searchsorted(self.edges, bp, side="right") - 1
+        inside = (piece >= 0) & (piece < n) & (bp > self.edges[np.clip(piece, 0, n)])
+        cut = np.unique(piece[inside])
+        fixed = (self.x, self.w, self.rows.nodes, self.rows.S, self.rows.G, self.rows.cell)
+        if cut.size == 0:
+            parts = fixed
+        else:
+            edges = np.unique(np.concatenate((self.edges[cut], self.edges[cut + 1], bp[inside])))
+            owner = np.searchsorted(self.edges, 0.5 * (edges[:-1] + edges[1:])) - 1
+            keep = np.isin(owner, cut)
+            x, w = _gauss(edges[:-1][keep], np.diff(edges)[keep])
+            sub = make_shape(self.grid, x, w, self.functions)
+            k = GAUSS_POINTS
+            pieces = (x.reshape(-1, k), w.reshape(-1, k), *(a.reshape(-1, k, *a.shape[1:])
+                                                             for a in (sub.nodes, sub.S, sub.G, sub.cell)))
+            first = np.searchsorted(owner[keep], cut).tolist()  # each cut piece's first sub-piece
+            runs = _runs(cut.tolist(), first + [int(keep.sum())], n)
+            parts = [np.concatenate([(f, s)[j][lo:hi] for j, lo, hi in runs]) for f, s in zip(fixed, pieces)]
+        x, w, nodes, S, G, cell = parts
+        k = nodes.shape[-1]
+        shape = Shape(nodes.reshape(-1, k), S.reshape(-1, k), G.reshape(-1, k), self.grid.n_nodes, cell.ravel())
+        return x.ravel(), w.ravel(), shape
+
+
+def _runs(cut: list, first: list, n: int) -> list:
+    """How the pieces follow each other along the domain when each cut piece ``cut[j]`` is replaced
+    by its sub-pieces ``first[j] ... first[j + 1] - 1``: runs ``(0, lo, hi)`` of the fixed pieces
+    ``lo ... hi - 1`` and ``(1, lo, hi)`` of the sub-pieces."""
+    runs, start = [], 0
+    for j, c in enumerate(cut):  # a few breakpoints, not nodes
+        runs += [(0, start, c), (1, first[j], first[j + 1])]
+        start = c + 1
+    return runs + [(0, start, n)]
+
+
+@lru_cache(maxsize=8)
+def quadrature_rule(grid: Grid, functions: str) -> QuadratureRule:
+    """:class:`QuadratureRule` of ``grid`` for the grid functions ``"mpm"`` or ``"bspline"``."""
+    edges = _pieces(grid)
+    x, w = _gauss(edges[:-1], np.diff(edges))
+    rows = make_shape(grid, x, w, functions)
+    k, m = GAUSS_POINTS, edges.size - 1
+    rows = Shape(rows.nodes.reshape(m, k, -1), rows.S.reshape(m, k, -1), rows.G.reshape(m, k, -1), grid.n_nodes,
+                 rows.cell.reshape(m, k))
+    return QuadratureRule(grid, functions, edges, x.reshape(m, k), w.reshape(m, k), rows)
 
 
 @dataclass(frozen=True, eq=False)
@@ -245,9 +313,8 @@ def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float, with
     (the exact form of the mass stage): the mass matrices are instead the FE mass of
     :func:`fe_mass` (on scikit-fem's basis), ``m_i`` its row sums (the same integrals).
     """
-    x, w = quadrature(grid, fields.breakpoints(t))
+    x, w, shape = quadrature_rule(grid, grid_functions(basis))(fields.breakpoints(t))
     rho, v, sigma = fields.integrand(x, t)
-    shape = make_shape(grid, x, w, grid_functions(basis))
     mass = w * rho
     M, m_i = fe_mass(grid, basis, fields, t) if with_fe_mass else (None, nodal_mass(shape, mass))
     return GridData(shape, mass, m_i, nodal_momentum(shape, mass, v), nodal_internal_force(shape, w, sigma), M)
@@ -337,7 +404,15 @@ class RiemannFields:
         return anchor, F, value, slope
 
     def _profile(self, xi):
-        """``U(xi)``, ``F(xi)`` and ``G(xi) = F - xi U`` for finite ``xi``."""
+        """``U(xi)``, ``F(xi)`` and ``G(xi) = F - xi U`` for finite ``xi``: the compiled
+        :func:`~mpm_fem.exact_kernels.profile`, equal bit for bit to :meth:`_profile_numpy`."""
+        xi = np.asarray(xi, dtype=float)
+        U, F, G = exact_kernels.profile(np.ascontiguousarray(xi).ravel(), self._speeds, *self._pieces)
+        return U.reshape(xi.shape), F.reshape(xi.shape), G.reshape(xi.shape)
+
+    def _profile_numpy(self, xi):
+        """The readable reference of :meth:`_profile`: ``U = U_k + m_k d``, ``F = F_k + U_k d + m_k
+        d^2 / 2``, ``G = F - xi U`` with ``d = xi - xi_k``, ``k`` the piece holding ``xi``."""
         anchor, F0, U0, m = self._pieces
         k = np.searchsorted(self._speeds, xi, side="right")
         d = xi - anchor[k]
@@ -346,9 +421,23 @@ class RiemannFields:
         G = F0[k] - U0[k] * anchor[k] + 0.5 * m[k] * d * d - xi * m[k] * d
         return U, F, G
 
-    def _sample(self, x, t):
+    @cached_property
+    def _waves(self) -> tuple:
+        """``(p_star, u_star)`` and the left and mirrored right waves as the compiled sampler reads them."""
         from baselines.exact import riemann
 
+        p_star, u_star, left, right = riemann.waves(self.left, self.right, self.gamma)
+        mirrored = (float(self.right[0]), -float(self.right[1]), float(self.right[2]))
+        return (p_star, u_star, exact_kernels.wave_constants(self.left, left, self.gamma),
+                exact_kernels.wave_constants(mirrored, right, self.gamma))
+
+    def _sample(self, x, t):
+        """The Riemann solution ``(rho, u, p)`` at ``x`` and ``t``: for ``t > 0`` the compiled
+        :func:`~mpm_fem.exact_kernels.sample`, equal bit for bit to :func:`baselines.exact.riemann.sample`."""
+        from baselines.exact import riemann
+
+        if t > 0:
+            return exact_kernels.sample(x, t, self.x0, self.gamma, *self._waves)
         return riemann.sample(x, t, self.left, self.right, x0=self.x0, gamma=self.gamma)
 
     def breakpoints(self, t):
@@ -374,20 +463,27 @@ class RiemannFields:
         x = np.asarray(x, dtype=float)
         if t == 0:
             return self._initial(x)[1]
-        l = self.half_width
-        U_hi = self._profile((x + l - self.x0) / t)[0]
-        U_lo = self._profile((x - l - self.x0) / t)[0]
-        return (U_hi - U_lo) / (2 * l)
+        return self._averaged(x, t, False)[1]
 
     def reference(self, x, t):
         x = np.asarray(x, dtype=float)
         if t == 0:
-            v, v_x, v_t = self._initial(x)
-        else:
-            l = self.half_width
-            U_hi, F_hi, G_hi = self._profile((x + l - self.x0) / t)
-            U_lo, F_lo, G_lo = self._profile((x - l - self.x0) / t)
-            v = t * (F_hi - F_lo) / (2 * l)
-            v_x = (U_hi - U_lo) / (2 * l)
-            v_t = (G_hi - G_lo) / (2 * l)
+            return self._initial(x)
+        return self._averaged(x, t, True)
+
+    def _averaged(self, x, t, full):
+        """``(v*, v*_x, a*)`` at ``t > 0`` in one compiled pass (:func:`~mpm_fem.exact_kernels.averaged`;
+        ``full=False``: ``v*_x`` only), equal bit for bit to :meth:`_averaged_numpy`."""
+        out = exact_kernels.averaged(np.ascontiguousarray(x).ravel(), float(t), float(self.half_width), float(self.x0),
+                                     full, self._speeds, *self._pieces)
+        return tuple(a.reshape(x.shape) if a.size == x.size else a for a in out)
+
+    def _averaged_numpy(self, x, t):
+        """The readable reference of :meth:`_averaged` (class docstring), from :meth:`_profile_numpy`."""
+        l = self.half_width
+        U_hi, F_hi, G_hi = self._profile_numpy((x + l - self.x0) / t)
+        U_lo, F_lo, G_lo = self._profile_numpy((x - l - self.x0) / t)
+        v = t * (F_hi - F_lo) / (2 * l)
+        v_x = (U_hi - U_lo) / (2 * l)
+        v_t = (G_hi - G_lo) / (2 * l)
         return v, v_x, v_t + v * v_x

@@ -22,11 +22,14 @@ terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) -
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.0025 (GIMP and both B-splines to 0.005), Burgers 0.04 ... 0.01. A Sod case
-(16 runs, the exact stages on the numpy path) measured in CPU seconds, P1 / GIMP / B-spline /
-particle-domain B-spline: h = 0.01: 18 / 35 / 25 / 38; 0.005: 54 / 112 / 90 / 120; 0.0025: 134 (P1; the
-others ~300 / 225 / 360 from their measured time per step); 0.00125: ~445 / 1340 / 820 / 1370; 0.000625:
-P1 ~1840. The plan as it stands is ~13 CPU-minutes; every basis to 0.00125 would add ~1.4 CPU-hours.
+Meshes: Sod h = 0.01 ... 0.0025 for P1, 0.01 ... 0.005 for GIMP and both B-splines; Burgers 0.04 ...
+0.01. A Sod case (16 runs; the fourteen with an exact stage take the numpy step, whose exact fields
+are compiled, :mod:`mpm_fem.exact_kernels`, and whose quadrature rows are cached per grid; the two
+all-MPM runs take the fused step) measured in CPU seconds on the shared 2-core machine: P1 at
+h = 0.0025 110 (164 before the compiled exact fields, the same numbers bit for bit); GIMP at 0.005
+83 (91 before: the GIMP rows at the particles dominate). A halving costs about 4x (twice the
+particles, twice the steps): P1 at 0.00125 359 (measured), at 0.000625 ~1450; GIMP and the B-splines at
+0.0025 ~200-330 each. The study (E1 with E2) already takes ~20 CPU-minutes, so no mesh is added.
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125, the Sod study's meshes but
 its single finest: each halving costs 4x; at 0.00125 the three bases took 2.8 / 8.9 / 7.0 s (P1 /
 GIMP / B-spline), so the two finest meshes add ~6 CPU-minutes.

@@ -172,6 +172,18 @@ def _left_wave(state, p_star: float, u_star: float, gamma: float) -> dict:
     }
 
 
+def waves(left, right, gamma: float = 1.4) -> tuple[float, float, dict, dict]:
+    """``(p_star, u_star, left_wave, right_wave)``: the star state and the two waves as
+    :func:`sample` uses them, the right one as the left wave of the mirrored data (module
+    docstring). A wave is a dict: ``shock``, and ``speed`` (shock) or ``head`` and ``tail``
+    (rarefaction), and ``rho_star`` (Toro (4.50)-(4.55)). Vacuum data raise ``ValueError``."""
+    gamma = _checked_gamma(gamma)
+    left, right = _checked_state(left, "left"), _checked_state(right, "right")
+    p_star, u_star = _solve_star(left, right, gamma)
+    return (p_star, u_star, _left_wave(left, p_star, u_star, gamma),
+            _left_wave(_mirror(right), p_star, -u_star, gamma))
+
+
 def _sample_left_wave(s, state, p_star: float, u_star: float, gamma: float):
     """``(rho, u, p)`` at ``S = (x - x0)/t <= u_star``, Toro section 4.5.1 (left wave)."""
     rho, u, p = state
