@@ -18,11 +18,13 @@ every remedy on all six (``SOD_MESHES``). Every remedy runs the fused compiled s
 (:mod:`mpm_fem.fused`, equal to the numpy step), all of them in its compiled loop (the Taylor
 reconstruction, XPIC(m) and the grid volume included). Measured at h = 0.0003125 (one run each,
 CPU seconds, compiled code warm, on a 2-core machine shared by four jobs; 51,200 particles, about
-30,000 steps): MPM 32 s, FLIP 0.99 34 s, XPIC(2) 40 s, XPIC(5) 59 s@@MORE@@. The
-mesh h = 0.00015625 is left out: a halving costs about 4x (twice the particles, twice the steps;
-measured earlier 3.3x for MPM and 4.9x for the B-spline domain from 0.000625 to 0.0003125), so the
-five remedies that pass the E5 criterion on the coarser meshes would add about @@FINE@@ CPU-min at
-0.00015625 to the study's @@TOTAL@@: over the 25 CPU-min the study may take. E5 counts a remedy as
+30,000 steps): MPM 32 s, FLIP 0.99 34 s, XPIC(2) 40 s, XPIC(5) 59 s, Taylor LS 39 s, grid volume
+231 s (its reset computes the GIMP rows of the particle domains twice per step); earlier, before the
+remedies ran in the loop, B-spline domain 211 s and B-spline domain + XPIC(5) 231 s. The mesh
+h = 0.00015625 is left out: a halving costs about 4x (twice the particles, twice the steps; 3.3x for
+MPM and 4.9x for the B-spline domain from 0.000625 to 0.0003125), so the five remedies that pass the
+E5 criterion on the coarser meshes (MPM and the four with the B-spline domain) would add about an
+hour of CPU at 0.00015625, far over the 25 CPU-min the study may take. E5 counts a remedy as
 removing the plateau only if it ran on every Sod mesh of the table. Burgers h = 0.04 ... 0.005 (the
 viscous step limit makes a halving of h cost 8x).
 
