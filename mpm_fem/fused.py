@@ -44,20 +44,26 @@ The plateau remedies of :class:`~mpm_fem.step.Stages`, with the numpy step's ope
 
     flip      pass 2 blends, ``v_p <- flip (v_p + dt sum S a) + (1 - flip) sum S v^{n+1}``
               (``consts[5]``; per step and in the loop)
-    xpic      m - 1 compiled passes ``P_i = sum_p S_ip m_p sum_j S_jp u_j`` (:func:`_xpic_momentum`),
-              each solved with the step's mass and the boundary rule of a velocity change in numpy
-              (:mod:`mpm_fem.xpic`); pass 2 then sets ``v_p = sum_i S_ip (v*_i + dt a_i)``
-              (``consts[6] > 0``: its nodal field comes in place of ``a_i``). Per step only.
+    xpic      m - 1 compiled passes ``P_i = sum_p S_ip m_p sum_j S_jp u_j`` (:func:`_scatter_pass`),
+              each solved with the step's mass and the boundary rule of a velocity change
+              (:mod:`mpm_fem.xpic`; per step in numpy, in the loop compiled: the lumped mass, zero
+              change at the end nodes); pass 2 then sets ``v_p = sum_i S_ip (v*_i + dt a_i)``
+              (``consts[6] > 0``: its nodal field comes in place of ``a_i``). Per step and in the loop.
     basis     ``"bspline_gimp"`` (code 3): the B-splines averaged over the particle domain
               (:func:`_bspline_domain_row`); rows stored and widened as GIMP's (``c_hi - c_lo + 4``).
     volume    ``"grid"``: after pass 1 (without the gas force) the volume reset of the numpy step
-              (:func:`mpm_fem.volume.grid_volume_factor`, the model's ``with_volume``; numpy), then
-              the gas force of the reset state (:func:`_gas_force`). Per step only.
+              (:func:`mpm_fem.volume.grid_volume_factor`, the model's ``with_volume``), compiled in
+              two passes (:func:`_volume_reset`), then the gas force of the reset state
+              (:func:`_scatter_pass`). Per step and in the loop.
+    reconstruct  ``"taylor"``: the force of the Taylor least-squares stress
+              (:func:`mpm_fem.reconstruction.reconstructed_force`) in place of the particles' force,
+              compiled (:func:`_taylor_force`: one pass for the cell sums, one over the cells'
+              quadrature points, in the numpy order). Per step and in the loop.
 
 Supported: the four bases (``"mpm"``, ``"gimp"``, ``"bspline"``, ``"bspline_gimp"``), USL, USF,
 MUSL, lumped and consistent mass, calculated or exact acceleration, the ideal gas and viscous
-Burgers (both its forces), the PIC/FLIP blend, XPIC(m) and the grid volume. Stages with an exact
-projection, mass or interpolation, and the Taylor reconstruction, run the numpy step
+Burgers (both its forces), and every remedy: the PIC/FLIP blend, XPIC(m), the grid volume and the
+Taylor reconstruction. Stages with an exact projection, mass or interpolation run the numpy step
 (:func:`supported` says which), as does any ``kernel="numpy"`` run.
 """
 
@@ -72,10 +78,10 @@ from .grid import Grid
 from .models.burgers import ViscousBurgers
 from .models.euler import IdealGas
 from .particles import Particles, PositivityError
-from .shape import Shape, make_shape
-from .step import SCHEMES, Dirichlet, GridState, Stages, Walls, _reset_volume
+from .reconstruction import OFFSETS, force_quadrature
+from .shape import Shape, basis_integrals, make_shape
+from .step import SCHEMES, Dirichlet, GridState, Stages, Walls
 from .transfer import solve_consistent
-from .volume import grid_volume_factor
 from .xpic import boundary_change_rule
 
 KERNELS = ("fused", "numpy")
@@ -88,8 +94,6 @@ def supported(model, stages: Stages) -> str | None:
     """``None`` if the fused step implements this model and these stages, else the reason."""
     if stages.uses_exact_fields:
         return "the exact projection, mass and interpolation stages run the numpy step"
-    if stages.reconstruct != "none":
-        return "the plateau remedy reconstruct runs the numpy step"
     if not isinstance(model, (IdealGas, ViscousBurgers)):
         return f"the fused step has no kernel for the model {type(model).__name__}"
     return None
@@ -673,17 +677,35 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
         _sum_chunks(buf, j, out, 1.0)
 
 
-def _viscous_force(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i):
-    """Burgers' stress before the force: ``F_i = - sum_p V_p eps (sum_j G_jp v_j) G_ip``."""
+PRESSURE, VISCOUS_STRESS, MOMENTUM = 0, 1, 2  # the weights of _scatter_pass
+
+
+def _scatter_pass(nodes, h, inv_spacing, x, rows, S, G, cell, f_i, a, b, coef, chunks, out):
+    """One scatter over the particles, ``out_i = sum_p w_p W_ip`` (each particle's row recomputed or
+    read as in pass 2), with the weight the compile-time ``WEIGHT`` picks:
+
+        PRESSURE         W = G_ip, w_p = a_p b_p:                  the gas force ``F_i = sum_p V_p p_p G_ip``
+                                                                   (after the volume reset)
+        VISCOUS_STRESS   W = G_ip, w_p = a_p (coef sum_j G_jp f_j), ``out = -sum``: Burgers' force
+                         ``F_i = - sum_p V_p eps (dv/dx)_p G_ip`` (its stress before the force)
+        MOMENTUM         W = S_ip, w_p = a_p sum_j S_jp f_j:        XPIC's ``P_i = sum_p S_ip m_p (sum_j S_jp u_j)``
+                         (:func:`mpm_fem.transfer.nodal_momentum` of ``shape.gather(u)``)
+
+    (``b``, ``coef``, ``f_i``: unused where the weight does not name them)."""
     n = x.size
     K = WIDTH  # nodes per particle
-    buf = np.zeros((chunks, 1, F_i.size))
+    buf = np.zeros((chunks, 1, out.size))
     for k in prange(chunks):
         r, Sl, Gl = _one_row(K)
         for q in range(*_chunk(n, chunks, k)):
             _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            _scatter(buf, k, r, Gl, V[q] * (eps * _gather(Gl, v_i, r, K)), K)
-    _sum_chunks(buf, 0, F_i, -1.0)
+            if WEIGHT == PRESSURE:
+                _scatter(buf, k, r, Gl, a[q] * b[q], K)
+            elif WEIGHT == VISCOUS_STRESS:
+                _scatter(buf, k, r, Gl, a[q] * (coef * _gather(Gl, f_i, r, K)), K)
+            else:
+                _scatter(buf, k, r, Sl, a[q] * _gather(Sl, f_i, r, K), K)
+    _sum_chunks(buf, 0, out, -1.0 if WEIGHT == VISCOUS_STRESS else 1.0)
 
 
 def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, force, chunks,
@@ -802,31 +824,105 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
         _sum_chunks(buf, 0, P_i, 1.0)
 
 
-def _gas_force(nodes, h, inv_spacing, x, rows, S, G, cell, V, p, chunks, F_i):
-    """The gas force of pass 1 alone (after the volume reset): ``F_i = sum_p V_p p_p G_ip``."""
+@njit(cache=True, inline="always")
+def _domain_row(basis, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl):
+    """Particle q's row ``Sbar_ip`` of the volume reset (:mod:`mpm_fem.volume`) into ``r``, ``Sl``:
+    the step's own stored row (GIMP, particle-domain B-spline), or the domain average of the point
+    basis' grid functions at ``x_q``, ``V_q`` (point mass: GIMP; B-spline: the particle-domain
+    B-spline), in ``r.size`` columns (columns past a domain's nodes have zero weight). Returns the
+    width the row needs (more than ``r.size``: the caller retries wider)."""
+    if basis == 1 or basis == 3:
+        for j in range(r.size):
+            r[j], Sl[j] = rows[q, j], S[q, j]
+        return r.size
+    _, need = _shape_row(1 if basis == 0 else 3, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
+    return need
+
+
+def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks, width,
+                  V_i, ratio, V_r, rho_r, p_r, flags, values):
+    """The grid volume reset (:func:`mpm_fem.volume.grid_volume_factor`, then the model's
+    ``with_volume``): ``V_i = sum_p V_p Sbar_ip``, ``f_p = sum_i Sbar_ip (int S_i / V_i)`` (0 where
+    ``V_i = 0``; ``integrals`` holds ``int S_i``), ``V_p <- V_p f_p`` into ``V_r``; the gas at the same
+    mass and specific energy, ``rho_p = m_p / V_p``, ``p_p = (gamma - 1) rho_p eps_p + q_p rho_p /
+    rho_p^old`` (``q_p`` its viscosity) into ``rho_r``, ``p_r`` (Burgers: ``m_p = V_p``, which its
+    update sets anyway). The domain rows take ``width`` columns. ``flags[k] = (first particle of
+    chunk k whose new density (gas) or volume (Burgers) is not > 0, the width its rows need)``,
+    ``values[k, 0]`` that density or volume."""
+    n = x.size
+    gas = MODEL == GAS
+    buf = np.zeros((chunks, 1, V_i.size))
+    for k in prange(chunks):
+        r, Sl, Gl = _one_row(width)
+        need = 0
+        for q in range(*_chunk(n, chunks, k)):
+            need = max(need, _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl))
+            _scatter(buf, k, r, Sl, V[q], width)
+        flags[k, 1] = need
+    _sum_chunks(buf, 0, V_i, 1.0)
+    _divide_by_lumped(integrals, V_i, ratio)
+    gm1 = consts[0]
+    for k in prange(chunks):
+        r, Sl, Gl = _one_row(width)
+        bad, value = -1.0, 0.0
+        for q in range(*_chunk(n, chunks, k)):
+            _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl)
+            V_r[q] = V[q] * _gather(Sl, ratio, r, width)
+            if gas:
+                rho_r[q] = m[q] / V_r[q]
+                viscosity = p[q] - gm1 * rho[q] * e[q]
+                p_r[q] = gm1 * rho_r[q] * e[q] + viscosity * rho_r[q] / rho[q]
+                bad, value = _first(bad, value, q, rho_r[q])
+            else:
+                bad, value = _first(bad, value, q, V_r[q])
+        flags[k, 0], values[k, 0] = int(bad), value
+
+
+def _taylor_force(nodes, h, inv_spacing, x, rows, S, G, cell, p, v_i, eps, points, G_q, weights, offsets, chunks,
+                  sums, F_i):
+    """The reconstructed force (:func:`mpm_fem.reconstruction.reconstructed_force`, the same
+    operations): the stress ``sigma_p`` (gas ``-p_p``; Burgers ``eps sum_i G_ip v_i``) fitted cell by
+    cell by ``s0_c + s1_c (xi - 1/2)`` (:func:`~mpm_fem.reconstruction.taylor_fit`: the sums of 1,
+    ``d``, ``d^2``, ``sigma``, ``sigma d`` over a cell's particles in index order, ``d = xi_p - 1/2``,
+    into ``sums``), then ``F_i = - sum_g w_g sigma_h(x_g) S_i'(x_g)`` over the four points ``x_g`` of
+    every cell (:func:`~mpm_fem.reconstruction.force_quadrature`: their nodes ``points``, ``S_i'`` in
+    ``G_q``, ``w_g = h_c / 4``; ``offsets``: ``xi_g - 1/2``), point by point."""
     n = x.size
     K = WIDTH  # nodes per particle
-    buf = np.zeros((chunks, 1, F_i.size))
+    gas = MODEL == GAS
+    n_cells = sums.shape[1]
+    buf = np.zeros((chunks, 5, n_cells))
     for k in prange(chunks):
         r, Sl, Gl = _one_row(K)
         for q in range(*_chunk(n, chunks, k)):
-            _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            _scatter(buf, k, r, Gl, V[q] * p[q], K)
-    _sum_chunks(buf, 0, F_i, 1.0)
-
-
-def _xpic_momentum(nodes, h, inv_spacing, x, rows, S, G, cell, m, u_i, chunks, P_i):
-    """XPIC's projection of an interpolated grid field: ``P_i = sum_p S_ip m_p (sum_j S_jp u_j)``
-    (:func:`mpm_fem.transfer.nodal_momentum` of ``shape.gather(u)``)."""
-    n = x.size
-    K = WIDTH  # nodes per particle
-    buf = np.zeros((chunks, 1, P_i.size))
-    for k in prange(chunks):
-        r, Sl, Gl = _one_row(K)
-        for q in range(*_chunk(n, chunks, k)):
-            _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            _scatter(buf, k, r, Sl, m[q] * _gather(Sl, u_i, r, K), K)
-    _sum_chunks(buf, 0, P_i, 1.0)
+            if gas:
+                sigma = -p[q]
+            else:
+                _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+                sigma = eps * _gather(Gl, v_i, r, K)
+            c, xi = _locate(nodes, inv_spacing, x[q])
+            d = xi - 0.5
+            buf[k, 0, c] += 1.0
+            buf[k, 1, c] += d
+            buf[k, 2, c] += d * d
+            buf[k, 3, c] += sigma
+            buf[k, 4, c] += sigma * d
+    for j in range(5):
+        _sum_chunks(buf, j, sums[j], 1.0)
+    F_i[:] = 0.0
+    per_cell = offsets.size
+    for c in range(n_cells):
+        count, sd, sdd, sq, sqd = sums[0, c], sums[1, c], sums[2, c], sums[3, c], sums[4, c]
+        det = count * sdd - sd * sd
+        least = max(count, 1.0)
+        s1 = (count * sqd - sd * sq) / det if det > 1e-12 * (least * least) else 0.0
+        s0 = (sq - s1 * sd) / count if count > 0 else 0.0
+        for g in range(c * per_cell, (c + 1) * per_cell):
+            w_sigma = weights[g] * (s0 + s1 * offsets[g - c * per_cell])
+            for j in range(points.shape[1]):
+                F_i[points[g, j]] += G_q[g, j] * w_sigma
+    for i in range(F_i.size):
+        F_i[i] = -F_i[i]
 
 
 def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p, dt, consts, chunks,
@@ -906,7 +1002,8 @@ def _reservoir_quiet(x, window):
 
 def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t, T, speed, fixed_dt, cfl, h_min,
              refine, viscous_limit, steps, max_steps, budget, cell, rows, S, G, grid, flags, upd, values, speeds,
-             dirichlet, window, exact):
+             dirichlet, window, exact, xpic, volume_width, integrals, reset, taylor, points, G_q, weights, offsets,
+             sums):
     """Up to ``budget`` steps of :meth:`FusedStep.step` between walls with the lumped mass, each with
     the time step :func:`mpm_fem.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL``
     from the previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between
@@ -921,6 +1018,13 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     step whose particles the reservoir would change (:func:`_reservoir_quiet`): the caller applies it.
     With ``exact`` the nodal acceleration is the problem's exact one (:func:`_exact_acceleration`, in
     object mode), and no viscous force is computed.
+    The remedies: ``xpic = m > 0``, XPIC(m) as :meth:`FusedStep._xpic_target` with the lumped mass
+    (``m - 1`` passes :func:`_scatter_pass`, each divided by ``m_i``, the change zero at the end
+    nodes); ``volume_width > 0``, the grid volume reset (:func:`_volume_reset`, domain rows that wide,
+    ``integrals = int S_i``, the reset state in ``reset[0]``) and then the force of the reset state.
+    ``taylor``: the reconstructed force (:func:`_taylor_force`, its quadrature ``points``, ``G_q``,
+    ``weights``, ``offsets``, scratch ``sums``) in place of the particles' force. ``grid`` holds 13
+    nodal arrays (7 without a remedy).
     Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     n = cell.size
     gas = MODEL == GAS
@@ -947,8 +1051,8 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
         o = 1 - cur
         x_n, v_new, V_n, m_n, rho_n, e_n, p_n = state[o, 0, :n], state[o, 1, :n], state[o, 2, :n], state[o, 3, :n], \
             state[o, 4, :n], state[o, 5, :n], state[o, 6, :n]
-        PROJECT(nodes, h, inv_spacing, x, V, m, v, p, gas and scheme != 1, store, chunks, rows, S, G, cell,
-                m_i, P_i, F_i, flags)
+        PROJECT(nodes, h, inv_spacing, x, V, m, v, p, gas and scheme != 1 and volume_width == 0 and not taylor,
+                store, chunks, rows, S, G, cell, m_i, P_i, F_i, flags)
         need = 2
         for k in range(chunks):
             need = max(need, flags[k, 2])
@@ -964,13 +1068,30 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
             with objmode(g_next="float64[::1]"):
                 g_next = _end_values(t_next)
             _set_ends(ends, g_t, v_i)
+        if volume_width > 0:  # the volume reset, then the force of the reset state
+            VOLUME(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks,
+                   WIDTH if store else volume_width, grid[11], grid[12], reset[0, 0, :n], reset[0, 1, :n],
+                   reset[0, 2, :n], upd, values)
+            wide = 0
+            for k in range(chunks):
+                wide = max(wide, upd[k, 1])
+            if (upd[:, 0] >= 0).any() or (not store and wide > volume_width):
+                break
+            V = reset[0, 0, :n]
+            if gas:
+                rho, p = reset[0, 1, :n], reset[0, 2, :n]
+                if scheme != 1 and not exact and not taylor:
+                    GAS_FORCE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, p, 0.0, chunks, F_i)
         if scheme == 1:  # USF: the state first, then its force
-            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact, chunks,
-                   V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
+            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact and not taylor,
+                   chunks, V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
             if (upd >= 0).any():
                 break
-        elif not gas and not exact:
-            VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, eps, chunks, F_i)
+        elif not gas and not exact and not taylor:
+            VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, V, eps, chunks, F_i)
+        if taylor and not exact:
+            TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if scheme == 1 else p, v_i, eps, points, G_q,
+                   weights, offsets, chunks, sums, F_i)
         if exact:
             with objmode(a_exact="float64[::1]"):
                 a_exact = _exact_acceleration(t)
@@ -984,14 +1105,30 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
                 a_i[ends[k]] = (g_next[k] - v_i[ends[k]]) / dt
         for i in range(v_n.size):
             v_n[i] = v_i[i] + dt * a_i[i]
+        target = a_i
+        if xpic > 0:  # XPIC(m): v* = sum_k [P (I - B)]^k v_i, and pass 2 interpolates v* + dt a_i
+            P_x, term, v_star, target = grid[7], grid[8], grid[9], grid[10]
+            term[:] = v_i
+            v_star[:] = v_i
+            for _ in range(xpic - 1):
+                XPIC(nodes, h, inv_spacing, x, rows, S, G, cell, term, m, m, 0.0, chunks, P_x)
+                _divide_by_lumped(P_x, m_i, P_x)
+                for i in range(term.size):
+                    term[i] = term[i] - P_x[i]
+                for i in ends:
+                    term[i] = 0.0
+                for i in range(term.size):
+                    v_star[i] += term[i]
+            for i in range(target.size):
+                target[i] = v_star[i] + dt * a_i[i]
         if scheme == 0:
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, True, False,
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, True, False,
                  chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
         elif scheme == 1:
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V_n, m, v, rho_n, e_n, p_n, dt, consts, False,
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V_n, m, v, rho_n, e_n, p_n, dt, consts, False,
                  False, chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
         else:  # MUSL: move, re-project the momentum, then the state
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, False, True,
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, False, True,
                  chunks, x_n, v_new, V, m, rho, e, p, P_musl, flags, values, speeds)
             _lumped_walls(P_musl, m_i, ends, v_n)
             if dirichlet:
@@ -1023,8 +1160,8 @@ def _compile(fn, parallel, passes=None, **constants):
     return njit(cache=True, parallel=parallel)(variant)
 
 
-BASIS, MODEL, WIDTH = 0, 0, 3  # replaced per compiled variant
-PROJECT = VISCOUS = UPDATE = MOVE = FINISH = None  # the passes a compiled _advance calls
+BASIS, MODEL, WIDTH, WEIGHT = 0, 0, 3, 0  # replaced per compiled variant
+PROJECT = VISCOUS = UPDATE = MOVE = FINISH = GAS_FORCE = XPIC = VOLUME = TAYLOR = None  # the passes a compiled _advance calls
 _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
 _FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")  # Particles' names, same order
 _SCHEME_CODE = {"usl": 0, "usf": 1, "musl": 2}
@@ -1056,7 +1193,11 @@ class _Passes:
             passes = None
             if fn is _advance:  # the loop calls this variant's passes, compiled into it
                 shape = dict(BASIS=constants["BASIS"], WIDTH=constants["WIDTH"])
-                passes = dict(PROJECT=self.get(_project, **shape), VISCOUS=self.get(_viscous_force, **shape),
+                passes = dict(PROJECT=self.get(_project, **shape),
+                              **{name: self.get(_scatter_pass, **shape, WEIGHT=weight) for name, weight in
+                                 (("VISCOUS", VISCOUS_STRESS), ("GAS_FORCE", PRESSURE), ("XPIC", MOMENTUM))},
+                              VOLUME=self.get(_volume_reset, BASIS=constants["BASIS"], MODEL=constants["MODEL"]),
+                              TAYLOR=self.get(_taylor_force, **constants),
                               **{name: self.get(f, **constants) for name, f in
                                  (("UPDATE", _update), ("MOVE", _move), ("FINISH", _finish))})
                 constants = dict(constants, THREADED=int(self.parallel))  # a name per variant
@@ -1114,6 +1255,14 @@ class FusedStep:
         # the stored cells and node indices (pass 1 -> the grid stage and pass 2): 4 bytes, not 8
         self._index = np.int32 if grid.n_nodes <= np.iinfo(np.int32).max else np.intp
         self._h_min = float(grid.h.min())
+        self.integrals = (np.ascontiguousarray(basis_integrals(grid, stages.basis), dtype=float)
+                          if stages.volume == "grid" else np.empty(0))  # the volume reset: int S_i
+        self.volume_width = 3 if self.basis in (0, 1) else 5
+        self.quadrature = (np.empty((0, 2), np.intp), np.empty((0, 2)), np.empty(0), np.empty(0))
+        if stages.reconstruct == "taylor":  # the reconstructed force's points: their nodes, S_i', weights
+            points, weights = force_quadrature(grid, stages.basis)
+            self.quadrature = (np.ascontiguousarray(points.nodes, dtype=np.intp), np.ascontiguousarray(points.G),
+                               np.ascontiguousarray(weights), np.ascontiguousarray(OFFSETS))
 
     def _width(self, K):
         """Use the passes compiled for K nodes per particle (GIMP: 2 + the cells a domain spans)."""
@@ -1121,7 +1270,7 @@ class FusedStep:
         constants = dict(BASIS=self.basis, MODEL=self.kind, WIDTH=K)
         self.project = self._passes.get(_project, BASIS=self.basis, WIDTH=K)
         self.update, self.move, self.finish = (self._passes.get(fn, **constants) for fn in (_update, _move, _finish))
-        self.viscous_force = self._passes.get(_viscous_force, BASIS=self.basis, WIDTH=K)
+        self.viscous_force = self._passes.get(_scatter_pass, BASIS=self.basis, WIDTH=K, WEIGHT=VISCOUS_STRESS)
 
     def _empty(self, name, shape, dtype=float):
         """A fresh array, or with ``reuse`` one of two alternating sets: a step never writes the
@@ -1151,15 +1300,14 @@ class FusedStep:
     def loops(self, problem) -> bool:
         """Whether :meth:`advance` can take the steps of ``problem``: walls or Dirichlet ends (this
         step's boundary), the lumped mass, the calculated acceleration and the weak force or the
-        exact acceleration (this step's), no XPIC and no volume reset, and no
+        exact acceleration (this step's), and no
         particle boundary or one that says when it acts (:meth:`_window`; no observer: the caller's)."""
         ends = type(problem.boundary) is Walls or (type(problem.boundary) is Dirichlet
                                                    and problem.boundary is self.boundary)
         exact = (self.stages.acceleration == "exact" and self.exact_acceleration is not None
                  and problem.exact_acceleration is self.exact_acceleration)
         return (ends and self.stages.mass == "lumped" and (self.stages.acceleration == "calculated" or exact)
-                and not self.slides and not self.stages.xpic and self.stages.volume == "carried"
-                and (problem.particle_boundary is None or self._window(problem) is not None))
+                and not self.slides and (problem.particle_boundary is None or self._window(problem) is not None))
 
     def _window(self, problem):
         """``(a, b, spacing)`` of a particle boundary that leaves the particles as they are while
@@ -1185,12 +1333,14 @@ class FusedStep:
             self._cur = 0
         rows_n = n if self.basis in _DOMAIN_BASES else 0
         if (self._scratch is None or self._scratch[0].size < n or self._scratch[1].shape[0] < rows_n
-                or self._scratch[1].shape[1] != self.K or self._scratch[5].shape[0] != chunks):
+                or self._scratch[1].shape[1] != self.K or self._scratch[5].shape[0] != chunks
+                or (self.stages.volume == "grid" and self._scratch[9].shape[2] < n)):
             room, rows_room = n + spare(n), rows_n + spare(rows_n)
             self._scratch = (np.empty(room, self._index), np.empty((rows_room, self.K), self._index),
-                             np.empty((rows_room, self.K)), np.empty((rows_room, self.K)), np.empty((7, self.grid.n_nodes)),
+                             np.empty((rows_room, self.K)), np.empty((rows_room, self.K)), np.empty((13, self.grid.n_nodes)),
                              np.empty((chunks, 3), np.int64), np.empty((chunks, 2), np.int64), np.zeros((chunks, 2)),
-                             np.empty(chunks))
+                             np.empty(chunks), np.empty((1, 3, room if self.stages.volume == "grid" else 0)),
+                             np.empty((5, self.grid.n_cells)))
         cell, rows, S, G = self._scratch[0][:n], self._scratch[1][:rows_n], self._scratch[2][:rows_n], self._scratch[3][:rows_n]
         loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)
         fixed = problem.dt if problem.dt is not None else 0.0
@@ -1204,7 +1354,9 @@ class FusedStep:
                 self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
                 chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
                 float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
-                cell, rows, S, G, *self._scratch[4:], dirichlet, window, exact)
+                cell, rows, S, G, *self._scratch[4:9], dirichlet, window, exact, int(self.stages.xpic),
+                self.volume_width if self.stages.volume == "grid" else 0, self.integrals, self._scratch[9],
+                self.stages.reconstruct == "taylor", *self.quadrature, self._scratch[10])
         finally:
             _LOOP_CALLS.pop()
         if done:
@@ -1213,17 +1365,39 @@ class FusedStep:
             particles = self._out
         return particles, t, done, dt_min, dt_max
 
+    def _grid_volume(self, geometry, x, rows, S, V, m, rho, e, p, chunks):
+        """The grid volume reset (:func:`_volume_reset`): ``(V, rho, p)`` of the reset state (Burgers:
+        ``rho``, ``p`` as they are); raises :class:`PositivityError` as the model's ``with_volume``."""
+        reset = self._passes.get(_volume_reset, BASIS=self.basis, MODEL=self.kind)
+        n, n_nodes = x.size, self.grid.n_nodes
+        V_r, rho_r, p_r = (self._empty(name, n) for name in ("V_reset", "rho_reset", "p_reset"))
+        V_i, ratio = self._empty("V_i", n_nodes), self._empty("ratio", n_nodes)
+        flags, values = np.empty((chunks, 2), np.int64), np.zeros((chunks, 2))
+        while True:
+            width = self.K if self.basis in _DOMAIN_BASES else self.volume_width
+            reset(*geometry, x, rows, S, V, m, rho, e, p, self.integrals, self.consts, chunks, width,
+                  V_i, ratio, V_r, rho_r, p_r, flags, values)
+            need = int(flags[:, 1].max(initial=0))
+            if need <= width:
+                break
+            self.volume_width = need  # a particle domain spans another cell: redo with wider rows
+        for k in range(chunks):
+            if flags[k, 0] >= 0:
+                q = int(flags[k, 0])
+                raise PositivityError("density" if self.kind == GAS else "volume", q, float(x[q]), float(values[k, 0]))
+        return (V_r, rho_r, p_r) if self.kind == GAS else (V_r, rho, p)
+
     def _xpic_target(self, shape, shape_args, m, m_i, v_i, a_i, t, dt, chunks):
         """XPIC(m)'s grid field ``v* + dt a_i`` whose interpolation is the particle velocity
         (:func:`mpm_fem.xpic.xpic_grid_velocity`, the same operations): ``m - 1`` compiled passes
         ``P_i = sum_p S_ip m_p (sum_j S_jp u_j)``, each solved with the step's mass and the
         boundary rule of a velocity change applied."""
         rule = boundary_change_rule(self.boundary, self.grid, t)
-        momentum = self._passes.get(_xpic_momentum, BASIS=self.basis, WIDTH=self.K)
+        momentum = self._passes.get(_scatter_pass, BASIS=self.basis, WIDTH=self.K, WEIGHT=MOMENTUM)
         P_x = self._empty("P_xpic", m_i.shape)
         v_star, term = v_i.copy(), v_i
         for _ in range(self.stages.xpic - 1):
-            momentum(*shape_args, m, term, chunks, P_x)
+            momentum(*shape_args, term, m, m, 0.0, chunks, P_x)
             term = rule(term - self._solve(shape, m, m_i, P_x, "v_xpic"))
             v_star += term
         return v_star + dt * a_i
@@ -1235,8 +1409,8 @@ class FusedStep:
         rho, e, p = particles.density, particles.energy, particles.pressure
         gas = self.kind == GAS
         scheme, exact = self.stages.scheme, self.stages.acceleration == "exact"
-        grid_volume = self.stages.volume == "grid"
-        gas_force = gas and scheme != "usf" and not exact and not grid_volume
+        grid_volume, taylor = self.stages.volume == "grid", self.stages.reconstruct == "taylor"
+        gas_force = gas and scheme != "usf" and not exact and not grid_volume and not taylor
         store = self.basis in _DOMAIN_BASES or self.stages.mass == "consistent"
         geometry = (self.nodes, self.h, self.inv_spacing)
         n_nodes = grid.n_nodes
@@ -1260,23 +1434,27 @@ class FusedStep:
         shape = Shape(rows, S, G, n_nodes, cell)
         v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
         shape_args = (*geometry, x, rows, S, G, cell)
-        if grid_volume:  # the volume reset, in numpy (mpm_fem.volume), then the force of the reset state
-            reset = _reset_volume(self.model, particles, grid_volume_factor(grid, x, V, self.stages.basis, shape))
-            V, rho, e, p = reset.volume, reset.density, reset.energy, reset.pressure
-            if gas and scheme != "usf" and not exact:
-                self._passes.get(_gas_force, BASIS=self.basis, WIDTH=self.K)(*shape_args, V, p, chunks, F_i)
+        if grid_volume:  # the volume reset (mpm_fem.volume), then the force of the reset state
+            V, rho, p = self._grid_volume(geometry, x, rows, S, V, m, rho, e, p, chunks)
+            if gas and scheme != "usf" and not exact and not taylor:
+                self._passes.get(_scatter_pass, BASIS=self.basis, WIDTH=self.K, WEIGHT=PRESSURE)(
+                    *shape_args, v_i, V, p, 0.0, chunks, F_i)
 
         V_new, m_new = empty("V", n), (empty("m", n) if not gas else m)
         rho_new, e_new, p_new = (empty("rho", n), empty("e", n), empty("p", n)) if gas else (rho, e, p)
         values = np.zeros((chunks, 2))
         if scheme == "usf":
             upd = np.empty((chunks, 2), np.int64)
-            self.update(*shape_args, v_i, V, m, rho, e, p, dt, self.consts, not exact and not self.slides, chunks,
-                        V_new, m_new, rho_new, e_new, p_new, F_i, upd, values)
+            self.update(*shape_args, v_i, V, m, rho, e, p, dt, self.consts, not exact and not self.slides and not taylor,
+                        chunks, V_new, m_new, rho_new, e_new, p_new, F_i, upd, values)
             if (upd >= 0).any():
                 self._positivity(upd, values, x)
-        elif not gas and not exact and not self.slides:
-            self.viscous_force(*shape_args, v_i, V, self.consts[4], chunks, F_i)
+        elif not gas and not exact and not self.slides and not taylor:
+            self.viscous_force(*shape_args, v_i, V, V, self.consts[4], chunks, F_i)
+        if taylor and not exact and not self.slides:  # the reconstructed force of the (updated) stress
+            self._passes.get(_taylor_force, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)(
+                *shape_args, p_new if scheme == "usf" else p, v_i, self.consts[4], *self.quadrature, chunks,
+                empty("sums", (5, grid.n_cells)), F_i)
         if exact:
             if self.exact_acceleration is None:
                 raise ValueError("this problem has no exact acceleration to use")

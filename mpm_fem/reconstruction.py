@@ -25,12 +25,13 @@ from __future__ import annotations
 import numpy as np
 
 from .grid import Grid
-from .shape import grid_functions, locate, make_shape
+from .shape import Shape, grid_functions, locate, make_shape
 
 RECONSTRUCTIONS = ("none", "taylor")
 
 _G = 0.5 + np.array([-1.0, 1.0]) / (2.0 * np.sqrt(3.0))  # Gauss points on [0, 1]
 _LOCAL = np.concatenate((0.5 * _G, 0.5 + 0.5 * _G))  # two per half cell, weights 1/4 each
+OFFSETS = _LOCAL - 0.5  # xi - 1/2 at the four points of a cell
 
 
 def taylor_fit(cell: np.ndarray, xi: np.ndarray, q: np.ndarray, n_cells: int) -> tuple[np.ndarray, np.ndarray]:
@@ -52,9 +53,15 @@ def reconstructed_force(grid: Grid, x: np.ndarray, stress: np.ndarray, basis: st
     the particles ``x`` (module docstring); ``S_i`` the grid functions of ``basis`` (n_nodes,)."""
     cell, xi = locate(grid, x)
     s0, s1 = taylor_fit(cell, xi, np.asarray(stress, dtype=float), grid.n_cells)
+    sigma = (s0[:, None] + s1[:, None] * OFFSETS).ravel()
+    shape, weights = force_quadrature(grid, basis)
+    return -shape.scatter_gradient(weights * sigma)
+
+
+def force_quadrature(grid: Grid, basis: str = "mpm") -> tuple[Shape, np.ndarray]:
+    """The quadrature of the reconstructed force: the four points of every cell, cell by cell
+    (``x_c + h_c`` times the local points), the grid functions of ``basis`` there (their ``G`` is
+    ``S_i'``), and the weights ``h_c / 4``."""
     left, h = grid.nodes[:-1], grid.h
     points = (left[:, None] + h[:, None] * _LOCAL).ravel()
-    sigma = (s0[:, None] + s1[:, None] * (_LOCAL - 0.5)).ravel()
-    weights = np.repeat(h / 4.0, _LOCAL.size)
-    shape = make_shape(grid, points, basis=grid_functions(basis))
-    return -shape.scatter_gradient(weights * sigma)
+    return make_shape(grid, points, basis=grid_functions(basis)), np.repeat(h / 4.0, _LOCAL.size)

@@ -97,8 +97,8 @@ class Stages(StageSwitches):
 
     @property
     def uses_remedy(self) -> bool:
-        """Whether a plateau remedy is on (the fused step runs the blend, XPIC, ``bspline_gimp`` and
-        the grid volume; ``reconstruct`` runs in :func:`explicit_step` only)."""
+        """Whether a plateau remedy is on (the fused step runs every one: the blend, XPIC,
+        ``bspline_gimp``, the grid volume and ``reconstruct``)."""
         return (self.basis == "bspline_gimp" or self.flip != 1 or self.xpic != 0 or self.reconstruct != "none"
                 or self.volume != "carried")
 

@@ -14,29 +14,22 @@ combinations that promise most, errors over grid nodes and over particles:
   column: it varies from run to run and no verdict uses it.
 
 Meshes: Sod h = 0.01 ... 0.0003125 (the convergence study's meshes but its finest, 0.00015625),
-each remedy on the first ``SOD_MESHES[name]`` of them. The blend, XPIC(m), the particle-domain
-B-spline and the grid volume run the fused compiled step (:mod:`mpm_fem.fused`, equal to the
-numpy step); the Taylor reconstruction runs the numpy step only, and its three remedies stop at
-h = 0.00125 (``SOD_NUMPY_MESHES``; in the numpy step each halving costs 4x, the two finer meshes
-about 20x the four kept). Measured with the fused step (one run each, CPU seconds, compiled code warm, a shared
-2-core machine): B-spline domain + XPIC(5) 61 s at h = 0.000625 and 231 s at 0.0003125; B-spline
-domain 43 s and 211 s; point-mass MPM 14 s and 46 s; FLIP 0.99 11 s at 0.000625; the grid volume
-184 s at 0.000625 (its reset recomputes the GIMP rows in numpy every step). So MPM (the plateau's
-reference) and the two promising remedies, B-spline domain and B-spline domain + XPIC(5), run every
-mesh to 0.0003125; FLIP 0.99 (cheap) stops at 0.000625; the grid volume stays at 0.00125 (its
-particle order there is 0.42 already, and one more mesh costs 3 CPU-min): together about 10 CPU-min
-more than the four coarse meshes (which now run fused, faster than before). E5 counts a remedy as
-removing the plateau only if it ran on every Sod mesh of the table (to 0.0003125): those that stop
-earlier are reported, never credited. Burgers h = 0.04 ... 0.005 (the viscous step limit makes a
-halving of h cost 8x).
+every remedy on all six (``SOD_MESHES``). Every remedy runs the fused compiled step
+(:mod:`mpm_fem.fused`, equal to the numpy step), all of them in its compiled loop (the Taylor
+reconstruction, XPIC(m) and the grid volume included). Measured at h = 0.0003125 (one run each,
+CPU seconds, compiled code warm, on a 2-core machine shared by four jobs; 51,200 particles, about
+30,000 steps): MPM 32 s, FLIP 0.99 34 s, XPIC(2) 40 s, XPIC(5) 59 s, Taylor LS 39 s, grid volume
+231 s (its reset computes the GIMP rows of the particle domains twice per step); earlier, before the
+remedies ran in the loop, B-spline domain 211 s and B-spline domain + XPIC(5) 231 s. The mesh
+h = 0.00015625 is left out: a halving costs about 4x (twice the particles, twice the steps; 3.3x for
+MPM and 4.9x for the B-spline domain from 0.000625 to 0.0003125), so the five remedies that pass the
+E5 criterion on the coarser meshes (MPM and the four with the B-spline domain) would add about an
+hour of CPU at 0.00015625, far over the 25 CPU-min the study may take. E5 counts a remedy as
+removing the plateau only if it ran on every Sod mesh of the table. Burgers h = 0.04 ... 0.005 (the
+viscous step limit makes a halving of h cost 8x).
 
-XPIC(m) (:mod:`mpm_fem.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline. On Sod
-three of them stop at h = 0.0025 (``SOD_MESHES``), hopeless on the coarse meshes already (one run at
-every mesh measured it): XPIC(2) and XPIC(5) alone keep point-mass MPM's particle order between
-h = 0.005 and 0.0025 (0.68 and 0.68 against MPM's 0.66; criterion 0.8) and stall at 0.00125 (0.27,
-0.21); the B-spline + XPIC(2) has 1.1-1.2x the nodal density L1 of the B-spline alone and 3.0-3.1x
-the FV error at every coarse h (goal 1.5x), and its finest mesh alone cost ~60 CPU-s with the
-numpy step. Burgers runs them all on every mesh.
+XPIC(m) (:mod:`mpm_fem.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline, on every
+mesh of both problems.
 """
 
 from __future__ import annotations
@@ -75,9 +68,7 @@ REMEDIES = {
     "B-spline domain + XPIC(2)": {"basis": "bspline_gimp", "xpic": 2},
     "B-spline domain + XPIC(5)": {"basis": "bspline_gimp", "xpic": 5},
 }
-SOD_MESHES = {"MPM": 6, "B-spline domain": 6, "B-spline domain + XPIC(5)": 6, "FLIP 0.99": 5,
-              **{name: 3 for name in ("XPIC(2)", "XPIC(5)", "B-spline domain + XPIC(2)")}}  # the rest: 4 (docstring)
-SOD_NUMPY_MESHES = 4  # the remedies the fused step does not run (reconstruct): to h = 0.00125
+SOD_MESHES = {name: 6 for name in REMEDIES}  # every remedy to h = 0.0003125 (docstring: the measured costs)
 QUICK = dict(SOD_H=SOD_H[:2], BURGERS_H=BURGERS_H[:2],
              REMEDIES=("MPM", "Taylor LS", "grid volume", "FLIP 0.99", "Taylor + volume", "XPIC(5)"))
 
@@ -123,7 +114,7 @@ def _plan(quick: bool) -> dict:
     sod_h, burgers_h = q.get("SOD_H", SOD_H), q.get("BURGERS_H", BURGERS_H)
     return {
         "sod": {(n, h): {"solver": "sod", "h": h, **SOD_MPM, **REMEDIES[n]}
-                for n in names for h in sod_h[:SOD_MESHES.get(n, SOD_NUMPY_MESHES)]},
+                for n in names for h in sod_h[:SOD_MESHES[n]]},
         "burgers": {(n, h): {"solver": "burgers", "h": h, **BURGERS, **REMEDIES[n]} for n in names for h in burgers_h},
         "fem": {h: {"solver": "fem", "h": h} for h in sod_h},
         "fv": {h: {"solver": "fv", "h": h} for h in sod_h},
@@ -135,8 +126,7 @@ def _cost(case: dict) -> float:
     h = case["h"]
     if case["solver"] in ("fem", "fv"):
         return 1.0 / h**2
-    numpy_only = 5.0 if case.get("reconstruct", "none") != "none" else 1.0  # the rest run the fused step
-    slow = numpy_only * (4.0 if case.get("basis") == "bspline_gimp" else 1.0) * (1.0 + 0.3 * case.get("xpic", 0))
+    slow = (4.0 if case.get("basis") == "bspline_gimp" else 1.0) * (1.0 + 0.3 * case.get("xpic", 0))
     if case["solver"] == "burgers":
         return slow * 4 * 0.09 / h**3
     return slow * case["ppc"] / (h**2 * case["cfl"])

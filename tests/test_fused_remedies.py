@@ -1,8 +1,9 @@
 """The plateau remedies in the fused step (mpm_fem.fused) against the numpy step (mpm_fem.step):
 the PIC/FLIP blend, XPIC(m), the particle-domain B-spline ``"bspline_gimp"`` and the grid volume
-reset, to 1e-12 relative (every basis on a uniform grid takes uniform-grid arithmetic),
-through the per-step path (Dirichlet ends with a reservoir, the consistent mass, XPIC) and the
-compiled loop (walls, lumped mass: the blend and the particle-domain B-spline)."""
+reset, to 1e-12 relative (every basis on a uniform grid takes uniform-grid arithmetic), through
+the per-step path (the consistent mass; an observer) and the compiled loop (walls or Dirichlet ends
+with a reservoir, lumped mass: every remedy), and the loop against the per-step path bit for bit in
+every basis."""
 
 import numpy as np
 import pytest
@@ -97,6 +98,11 @@ SLOW = pytest.mark.slow
     pytest.param(dict(volume="grid"), "usf", "consistent", "piston", marks=SLOW),
     pytest.param(dict(volume="grid", basis="gimp"), "musl", "lumped", "burgers", marks=SLOW),
     (dict(volume="grid", basis="bspline_gimp", xpic=2), "usl", "lumped", "piston"),
+    (dict(reconstruct="taylor"), "usl", "lumped", "walls"),
+    (dict(reconstruct="taylor", basis="bspline_gimp"), "musl", "consistent", "piston"),
+    pytest.param(dict(reconstruct="taylor", volume="grid"), "usf", "lumped", "piston", marks=SLOW),
+    pytest.param(dict(reconstruct="taylor"), "usf", "consistent", "burgers", marks=SLOW),
+    pytest.param(dict(reconstruct="taylor", basis="bspline", volume="grid"), "usl", "lumped", "burgers", marks=SLOW),
 ])
 def test_remedy_in_the_fused_step_equals_the_numpy_step_bit_for_bit(remedy, scheme, mass, case):
     """200 steps (the reservoir adds and removes particles on the Burgers case)."""
@@ -113,10 +119,11 @@ def test_the_blend_changes_the_step():
     assert np.allclose(runs["pic"], runs["xpic1"], rtol=0, atol=1e-14)
 
 
-@pytest.mark.parametrize("remedy", [dict(flip=0.99), dict(basis="bspline_gimp"), dict(xpic=5), dict(volume="grid")])
+@pytest.mark.parametrize("remedy", [dict(flip=0.99), dict(basis="bspline_gimp"), dict(xpic=5), dict(volume="grid"),
+                                    dict(volume="grid", basis="bspline_gimp", xpic=2), dict(reconstruct="taylor"),
+                                    dict(reconstruct="taylor", volume="grid", basis="bspline_gimp")])
 def test_sod_through_the_compiled_loop_equals_the_numpy_step(remedy, loop_steps):
-    """Sod's tube with the CFL step: the blend and the particle-domain B-spline run in the compiled
-    loop (every step but the first); XPIC and the volume reset run the per-step path (no loop step)."""
+    """Sod's tube with the CFL step: every remedy runs in the compiled loop (every step but the first)."""
     settings = dict(h=0.02, ppc=4, T=0.05, cfl=0.3, **remedy)
     reference = simulate(SodSettings(**settings, kernel="numpy"), progress=False)
     fused = simulate(SodSettings(**settings), progress=False)
@@ -124,14 +131,55 @@ def test_sod_through_the_compiled_loop_equals_the_numpy_step(remedy, loop_steps)
     assert _worst(reference, fused) <= TOLERANCE
     assert reference.t == pytest.approx(fused.t, rel=TOLERANCE)
     assert (reference.dt_min, reference.dt_max) == pytest.approx((fused.dt_min, fused.dt_max), rel=TOLERANCE)
-    assert sum(loop_steps) == (0 if "xpic" in remedy or "volume" in remedy else fused.steps - 1)
+    assert sum(loop_steps) == fused.steps - 1
+
+
+@pytest.mark.parametrize(("remedy", "scheme", "case"), [
+    (dict(xpic=3), "usl", "walls"),
+    (dict(volume="grid"), "usf", "piston"),
+    (dict(volume="grid", basis="bspline_gimp", xpic=2), "musl", "walls"),
+    pytest.param(dict(xpic=5, basis="bspline_gimp"), "musl", "piston", marks=SLOW),
+    pytest.param(dict(volume="grid", basis="bspline"), "usl", "walls", marks=SLOW),
+    pytest.param(dict(xpic=5), "usl", "burgers", marks=SLOW),
+    pytest.param(dict(volume="grid", basis="gimp"), "musl", "burgers", marks=SLOW),
+    pytest.param(dict(volume="grid", xpic=2), "usf", "burgers", marks=SLOW),
+    (dict(reconstruct="taylor", volume="grid"), "usf", "piston"),
+    pytest.param(dict(reconstruct="taylor", basis="bspline_gimp"), "musl", "burgers", marks=SLOW),
+])
+def test_remedies_in_the_compiled_loop_equal_the_per_step_path_bit_for_bit(remedy, scheme, case, loop_steps):
+    """Lumped mass, walls or Dirichlet ends (Burgers: and the reservoir): the compiled loop takes
+    every step but the first; an observer keeps the run on the per-step path (no loop step). The
+    two are the same code and grid arithmetic, so every field is equal bit for bit, in every basis
+    (the per-step path equals the numpy step: the test above)."""
+    problem, particles = _gas(case, 200) if case in ("walls", "piston") else _burgers(200)
+    stages = Stages(scheme=scheme, **remedy)
+    per_step = run(problem, GRID, particles, stages, progress=False, observer=lambda *args: None)
+    assert sum(loop_steps) == 0
+    loop = run(problem, GRID, particles, stages, progress=False)
+    assert loop.steps == per_step.steps >= 200 and sum(loop_steps) == loop.steps - 1
+    worst = _worst(per_step, loop)
+    assert worst == 0.0, f"the loop differs from the per-step path by {worst:.3g}"
+    numpy = run(problem, GRID, particles, stages, progress=False, kernel="numpy")
+    assert _worst(numpy, loop) <= _allowed(stages)
 
 
 def test_what_the_fused_step_runs_and_refuses():
     for remedy in (dict(flip=0.5), dict(xpic=5), dict(basis="bspline_gimp"), dict(basis="bspline_gimp", xpic=5),
-                   dict(volume="grid")):
+                   dict(volume="grid"), dict(reconstruct="taylor"),
+                   dict(reconstruct="taylor", volume="grid", basis="bspline_gimp")):
         assert supported(IdealGas(), Stages(**remedy)) is None
-    assert "reconstruct" in supported(IdealGas(), Stages(reconstruct="taylor"))
+    assert "exact" in supported(IdealGas(), Stages(projection="exact"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("basis", ["mpm", "bspline_gimp"])
+@pytest.mark.parametrize("case", ["walls", "burgers"])
+def test_taylor_reconstruction_with_the_grid_volume_over_1000_steps(basis, case):
+    """The compiled reconstruction keeps the numpy step's order of operations: bit for bit over
+    1,000 steps (the point mass: its uniform-grid arithmetic, to 1e-12)."""
+    stages = Stages(basis=basis, reconstruct="taylor", volume="grid")
+    reference, fused = _compare(case, stages, 1000)
+    assert _worst(reference, fused) <= _allowed(stages)
 
 
 @pytest.mark.slow
