@@ -8,7 +8,7 @@ every basis."""
 import numpy as np
 import pytest
 
-from mpm_fem.fused import supported
+from mpm_fem.fused import FusedStep, supported
 from mpm_fem.grid import uniform_grid
 from mpm_fem.models.burgers import ViscousBurgers
 from mpm_fem.models.euler import IdealGas
@@ -16,13 +16,14 @@ from mpm_fem.particles import make_particles, seed_positions
 from mpm_fem.problems.burgers import Reservoir
 from mpm_fem.problems.sod import SodSettings, simulate
 from mpm_fem.solve import Problem, run
-from mpm_fem.step import Dirichlet, Stages, Walls
+from mpm_fem.step import Dirichlet, Stages, Walls, explicit_step
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 GRID = uniform_grid(0.0, 1.0, 0.1)
 
 
 TOLERANCE = 1e-12  # every basis on a uniform grid: the fused step's uniform-grid arithmetic (test_fused.py)
+DRIFT = 1e-10  # a whole run with the Taylor reconstruction (its round-off grows: see its test)
 
 
 def _assert_same(a, b):
@@ -175,11 +176,30 @@ def test_what_the_fused_step_runs_and_refuses():
 @pytest.mark.parametrize("basis", ["mpm", "bspline_gimp"])
 @pytest.mark.parametrize("case", ["walls", "burgers"])
 def test_taylor_reconstruction_with_the_grid_volume_over_1000_steps(basis, case):
-    """The compiled reconstruction keeps the numpy step's order of operations: bit for bit over
-    1,000 steps (the point mass: its uniform-grid arithmetic, to 1e-12)."""
+    """The compiled reconstruction keeps the numpy step's operations: every 100th step of a
+    1,000-step numpy run, one fused step from the same particles equals one numpy step to
+    ``TOLERANCE``. The whole fused run (the compiled loop) stays within ``DRIFT`` of the numpy run:
+    the least-squares fit divides by the spread of a cell's particles, so the uniform-grid
+    arithmetic's round-off, made afresh every step, grows over the run (measured at most 1.4e-12
+    relative, the particle-domain B-spline between walls; 4e-14 after 100 steps), while a defect
+    moves a field by the discretisation error, 1e-3 or more."""
     stages = Stages(basis=basis, reconstruct="taylor", volume="grid")
-    reference, fused = _compare(case, stages, 1000)
-    assert _worst(reference, fused) <= _allowed(stages)
+    problem, particles = _gas(case, 1000) if case == "walls" else _burgers(1000)
+    states = []
+    keep = lambda step, t, old, new, state: states.append((t, old)) if step % 100 == 0 else None  # noqa: E731
+    reference = run(problem, GRID, particles, stages, progress=False, kernel="numpy", observer=keep)
+    fused = run(problem, GRID, particles, stages, progress=False, kernel="fused")
+    assert reference.steps == fused.steps >= 1000 and len(states) >= 10
+    assert _worst(reference, fused) <= DRIFT
+    step = FusedStep(GRID, problem.model, problem.boundary, stages)
+    for t, old in states:
+        new, grid_state = explicit_step(GRID, old, problem.model, problem.boundary, t, problem.dt, stages)
+        new_fused, grid_fused = step.step(old, t, problem.dt)
+        for name in FIELDS:
+            u, v = getattr(new, name), getattr(new_fused, name)
+            assert float(np.max(np.abs(u - v))) <= TOLERANCE * float(np.max(np.abs(u))), (name, t)
+        assert float(np.max(np.abs(grid_state.velocity - grid_fused.velocity))) <= TOLERANCE * float(
+            np.max(np.abs(grid_state.velocity)))
 
 
 @pytest.mark.slow
