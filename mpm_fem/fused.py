@@ -1068,7 +1068,7 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
             with objmode(g_next="float64[::1]"):
                 g_next = _end_values(t_next)
             _set_ends(ends, g_t, v_i)
-        if volume_width > 0:  # the volume reset, then the force of the reset state
+        if VOLUME_ON:  # the volume reset, then the force of the reset state
             VOLUME(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks,
                    WIDTH if store else volume_width, grid[11], grid[12], reset[0, 0, :n], reset[0, 1, :n],
                    reset[0, 2, :n], upd, values)
@@ -1082,14 +1082,14 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
                 rho, p = reset[0, 1, :n], reset[0, 2, :n]
                 if scheme != 1 and not exact and not taylor:
                     GAS_FORCE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, p, 0.0, chunks, F_i)
-        if scheme == 1:  # USF: the state first, then its force
+        if SCHEME == 1:  # USF: the state first, then its force
             UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact and not taylor,
                    chunks, V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
             if (upd >= 0).any():
                 break
         elif not gas and not exact and not taylor:
             VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, V, eps, chunks, F_i)
-        if taylor and not exact:
+        if TAYLOR_ON and not exact:
             TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if scheme == 1 else p, v_i, eps, points, G_q,
                    weights, offsets, chunks, sums, F_i)
         if exact:
@@ -1106,7 +1106,7 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
         for i in range(v_n.size):
             v_n[i] = v_i[i] + dt * a_i[i]
         target = a_i
-        if xpic > 0:  # XPIC(m): v* = sum_k [P (I - B)]^k v_i, and pass 2 interpolates v* + dt a_i
+        if XPIC_ON:  # XPIC(m): v* = sum_k [P (I - B)]^k v_i, and pass 2 interpolates v* + dt a_i
             P_x, term, v_star, target = grid[7], grid[8], grid[9], grid[10]
             term[:] = v_i
             v_star[:] = v_i
@@ -1121,14 +1121,15 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
                     v_star[i] += term[i]
             for i in range(target.size):
                 target[i] = v_star[i] + dt * a_i[i]
-        if scheme == 0:
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, True, False,
+        usl, musl = scheme == 0, scheme == 2  # run-time flags: the per-step path's compiled MOVE
+        if SCHEME == 0:
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl,
                  chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
-        elif scheme == 1:
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V_n, m, v, rho_n, e_n, p_n, dt, consts, False,
-                 False, chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
+        elif SCHEME == 1:
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V_n, m, v, rho_n, e_n, p_n, dt, consts, usl,
+                 musl, chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
         else:  # MUSL: move, re-project the momentum, then the state
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, False, True,
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl,
                  chunks, x_n, v_new, V, m, rho, e, p, P_musl, flags, values, speeds)
             _lumped_walls(P_musl, m_i, ends, v_n)
             if dirichlet:
@@ -1161,6 +1162,8 @@ def _compile(fn, parallel, passes=None, **constants):
 
 
 BASIS, MODEL, WIDTH, WEIGHT = 0, 0, 3, 0  # replaced per compiled variant
+SCHEME, XPIC_ON, VOLUME_ON, TAYLOR_ON = 0, 0, 0, 0  # the loop's, per variant: its branches of the other
+# schemes and of the remedies not taken are pruned when it compiles
 PROJECT = VISCOUS = UPDATE = MOVE = FINISH = GAS_FORCE = XPIC = VOLUME = TAYLOR = None  # the passes a compiled _advance calls
 _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
 _FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")  # Particles' names, same order
@@ -1191,18 +1194,27 @@ class _Passes:
         key = (fn.__name__, tuple(sorted(constants.items())))
         if key not in self._made:
             passes = None
-            if fn is _advance:  # the loop calls this variant's passes, compiled into it
-                shape = dict(BASIS=constants["BASIS"], WIDTH=constants["WIDTH"])
-                passes = dict(PROJECT=self.get(_project, **shape),
-                              **{name: self.get(_scatter_pass, **shape, WEIGHT=weight) for name, weight in
-                                 (("VISCOUS", VISCOUS_STRESS), ("GAS_FORCE", PRESSURE), ("XPIC", MOMENTUM))},
-                              VOLUME=self.get(_volume_reset, BASIS=constants["BASIS"], MODEL=constants["MODEL"]),
-                              TAYLOR=self.get(_taylor_force, **constants),
-                              **{name: self.get(f, **constants) for name, f in
-                                 (("UPDATE", _update), ("MOVE", _move), ("FINISH", _finish))})
+            if fn is _advance:  # the loop calls this variant's passes, compiled into it; the others
+                passes = self._loop_passes(**constants)  # are None, their branches pruned at compile time
                 constants = dict(constants, THREADED=int(self.parallel))  # a name per variant
             self._made[key] = _compile(fn, False if fn is _advance else self.parallel, passes, **constants)
         return self._made[key]
+
+    def _loop_passes(self, BASIS, MODEL, WIDTH, SCHEME, XPIC_ON, VOLUME_ON, TAYLOR_ON):
+        """The passes the loop variant with these constants calls: pass 1 and 2 always, USF's update,
+        MUSL's last pass, Burgers' viscous force and each remedy's passes only where they run, so a
+        plain run compiles none of the remedies."""
+        shape = dict(BASIS=BASIS, WIDTH=WIDTH)
+        model = dict(shape, MODEL=MODEL)
+        scatter = lambda weight: self.get(_scatter_pass, **shape, WEIGHT=weight)  # noqa: E731
+        return dict(PROJECT=self.get(_project, **shape), MOVE=self.get(_move, **model),
+                    UPDATE=self.get(_update, **model) if SCHEME == 1 else None,
+                    FINISH=self.get(_finish, **model) if SCHEME == 2 else None,
+                    VISCOUS=scatter(VISCOUS_STRESS) if MODEL == BURGERS else None,
+                    GAS_FORCE=scatter(PRESSURE) if VOLUME_ON and MODEL == GAS else None,
+                    VOLUME=self.get(_volume_reset, BASIS=BASIS, MODEL=MODEL) if VOLUME_ON else None,
+                    XPIC=scatter(MOMENTUM) if XPIC_ON else None,
+                    TAYLOR=self.get(_taylor_force, **model) if TAYLOR_ON else None)
 
 
 _PASSES = {parallel: _Passes(parallel) for parallel in (False, True)}
@@ -1342,7 +1354,10 @@ class FusedStep:
                              np.empty(chunks), np.empty((1, 3, room if self.stages.volume == "grid" else 0)),
                              np.empty((5, self.grid.n_cells)))
         cell, rows, S, G = self._scratch[0][:n], self._scratch[1][:rows_n], self._scratch[2][:rows_n], self._scratch[3][:rows_n]
-        loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)
+        loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K,
+                                SCHEME=_SCHEME_CODE[self.stages.scheme], XPIC_ON=int(self.stages.xpic > 0),
+                                VOLUME_ON=int(self.stages.volume == "grid"),
+                                TAYLOR_ON=int(self.stages.reconstruct == "taylor"))
         fixed = problem.dt if problem.dt is not None else 0.0
         viscous = bool(getattr(self.model, "viscous_limit", False))
         dirichlet = type(self.boundary) is Dirichlet
