@@ -1024,7 +1024,10 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     ``integrals = int S_i``, the reset state in ``reset[0]``) and then the force of the reset state.
     ``taylor``: the reconstructed force (:func:`_taylor_force`, its quadrature ``points``, ``G_q``,
     ``weights``, ``offsets``, scratch ``sums``) in place of the particles' force. ``grid`` holds 13
-    nodal arrays (7 without a remedy).
+    nodal arrays (7 without a remedy). The scheme and which remedies run are also compile-time
+    constants of the variant (``SCHEME``, ``XPIC_ON``, ``VOLUME_ON``, ``TAYLOR_ON``; the run-time
+    ``scheme``, ``xpic``, ``volume_width``, ``taylor`` agree with them): the other branches are
+    pruned, and their passes (``None`` in the variant's scope) never compile.
     Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     n = cell.size
     gas = MODEL == GAS
