@@ -1000,10 +1000,9 @@ def _reservoir_quiet(x, window):
     return not (np.floor((lo - a) / s) > 0) and not (np.floor((b - hi) / s) > 0)
 
 
-def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t, T, speed, fixed_dt, cfl, h_min,
+def _advance(nodes, h, inv_spacing, ends, consts, chunks, state, cur, t, T, speed, fixed_dt, cfl, h_min,
              refine, viscous_limit, steps, max_steps, budget, cell, rows, S, G, grid, flags, upd, values, speeds,
-             dirichlet, window, exact, xpic, volume_width, integrals, reset, taylor, points, G_q, weights, offsets,
-             sums):
+             dirichlet, window, exact, xpic, volume_width, integrals, reset, points, G_q, weights, offsets, sums):
     """Up to ``budget`` steps of :meth:`FusedStep.step` between walls with the lumped mass, each with
     the time step :func:`mpm_fem.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL``
     from the previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between
@@ -1021,13 +1020,14 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
     The remedies: ``xpic = m > 0``, XPIC(m) as :meth:`FusedStep._xpic_target` with the lumped mass
     (``m - 1`` passes :func:`_scatter_pass`, each divided by ``m_i``, the change zero at the end
     nodes); ``volume_width > 0``, the grid volume reset (:func:`_volume_reset`, domain rows that wide,
-    ``integrals = int S_i``, the reset state in ``reset[0]``) and then the force of the reset state.
-    ``taylor``: the reconstructed force (:func:`_taylor_force`, its quadrature ``points``, ``G_q``,
-    ``weights``, ``offsets``, scratch ``sums``) in place of the particles' force. ``grid`` holds 13
-    nodal arrays (7 without a remedy). The scheme and which remedies run are also compile-time
-    constants of the variant (``SCHEME``, ``XPIC_ON``, ``VOLUME_ON``, ``TAYLOR_ON``; the run-time
-    ``scheme``, ``xpic``, ``volume_width``, ``taylor`` agree with them): the other branches are
-    pruned, and their passes (``None`` in the variant's scope) never compile.
+    ``integrals = int S_i``, the reset state in ``reset[0]``) and then the force of the reset state;
+    the Taylor reconstruction, the reconstructed force (:func:`_taylor_force`, its quadrature
+    ``points``, ``G_q``, ``weights``, ``offsets``, scratch ``sums``) in place of the particles' force.
+    ``grid`` holds :func:`_nodal_rows` nodal arrays: 7, then XPIC's 4 and the volume reset's 2 where
+    they run. The scheme and which remedies run are compile-time constants of the variant
+    (``SCHEME``, ``XPIC_ON``, ``VOLUME_ON``, ``TAYLOR_ON``; the run-time ``xpic`` and
+    ``volume_width`` give XPIC's m and the rows' width): the other branches are pruned, and their
+    passes (``None`` in the variant's scope) never compile.
     Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     n = cell.size
     gas = MODEL == GAS
@@ -1054,7 +1054,7 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
         o = 1 - cur
         x_n, v_new, V_n, m_n, rho_n, e_n, p_n = state[o, 0, :n], state[o, 1, :n], state[o, 2, :n], state[o, 3, :n], \
             state[o, 4, :n], state[o, 5, :n], state[o, 6, :n]
-        PROJECT(nodes, h, inv_spacing, x, V, m, v, p, gas and scheme != 1 and volume_width == 0 and not taylor,
+        PROJECT(nodes, h, inv_spacing, x, V, m, v, p, gas and SCHEME != 1 and not VOLUME_ON and not TAYLOR_ON,
                 store, chunks, rows, S, G, cell, m_i, P_i, F_i, flags)
         need = 2
         for k in range(chunks):
@@ -1072,8 +1072,9 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
                 g_next = _end_values(t_next)
             _set_ends(ends, g_t, v_i)
         if VOLUME_ON:  # the volume reset, then the force of the reset state
+            V_i = _nodal_rows(XPIC_ON, 0)  # its V_i and ratio follow XPIC's arrays
             VOLUME(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks,
-                   WIDTH if store else volume_width, grid[11], grid[12], reset[0, 0, :n], reset[0, 1, :n],
+                   WIDTH if store else volume_width, grid[V_i], grid[V_i + 1], reset[0, 0, :n], reset[0, 1, :n],
                    reset[0, 2, :n], upd, values)
             wide = 0
             for k in range(chunks):
@@ -1083,17 +1084,17 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
             V = reset[0, 0, :n]
             if gas:
                 rho, p = reset[0, 1, :n], reset[0, 2, :n]
-                if scheme != 1 and not exact and not taylor:
+                if SCHEME != 1 and not exact and not TAYLOR_ON:
                     GAS_FORCE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, p, 0.0, chunks, F_i)
         if SCHEME == 1:  # USF: the state first, then its force
-            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact and not taylor,
+            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, not exact and not TAYLOR_ON,
                    chunks, V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
             if (upd >= 0).any():
                 break
-        elif not gas and not exact and not taylor:
+        elif not gas and not exact and not TAYLOR_ON:
             VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, V, eps, chunks, F_i)
         if TAYLOR_ON and not exact:
-            TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if scheme == 1 else p, v_i, eps, points, G_q,
+            TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if SCHEME == 1 else p, v_i, eps, points, G_q,
                    weights, offsets, chunks, sums, F_i)
         if exact:
             with objmode(a_exact="float64[::1]"):
@@ -1124,7 +1125,7 @@ def _advance(nodes, h, inv_spacing, ends, consts, scheme, chunks, state, cur, t,
                     v_star[i] += term[i]
             for i in range(target.size):
                 target[i] = v_star[i] + dt * a_i[i]
-        usl, musl = scheme == 0, scheme == 2  # run-time flags: the per-step path's compiled MOVE
+        usl, musl = SCHEME == 0, SCHEME == 2  # run-time flags: the per-step path's compiled MOVE
         if SCHEME == 0:
             MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl,
                  chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
@@ -1167,6 +1168,12 @@ def _compile(fn, parallel, passes=None, **constants):
 BASIS, MODEL, WIDTH, WEIGHT = 0, 0, 3, 0  # replaced per compiled variant
 SCHEME, XPIC_ON, VOLUME_ON, TAYLOR_ON = 0, 0, 0, 0  # the loop's, per variant: its branches of the other
 # schemes and of the remedies not taken are pruned when it compiles
+@njit(cache=True, inline="always")
+def _nodal_rows(xpic_on, volume_on):
+    """The loop's nodal scratch arrays: ``m_i``, ``P_i``, ``F_i``, ``v_i``, ``a_i``, ``v_i^{n+1}``,
+    MUSL's ``P_i``; XPIC's ``P``, term, ``v*`` and target if it runs; the volume reset's ``V_i`` and
+    ratio if it runs (a plain run allocates 7; the reset's first is ``_nodal_rows(XPIC_ON, 0)``)."""
+    return 7 + 4 * xpic_on + 2 * volume_on
 PROJECT = VISCOUS = UPDATE = MOVE = FINISH = GAS_FORCE = XPIC = VOLUME = TAYLOR = None  # the passes a compiled _advance calls
 _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
 _FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")  # Particles' names, same order
@@ -1347,20 +1354,21 @@ class FusedStep:
             self._pools = ({}, {})  # the per-step arrays: refilled if a step falls back to step()
             self._cur = 0
         rows_n = n if self.basis in _DOMAIN_BASES else 0
+        volume, taylor = self.stages.volume == "grid", self.stages.reconstruct == "taylor"
         if (self._scratch is None or self._scratch[0].size < n or self._scratch[1].shape[0] < rows_n
                 or self._scratch[1].shape[1] != self.K or self._scratch[5].shape[0] != chunks
-                or (self.stages.volume == "grid" and self._scratch[9].shape[2] < n)):
+                or (volume and self._scratch[9].shape[2] < n)):
             room, rows_room = n + spare(n), rows_n + spare(rows_n)
             self._scratch = (np.empty(room, self._index), np.empty((rows_room, self.K), self._index),
-                             np.empty((rows_room, self.K)), np.empty((rows_room, self.K)), np.empty((13, self.grid.n_nodes)),
+                             np.empty((rows_room, self.K)), np.empty((rows_room, self.K)),
+                             np.empty((_nodal_rows(self.stages.xpic > 0, volume), self.grid.n_nodes)),
                              np.empty((chunks, 3), np.int64), np.empty((chunks, 2), np.int64), np.zeros((chunks, 2)),
-                             np.empty(chunks), np.empty((1, 3, room if self.stages.volume == "grid" else 0)),
-                             np.empty((5, self.grid.n_cells)))
+                             np.empty(chunks), np.empty((1, 3, room if volume else 0)),
+                             np.empty((5, self.grid.n_cells if taylor else 0)))
         cell, rows, S, G = self._scratch[0][:n], self._scratch[1][:rows_n], self._scratch[2][:rows_n], self._scratch[3][:rows_n]
         loop = self._passes.get(_advance, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K,
                                 SCHEME=_SCHEME_CODE[self.stages.scheme], XPIC_ON=int(self.stages.xpic > 0),
-                                VOLUME_ON=int(self.stages.volume == "grid"),
-                                TAYLOR_ON=int(self.stages.reconstruct == "taylor"))
+                                VOLUME_ON=int(volume), TAYLOR_ON=int(taylor))
         fixed = problem.dt if problem.dt is not None else 0.0
         viscous = bool(getattr(self.model, "viscous_limit", False))
         dirichlet = type(self.boundary) is Dirichlet
@@ -1369,12 +1377,11 @@ class FusedStep:
         _LOOP_CALLS.append((self.boundary, self.grid, self.exact_acceleration))
         try:
             cur, t, done, speed, dt_min, dt_max = loop(
-                self.nodes, self.h, self.inv_spacing, self._ends, self.consts, _SCHEME_CODE[self.stages.scheme],
-                chunks, self._state, self._cur, float(t), float(problem.T), float(self.speed), float(fixed),
-                float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
+                self.nodes, self.h, self.inv_spacing, self._ends, self.consts, chunks, self._state, self._cur,
+                float(t), float(problem.T), float(self.speed), float(fixed), float(problem.cfl), self._h_min, float(self.stages.refine), viscous, steps, max_steps, budget,
                 cell, rows, S, G, *self._scratch[4:9], dirichlet, window, exact, int(self.stages.xpic),
-                self.volume_width if self.stages.volume == "grid" else 0, self.integrals, self._scratch[9],
-                self.stages.reconstruct == "taylor", *self.quadrature, self._scratch[10])
+                self.volume_width if volume else 0, self.integrals, self._scratch[9], *self.quadrature,
+                self._scratch[10])
         finally:
             _LOOP_CALLS.pop()
         if done:

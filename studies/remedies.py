@@ -13,20 +13,21 @@ combinations that promise most, errors over grid nodes and over particles:
   time, for MPM with each remedy, fixed-mesh P1 FEM (lumped mass) and FV. Wall time is the last
   column: it varies from run to run and no verdict uses it.
 
-Meshes: Sod h = 0.01 ... 0.0003125 (the convergence study's meshes but its finest, 0.00015625),
-every remedy on all six (``SOD_MESHES``). Every remedy runs the fused compiled step
-(:mod:`mpm_fem.fused`, equal to the numpy step), all of them in its compiled loop (the Taylor
-reconstruction, XPIC(m) and the grid volume included). Measured at h = 0.0003125 (one run each,
-CPU seconds, compiled code warm, on a 2-core machine shared by four jobs; 51,200 particles, about
-30,000 steps): MPM 32 s, FLIP 0.99 34 s, XPIC(2) 40 s, XPIC(5) 59 s, Taylor LS 39 s, grid volume
-231 s (its reset computes the GIMP rows of the particle domains twice per step); earlier, before the
-remedies ran in the loop, B-spline domain 211 s and B-spline domain + XPIC(5) 231 s. The mesh
-h = 0.00015625 is left out: a halving costs about 4x (twice the particles, twice the steps; 3.3x for
-MPM and 4.9x for the B-spline domain from 0.000625 to 0.0003125), so the five remedies that pass the
-E5 criterion on the coarser meshes (MPM and the four with the B-spline domain) would add about an
-hour of CPU at 0.00015625, far over the 25 CPU-min the study may take. E5 counts a remedy as
-removing the plateau only if it ran on every Sod mesh of the table. Burgers h = 0.04 ... 0.005 (the
-viscous step limit makes a halving of h cost 8x).
+Meshes: Sod h = 0.01 ... 0.00015625, the convergence study's seven. Every remedy runs the first six
+(to 0.0003125); the finest, 0.00015625, runs plain MPM and the three remedies that removed the
+plateau on the six coarser meshes in the last full run (``FINEST``: the B-spline domain, alone, with
+Taylor + volume and with XPIC(5)); E5 counts a remedy as removing the plateau only if it ran on every
+Sod mesh of the table, so the others count as not removing it, which they do not on the coarser
+meshes already. Every remedy runs the fused compiled step (:mod:`mpm_fem.fused`, equal to the numpy
+step), all of them in its compiled loop (the Taylor reconstruction, XPIC(m) and the grid volume
+included). Measured at h = 0.0003125 (CPU seconds, one run each, compiled code warm, 2 jobs on 2
+cores; 51,200 particles, about 30,000 steps): MPM 32 s, FLIP 0.99 36 s, XPIC(2) 43 s, XPIC(5)
+71 s, Taylor LS 45 s, grid volume 124 s (its reset computes the GIMP rows of the particle domains
+twice per step), Taylor + volume 117 s, B-spline domain 158 s, with XPIC(2) 178 s, with XPIC(5)
+221 s, with Taylor + volume 245 s. A halving of h costs about 4x (twice the particles, twice the
+steps; 3.3x for MPM and 4.9x for the B-spline domain from 0.000625 to 0.0003125), so the finest mesh
+adds about 50 CPU-min, most of the study's cost; every remedy there would add about 25 more.
+Burgers h = 0.04 ... 0.005 (the viscous step limit makes a halving of h cost 8x).
 
 XPIC(m) (:mod:`mpm_fem.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline, on every
 mesh of both problems.
@@ -52,7 +53,7 @@ from mpm_fem.study import StudyOptions, publish, script_main
 from studies.sod import FEM, FV, H, MPM as SOD_MPM
 
 NAME = "remedies"
-SOD_H = H[:6]  # 0.01 ... 0.0003125; each remedy runs the first SOD_MESHES[name] of them (docstring)
+SOD_H = H[:7]  # 0.01 ... 0.00015625; each remedy runs the first SOD_MESHES[name] of them (docstring)
 BURGERS_H = (0.04, 0.02, 0.01, 0.005)
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, acceleration="calculated")
 REMEDIES = {
@@ -68,7 +69,8 @@ REMEDIES = {
     "B-spline domain + XPIC(2)": {"basis": "bspline_gimp", "xpic": 2},
     "B-spline domain + XPIC(5)": {"basis": "bspline_gimp", "xpic": 5},
 }
-SOD_MESHES = {name: 6 for name in REMEDIES}  # every remedy to h = 0.0003125 (docstring: the measured costs)
+FINEST = ("MPM", "B-spline domain", "B-spline domain + Taylor + volume", "B-spline domain + XPIC(5)")
+SOD_MESHES = {name: 7 if name in FINEST else 6 for name in REMEDIES}  # docstring: the measured costs
 QUICK = dict(SOD_H=SOD_H[:2], BURGERS_H=BURGERS_H[:2],
              REMEDIES=("MPM", "Taylor LS", "grid volume", "FLIP 0.99", "Taylor + volume", "XPIC(5)"))
 
