@@ -192,9 +192,23 @@ def test_a_loop_variant_carries_only_the_passes_its_run_takes(scheme, remedy, ru
             asked.append((constants, made))
         return made
 
+    steppers = []
+    advance = fused_module.FusedStep.advance
+
+    def keeping(self, *args, **kwargs):
+        steppers.append(self)
+        return advance(self, *args, **kwargs)
+
     monkeypatch.setattr(fused_module._Passes, "get", recording)
+    monkeypatch.setattr(fused_module.FusedStep, "advance", keeping)
     result = simulate(SodSettings(h=0.05, ppc=4, T=0.02, scheme=scheme, **remedy), progress=False)
     assert result.steps > 1 and sum(loop_steps) > 0 and asked  # the loop took the steps
+    stepper = steppers[-1]  # its scratch holds the remedies' arrays only where they run (memory)
+    n_nodes, n_cells = stepper.grid.n_nodes, stepper.grid.n_cells
+    xpic, volume, taylor = "xpic" in remedy, "volume" in remedy, "reconstruct" in remedy
+    assert stepper._scratch[4].shape == (7 + 4 * xpic + 2 * volume, n_nodes)
+    assert stepper._scratch[9].shape[2] == (stepper._state.shape[2] - fused_module._PAD if volume else 0)
+    assert stepper._scratch[10].shape == (5, n_cells if taylor else 0)
     for constants, loop in asked:
         scope = loop.py_func.__globals__
         names = ("PROJECT", "MOVE", "UPDATE", "FINISH", "VISCOUS", "GAS_FORCE", "VOLUME", "XPIC", "TAYLOR")
