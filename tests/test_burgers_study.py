@@ -148,8 +148,10 @@ def test_smoke_sixteen_particles_per_cell_cut_the_stalled_error():
 
 
 def test_smoke_gimp_removes_the_stall_on_the_coarse_meshes():
-    """The fast version of the slow GIMP check: order of the L1 error from h = 0.02 to 0.01 (2.00 measured)."""
-    order, errs = _order(0.02, 0.01, "particles", "L1", basis="gimp")
+    """The fast version of the slow GIMP check: order of the L1 error from h = 0.02 to 0.01 (2.00 measured).
+    On the numpy step, which measures the same method (the fused step's equality to it, GIMP and
+    Burgers, is tests/test_fused.py) without compiling GIMP's Burgers variants here."""
+    order, errs = _order(0.02, 0.01, "particles", "L1", basis="gimp", kernel="numpy")
     assert order >= 1.5, f"L1 errors {errs}, observed order {order:.2f}"
 
 
