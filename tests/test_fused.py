@@ -24,7 +24,7 @@ from mpm_fem.problems.burgers import Reservoir
 from mpm_fem.problems.sod import SodSettings, simulate
 from mpm_fem.shape import OutsideGridError
 from mpm_fem.solve import Problem, run
-from mpm_fem.step import Dirichlet, Stages, Walls
+from mpm_fem.step import SCHEMES, Dirichlet, Stages, Walls
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 STEPS = 1000
@@ -116,7 +116,7 @@ def _compare(basis, scheme, mass, model, boundary, steps):
     return reference, fused
 
 
-BASES, SCHEMES, MODELS = ("mpm", "gimp", "bspline"), ("usl", "usf", "musl"), ("gas", "burgers")
+BASES, MODELS = ("mpm", "gimp", "bspline"), ("gas", "burgers")  # the schemes: mpm_fem.step.SCHEMES
 
 
 def _pairwise(basis, scheme, model):
@@ -188,7 +188,7 @@ def _gas_variant_in_the_fast_set(basis, scheme):
 
 @pytest.mark.parametrize(("basis", "scheme"), [
     pytest.param(basis, scheme, marks=() if _gas_variant_in_the_fast_set(basis, scheme) else pytest.mark.slow)
-    for basis in ("mpm", "gimp", "bspline", "bspline_gimp") for scheme in SCHEMES])
+    for basis in BASES + ("bspline_gimp",) for scheme in SCHEMES])
 @pytest.mark.parametrize("mass", ["lumped", "consistent"])
 def test_a_grid_not_uniform_to_round_off_keeps_the_node_arithmetic_bit_for_bit(basis, scheme, mass):
     """Off a uniform grid every basis keeps the node arithmetic: bit for bit, 200 steps. P1 and GIMP
