@@ -22,10 +22,14 @@ takes uniform-grid arithmetic, ``s = (x - x_0)/h``, ``c = floor(s)``, ``xi = s -
 closed form from ``s`` with no node coordinate read and no division per node (:func:`_point`;
 GIMP :func:`_gimp_uniform`, one division per particle whose domain crosses a node; the B-spline
 :func:`_bspline_nearest`, the three splines around the nearest node; the particle-domain B-spline
-in :func:`_bspline_domain_row`, one division per particle). That equals the numpy step's node
-arithmetic to round-off (tested to 1e-12 relative over 1,000 steps), not bit for bit. The point
-mass and the B-spline keep the row and the node sums of consecutive particles in registers
-(:func:`_project_point`, :func:`_move_point`, :func:`_project_bspline`, :func:`_move_bspline`).
+in :func:`_bspline_domain_row`, one division per particle, ``M`` and ``N`` evaluated only in the
+pieces that do not vanish, :func:`_bspline_pieces`, the formula's floats). That equals the numpy
+step's node arithmetic to round-off (tested to 1e-12 relative over 1,000 steps), not bit for bit.
+The point mass and the B-spline keep the row and the node sums of consecutive particles in
+registers (:func:`_project_point`, :func:`_move_point`, :func:`_project_bspline`,
+:func:`_move_bspline`); the particle-domain bases build their rows in a loop of their own, from
+scalars, before they scatter (:func:`_project_domain`): an inlined helper that takes arrays costs
+reference counting on every call, which made their pass 1 two to three times slower.
 A grid not uniform to round-off keeps the node arithmetic, bit for bit, in every basis.
 
 Threads (``threads > 1``): the particles are cut into ``threads`` contiguous chunks; each chunk
@@ -171,39 +175,51 @@ def _hat_antiderivative(r):
 
 
 @njit(cache=True, inline="always")
-def _gimp_uniform(nodes, inv_spacing, x, V, row, S, G):
-    """GIMP's row on a uniform grid (:func:`mpm_fem.shape.gimp_shape` to round-off), in the scaled
-    coordinate ``s``: the domain ``[s_-, s_+]`` (cut at the grid's ends), ``S_i = (Psi(s_+ - i) -
-    Psi(s_- - i)) / (s_+ - s_-)``, ``G_i = (N(s_+ - i) - N(s_- - i)) / (x_+ - x_-)`` at the nodes
-    ``i = c_- .. c_- + K - 1`` (clipped at the last node, repeats zeroed). A domain inside one cell
-    has the hats' values at its midpoint, ``S = (1 - xi_m, xi_m)``, and ``G = (-1, 1)/h``: no
-    division. Returns the cell and the K it needs (``c_+ - c_- + 2``)."""
-    n_nodes = nodes.size
-    K = row.size
-    a, b = nodes[0], nodes[n_nodes - 1]
-    _, c = _scaled(nodes, inv_spacing, x)
-    s_lo, c_lo = _scaled(nodes, inv_spacing, max(x - 0.5 * V, a))
-    s_hi, c_hi = _scaled(nodes, inv_spacing, min(x + 0.5 * V, b))
+def _domain_ends(x0, b, top_cell, inv_spacing, x, V):
+    """The particle domain ``[x - V/2, x + V/2]`` cut at the grid's ends ``[x0, b]``, in uniform-grid
+    arithmetic (:func:`_scaled`'s operations, from scalars: no array handed over per particle, which
+    would cost reference counting in the hot loops): the particle's cell ``c``, and ``s_-, c_-,
+    s_+, c_+``, the scaled ends and their cells."""
+    c = min(int((x - x0) * inv_spacing), top_cell)
+    s_lo = (max(x - 0.5 * V, x0) - x0) * inv_spacing
+    s_hi = (min(x + 0.5 * V, b) - x0) * inv_spacing
+    return c, s_lo, min(int(s_lo), top_cell), s_hi, min(int(s_hi), top_cell)
+
+
+@njit(cache=True, inline="always")
+def _gimp_entry(k, s_lo, c_lo, s_hi, c_hi, inv_w, inv_spacing, last):
+    """Node, ``S`` and ``G`` of column ``k`` of GIMP's row on a uniform grid (:func:`_gimp_uniform`):
+    a domain inside one cell has the hats' values at its midpoint, ``S = (1 - xi_m, xi_m)``, ``G =
+    (-1, 1)/h`` (no division; ``inv_w`` unused); otherwise node ``i = min(c_- + k, last)``, ``S =
+    (Psi(s_+ - i) - Psi(s_- - i)) inv_w``, ``G = (N(s_+ - i) - N(s_- - i)) inv_w / h``, with
+    ``inv_w = 1 / (s_+ - s_-)`` and a node repeated at the last node zeroed."""
     if c_hi == c_lo:
         xi = 0.5 * (s_lo + s_hi) - c_lo
-        row[0], S[0], G[0] = c_lo, 1.0 - xi, -inv_spacing
-        row[1], S[1], G[1] = c_lo + 1, xi, inv_spacing
-        for k in range(2, K):
-            row[k], S[k], G[k] = min(c_lo + k, n_nodes - 1), 0.0, 0.0
-        return c, 2
-    inv_w = 1.0 / (s_hi - s_lo)
-    inv_len = inv_w * inv_spacing
-    previous = -1
-    for k in range(K):
-        i = min(c_lo + k, n_nodes - 1)
-        row[k] = i
-        if i == previous:
-            S[k], G[k] = 0.0, 0.0
-        else:
-            r_lo, r_hi = s_lo - i, s_hi - i
-            S[k] = (_hat_antiderivative(r_hi) - _hat_antiderivative(r_lo)) * inv_w
-            G[k] = (max(1.0 - abs(r_hi), 0.0) - max(1.0 - abs(r_lo), 0.0)) * inv_len
-        previous = i
+        if k == 0:
+            return c_lo, 1.0 - xi, -inv_spacing
+        if k == 1:
+            return c_lo + 1, xi, inv_spacing
+        return min(c_lo + k, last), 0.0, 0.0
+    i = min(c_lo + k, last)
+    if k > 0 and i == min(c_lo + k - 1, last):
+        return i, 0.0, 0.0
+    r_lo, r_hi = s_lo - i, s_hi - i
+    return (i, (_hat_antiderivative(r_hi) - _hat_antiderivative(r_lo)) * inv_w,
+            (max(1.0 - abs(r_hi), 0.0) - max(1.0 - abs(r_lo), 0.0)) * (inv_w * inv_spacing))
+
+
+@njit(cache=True, inline="always")
+def _gimp_uniform(nodes, inv_spacing, x, V, row, S, G):
+    """GIMP's row on a uniform grid (:func:`mpm_fem.shape.gimp_shape` to round-off), in the scaled
+    coordinate ``s``: the domain ``[s_-, s_+]`` (cut at the grid's ends, :func:`_domain_ends`),
+    ``S_i = (Psi(s_+ - i) - Psi(s_- - i)) / (s_+ - s_-)``, ``G_i = (N(s_+ - i) - N(s_- - i)) / (x_+ -
+    x_-)`` at the nodes ``i = c_- .. c_- + K - 1`` (:func:`_gimp_entry`). Returns the cell and the K
+    it needs (``c_+ - c_- + 2``; 2 for a domain inside one cell)."""
+    n_nodes = nodes.size
+    c, s_lo, c_lo, s_hi, c_hi = _domain_ends(nodes[0], nodes[n_nodes - 1], n_nodes - 2, inv_spacing, x, V)
+    inv_w = 1.0 / (s_hi - s_lo) if c_hi != c_lo else 0.0
+    for k in range(row.size):
+        row[k], S[k], G[k] = _gimp_entry(k, s_lo, c_lo, s_hi, c_hi, inv_w, inv_spacing, n_nodes - 1)
     return c, c_hi - c_lo + 2
 
 
@@ -283,14 +299,10 @@ def _piece(d, left, a, b, c):
 
 @njit(cache=True, inline="always")
 def _bspline_domain_ends(x0, b, top_cell, inv_spacing, x, V):
-    """The particle domain ``[x - V/2, x + V/2]`` cut at the grid's ends ``[x0, b]``, in uniform-grid
-    arithmetic (:func:`_scaled`, from scalars: no array passes per particle): the particle's cell,
-    the cells ``c_lo``, ``c_hi`` of its ends, ``1 / (s_+ - s_-)`` (the particle's one division) and the
-    :func:`_bspline_pieces` of each end."""
-    c = min(int((x - x0) * inv_spacing), top_cell)
-    y_lo = (max(x - 0.5 * V, x0) - x0) * inv_spacing
-    y_hi = (min(x + 0.5 * V, b) - x0) * inv_spacing
-    c_lo, c_hi = min(int(y_lo), top_cell), min(int(y_hi), top_cell)
+    """:func:`_domain_ends` for the particle-domain B-spline: the cell, the cells ``c_-``, ``c_+`` of the
+    domain's ends, ``1 / (s_+ - s_-)`` (the particle's one division) and the :func:`_bspline_pieces` of
+    each end."""
+    c, y_lo, c_lo, y_hi, c_hi = _domain_ends(x0, b, top_cell, inv_spacing, x, V)
     return c, c_lo, c_hi, 1.0 / (y_hi - y_lo), _bspline_pieces(y_lo, c_lo), _bspline_pieces(y_hi, c_hi)
 
 
@@ -679,13 +691,14 @@ def _project_bspline(nodes, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi
 
 
 @njit(cache=True, inline="always")
-def _project_bspline_domain(nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi, rows, S, G, cell, buf):
-    """Pass 1 of the particle-domain B-spline on a uniform grid over particles ``lo .. hi-1``, as the
-    generic loop of :func:`_project` (the same sums in the same order) in two loops: the rows first,
-    straight into ``rows``, ``S``, ``G`` with no array handed to a helper per particle (each such
-    call costs reference counting), then ``buf[0..2]`` += ``m_p S_ip``, ``m_p v_p S_ip``,
-    ``V_p p_p G_ip`` from the stored rows. Returns the first particle outside the grid, the first
-    with ``V <= 0`` (-1 if none) and the K the rows need."""
+def _project_domain(basis, nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi, rows, S, G, cell, buf):
+    """Pass 1 of a particle-domain basis (GIMP, ``basis`` 1; the particle-domain B-spline, 3) on a
+    uniform grid over particles ``lo .. hi-1``, as the generic loop of :func:`_project` (the same
+    sums in the same order) in two loops: the rows first, straight into ``rows``, ``S``, ``G``
+    (:func:`_gimp_entry`, :func:`_bspline_domain_entry`: scalars in and out, no array handed to a
+    helper per particle), then ``buf[0..2]`` += ``m_p S_ip``, ``m_p v_p S_ip``, ``V_p p_p G_ip`` from
+    the stored rows. Returns the first particle outside the grid, the first with ``V <= 0`` (-1 if
+    none) and the K the rows need."""
     n_nodes = nodes.size
     K = rows.shape[1]
     a, b = nodes[0], nodes[n_nodes - 1]
@@ -699,12 +712,19 @@ def _project_bspline_domain(nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi
             if empty < 0:
                 empty = q
             continue
-        c, c_lo, c_hi, inv_w, end_lo, end_hi = _bspline_domain_ends(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
+        if basis == 3:
+            c, c_lo, c_hi, inv_w, end_lo, end_hi = _bspline_domain_ends(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
+            need = max(need, c_hi - c_lo + 4)
+            for k in range(K):
+                rows[q, k] = min(max(c_lo - 1 + k, 0), n_nodes - 1)
+                S[q, k], G[q, k] = _bspline_domain_entry(k, c_hi - c_lo, inv_w, inv_spacing, end_lo, end_hi)
+        else:
+            c, s_lo, c_lo, s_hi, c_hi = _domain_ends(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
+            need = max(need, c_hi - c_lo + 2)
+            inv_w = 1.0 / (s_hi - s_lo) if c_hi != c_lo else 0.0
+            for k in range(K):
+                rows[q, k], S[q, k], G[q, k] = _gimp_entry(k, s_lo, c_lo, s_hi, c_hi, inv_w, inv_spacing, n_nodes - 1)
         cell[q] = c
-        need = max(need, c_hi - c_lo + 4)
-        for k in range(K):
-            rows[q, k] = min(max(c_lo - 1 + k, 0), n_nodes - 1)
-            S[q, k], G[q, k] = _bspline_domain_entry(k, c_hi - c_lo, inv_w, inv_spacing, end_lo, end_hi)
     for q in range(lo, hi):
         if not (x[q] >= a and x[q] <= b and V[q] > 0):
             continue
@@ -743,9 +763,9 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
             outside, need = _project_bspline(nodes, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi,
                                              rows, S, G, cell, buf[k]), 4
             lo = hi
-        if BASIS == 3 and inv_spacing > 0.0:  # the particle-domain B-spline on a uniform grid: its own loops
-            outside, empty, need = _project_bspline_domain(nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi,
-                                                           rows, S, G, cell, buf[k])
+        if (BASIS == 1 or BASIS == 3) and inv_spacing > 0.0:  # the domain bases on a uniform grid: likewise
+            outside, empty, need = _project_domain(BASIS, nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi,
+                                                   rows, S, G, cell, buf[k])
             lo = hi
         for q in range(lo, hi):
             if not (x[q] >= a and x[q] <= b):

@@ -20,13 +20,10 @@ Taylor + volume and with XPIC(5)); E5 counts a remedy as removing the plateau on
 Sod mesh of the table, so the others count as not removing it, which they do not on the coarser
 meshes already. Every remedy runs the fused compiled step (:mod:`mpm_fem.fused`, equal to the numpy
 step), all of them in its compiled loop (the Taylor reconstruction, XPIC(m) and the grid volume
-included). Measured at h = 0.0003125 (CPU seconds, one run each, compiled code warm, 2 jobs on 2
-cores; 51,200 particles, about 30,000 steps): MPM 32 s, FLIP 0.99 36 s, XPIC(2) 43 s, XPIC(5)
-71 s, Taylor LS 45 s, grid volume 124 s (its reset computes the GIMP rows of the particle domains
-twice per step), Taylor + volume 117 s, B-spline domain 158 s, with XPIC(2) 178 s, with XPIC(5)
-221 s, with Taylor + volume 245 s. A halving of h costs about 4x (twice the particles, twice the
-steps; 3.3x for MPM and 4.9x for the B-spline domain from 0.000625 to 0.0003125), so the finest mesh
-adds about 50 CPU-min, most of the study's cost; every remedy there would add about 25 more.
+included). What each run cost is in ``cost.csv`` (``wall_s``, measured in the run that wrote it). A
+halving of h costs about 4x (twice the particles, twice the steps), so the finest mesh costs about
+three times the six coarser ones together, and each of the seven other remedies would add there about
+four times its cost at h = 0.0003125.
 Burgers h = 0.04 ... 0.005 (the viscous step limit makes a halving of h cost 8x).
 
 XPIC(m) (:mod:`mpm_fem.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline, on every

@@ -170,3 +170,12 @@ def test_source_table_with_corrections_falls_monotonically():
         for eps, values in table.items():
             assert all(a > b for a, b in zip(values, values[1:])), f"{row} eps={eps}: {values}"
             assert all(0.8 < a / b < 4 for a, b in zip(values, values[1:])), f"{row} eps={eps}: {values}"
+
+
+def test_the_reported_step_is_the_run_step_not_the_last_sliver():
+    """57,600 steps of dt = T / 57,600 fall short of T by round-off (about 7e-13), so the run takes a
+    57,601st step of that sliver to land on T; the table's ``dt`` is the run's step, not the sliver
+    (its smallest step, ``dt_min``, which the table once reported: dt = 7.2e-13 at h = 0.00125)."""
+    r = study.run_case({"solver": "mpm", "h": 0.04, "refine": 1024, "ppc": 4})
+    assert r["steps"] == 57601 and r["dt_min"] < 1e-9, "the case no longer ends with a sliver step: pick another"
+    assert r["dt"] == pytest.approx(0.5 / 57600, rel=1e-9)
