@@ -280,7 +280,9 @@ def _bspline_pieces(y, c):
         j = n + 1, r in [-3/2, -1/2]:  M = u^3/6,  N = u^2/2,  u = r + 3/2
 
     (left of them ``M = M(3/2)``, right of them 0; ``N = 0``; the pieces agree where they meet).
-    Three divisions instead of the formula's fifteen at the five nodes of a row."""
+    Three divisions instead of the formula's fifteen at the five nodes of a row. Returns ``first``,
+    the three ``M``, then the three ``N`` (a flat tuple: a parallel variant's array analysis fails
+    on a tuple of tuples that holds ints)."""
     first = 0 if y - c < 0.5 else 1
     n = c + first
     w = 1.5 - (y - (n - 1))
@@ -298,22 +300,15 @@ def _piece(d, left, a, b, c):
 
 
 @njit(cache=True, inline="always")
-def _bspline_domain_ends(x0, b, top_cell, inv_spacing, x, V):
-    """:func:`_domain_ends` for the particle-domain B-spline: the cell, the cells ``c_-``, ``c_+`` of the
-    domain's ends, ``1 / (s_+ - s_-)`` (the particle's one division) and the :func:`_bspline_pieces` of
-    each end."""
-    c, y_lo, c_lo, y_hi, c_hi = _domain_ends(x0, b, top_cell, inv_spacing, x, V)
-    return c, c_lo, c_hi, 1.0 / (y_hi - y_lo), _bspline_pieces(y_lo, c_lo), _bspline_pieces(y_hi, c_hi)
-
-
-@njit(cache=True, inline="always")
-def _bspline_domain_entry(k, span, inv_w, inv_spacing, lo, hi):
+def _bspline_domain_entry(k, span, inv_w, inv_spacing, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo,
+                          d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi):
     """``S`` and ``G`` of column ``k`` of the particle-domain B-spline row (the spline of node
     ``j = c_lo - 1 + k``): ``(M(s_+ - j) - M(s_- - j)) / (s_+ - s_-)`` and ``(N(s_+ - j) - N(s_- - j))
-    / (x_+ - x_-)``, the ends' values from their pieces ``lo``, ``hi`` (``span = c_hi - c_lo``)."""
-    d_lo, d_hi = lo[0], hi[0] + span  # the columns where each end's three splines start
-    S = (_piece(k - d_hi, _M_TOP, hi[1], hi[2], hi[3]) - _piece(k - d_lo, _M_TOP, lo[1], lo[2], lo[3])) * inv_w
-    G = (_piece(k - d_hi, 0.0, hi[4], hi[5], hi[6]) - _piece(k - d_lo, 0.0, lo[4], lo[5], lo[6])) * (inv_w * inv_spacing)
+    / (x_+ - x_-)``, the ends' values from their :func:`_bspline_pieces` (``_lo``, ``_hi``; ``span =
+    c_+ - c_-``, ``inv_w = 1 / (s_+ - s_-)``)."""
+    d_hi += span  # the columns where each end's three splines start: d_lo, d_hi
+    S = (_piece(k - d_hi, _M_TOP, Ml_hi, M0_hi, Mr_hi) - _piece(k - d_lo, _M_TOP, Ml_lo, M0_lo, Mr_lo)) * inv_w
+    G = (_piece(k - d_hi, 0.0, Nl_hi, N0_hi, Nr_hi) - _piece(k - d_lo, 0.0, Nl_lo, N0_lo, Nr_lo)) * (inv_w * inv_spacing)
     return S, G
 
 
@@ -323,17 +318,21 @@ def _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G):
     ``j = c_lo - 1 .. c_lo - 2 + K`` (ghosts folded into the end nodes) averaged over the domain
     ``[x - V/2, x + V/2]`` cut at the grid's ends; returns its cell and the K it needs
     (``c_hi - c_lo + 4``). On a uniform grid (``inv_spacing > 0``) from uniform-grid arithmetic
-    (:func:`_bspline_domain_ends`, :func:`_bspline_domain_entry`: ``M`` and ``N`` at each end of the
-    domain from the pieces that do not vanish, the formula's floats), else bit for bit."""
+    (:func:`_domain_ends`, :func:`_bspline_domain_entry`: ``M`` and ``N`` at each end of the domain
+    from the pieces that do not vanish, the formula's floats), else bit for bit."""
     n_nodes = nodes.size
     K = row.size
     a, b = nodes[0], nodes[n_nodes - 1]
     h0 = h[0, 0]
-    if inv_spacing > 0.0:
-        c, c_lo, c_hi, inv_w, lo, hi = _bspline_domain_ends(a, b, n_nodes - 2, inv_spacing, x, V)
+    if inv_spacing > 0.0:  # uniform-grid arithmetic, the particle's one division
+        c, y_lo, c_lo, y_hi, c_hi = _domain_ends(a, b, n_nodes - 2, inv_spacing, x, V)
+        inv_w = 1.0 / (y_hi - y_lo)
+        d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo = _bspline_pieces(y_lo, c_lo)
+        d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi = _bspline_pieces(y_hi, c_hi)
         for k in range(K):
             row[k] = min(max(c_lo - 1 + k, 0), n_nodes - 1)
-            S[k], G[k] = _bspline_domain_entry(k, c_hi - c_lo, inv_w, inv_spacing, lo, hi)
+            S[k], G[k] = _bspline_domain_entry(k, c_hi - c_lo, inv_w, inv_spacing, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo,
+                                               N0_lo, Nr_lo, d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi)
         return c, c_hi - c_lo + 4
     c, _ = _locate(nodes, inv_spacing, x)
     lo = max(x - 0.5 * V, a)
@@ -713,11 +712,16 @@ def _project_domain(basis, nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi,
                 empty = q
             continue
         if basis == 3:
-            c, c_lo, c_hi, inv_w, end_lo, end_hi = _bspline_domain_ends(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
+            c, y_lo, c_lo, y_hi, c_hi = _domain_ends(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
             need = max(need, c_hi - c_lo + 4)
+            inv_w = 1.0 / (y_hi - y_lo)
+            d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo = _bspline_pieces(y_lo, c_lo)
+            d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi = _bspline_pieces(y_hi, c_hi)
             for k in range(K):
                 rows[q, k] = min(max(c_lo - 1 + k, 0), n_nodes - 1)
-                S[q, k], G[q, k] = _bspline_domain_entry(k, c_hi - c_lo, inv_w, inv_spacing, end_lo, end_hi)
+                S[q, k], G[q, k] = _bspline_domain_entry(k, c_hi - c_lo, inv_w, inv_spacing, d_lo, Ml_lo, M0_lo, Mr_lo,
+                                                         Nl_lo, N0_lo, Nr_lo, d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi,
+                                                         Nr_hi)
         else:
             c, s_lo, c_lo, s_hi, c_hi = _domain_ends(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
             need = max(need, c_hi - c_lo + 2)
