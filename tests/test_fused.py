@@ -307,3 +307,47 @@ def test_what_the_fused_step_refuses():
         SodSettings(threads=0)
     with pytest.raises(ValueError, match="unknown kernel"):
         SodSettings(kernel="gpu")
+
+
+def _domain_rows(fused_row, x, V, nodes, K=8):
+    """Each particle's row from ``fused_row`` (a compiled row of mpm_fem.fused) on a uniform grid,
+    ``K`` columns (each row needs at most K)."""
+    h = np.vstack([np.diff(nodes), 1.0 / np.diff(nodes)])
+    inv_spacing = 1.0 / (nodes[1] - nodes[0])
+    rows, S, G = np.empty((x.size, K), np.intp), np.empty((x.size, K)), np.empty((x.size, K))
+    for q in range(x.size):
+        _, need = fused_row(nodes, h, inv_spacing, x[q], V[q], rows[q], S[q], G[q])
+        assert need <= K
+    return rows, S, G
+
+
+def test_particle_domain_bspline_row_is_the_formula_float_for_float():
+    """The uniform-grid row of the particle-domain B-spline evaluates ``M`` and ``N`` only in the
+    pieces that do not vanish (``_bspline_pieces``): the same floats as the formula of
+    ``mpm_fem.shape`` (``_bspline_integral``, ``_quadratic_bspline``) at every node of the row, on
+    domain ends placed at random, on nodes, half-way between nodes and at the grid's ends."""
+    from mpm_fem.fused import _bspline_domain_row
+    from mpm_fem.shape import _bspline_integral, _quadratic_bspline
+
+    nodes = np.linspace(0.0, 1.0, 41)
+    n_cells = nodes.size - 1
+    rng = np.random.default_rng(11)
+    centres = np.concatenate([rng.uniform(0, 1, 4000), np.arange(n_cells + 1) / n_cells,
+                              (np.arange(n_cells) + 0.5) / n_cells, [0.0, 1.0, 1e-17, 1 - 1e-16]])
+    V = np.concatenate([rng.uniform(1e-6, 2.5, centres.size) / n_cells])
+    edges = (np.arange(n_cells + 1) / n_cells)[rng.integers(0, n_cells + 1, 400)]  # a domain end on a node
+    x = np.concatenate([centres, np.clip(edges + 0.5 * V[:400], 0, 1), np.clip(edges - 0.5 * V[:400], 0, 1)])
+    V = np.concatenate([V, V[:400], V[:400]])
+    rows, S, G = _domain_rows(_bspline_domain_row, x, V, nodes)
+    inv_spacing = 1.0 / (nodes[1] - nodes[0])
+    s_lo = (np.maximum(x - 0.5 * V, 0.0) - 0.0) * inv_spacing  # the row's uniform-grid arithmetic
+    s_hi = (np.minimum(x + 0.5 * V, 1.0) - 0.0) * inv_spacing
+    c_lo = np.minimum(s_lo.astype(int), n_cells - 1)
+    j = c_lo[:, None] - 1 + np.arange(S.shape[1])
+    inv_w = (1.0 / (s_hi - s_lo))[:, None]
+    S_formula = (_bspline_integral(s_hi[:, None] - j) - _bspline_integral(s_lo[:, None] - j)) * inv_w
+    G_formula = (_quadratic_bspline(s_hi[:, None] - j)[0] - _quadratic_bspline(s_lo[:, None] - j)[0]) * (inv_w * inv_spacing)
+    assert np.array_equal(rows, np.clip(j, 0, n_cells))
+    assert np.array_equal(S, S_formula), f"S differs by {np.abs(S - S_formula).max():.3g}"
+    assert np.array_equal(G, G_formula), f"G differs by {np.abs(G - G_formula).max():.3g}"
+    assert np.abs(S.sum(axis=1) - 1).max() < 1e-12  # the partition of unity
