@@ -35,6 +35,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from . import frame_chunks
+
+frame_chunks.install()  # numba's compiler crosses CPython 3.11's frame-chunk starts: reuse the chunks
+
 # the layout of a wave's constants (:func:`wave_constants`)
 RHO, U, P, A, SHOCK, SPEED, HEAD, TAIL, RHO_STAR = range(9)
 FAN = 2  # region code of a point inside a fan

@@ -20,16 +20,18 @@ any :class:`~mpm_fem.step.Boundary` and both mass kinds are supported.
 Except on a grid uniform to round-off (nodes within ``1e-9 h`` of ``x_0 + i h``): there every basis
 takes uniform-grid arithmetic, ``s = (x - x_0)/h``, ``c = floor(s)``, ``xi = s - c``, its row in
 closed form from ``s`` with no node coordinate read and no division per node (:func:`_point`;
-GIMP :func:`_gimp_uniform`, one division per particle whose domain crosses a node; the B-spline
-:func:`_bspline_nearest`, the three splines around the nearest node; the particle-domain B-spline
-in :func:`_bspline_domain_row`, one division per particle, ``M`` and ``N`` evaluated only in the
-pieces that do not vanish, :func:`_bspline_pieces`, the formula's floats). That equals the numpy
-step's node arithmetic to round-off (tested to 1e-12 relative over 1,000 steps), not bit for bit.
+the B-spline :func:`_bspline_nearest`, the three splines around the nearest node; the particle-domain
+bases from the domain's ends, :func:`_domain` and :func:`_domain_column`: GIMP one division per
+particle whose domain crosses a node, the particle-domain B-spline one division per particle, ``M``
+and ``N`` evaluated only in the pieces that do not vanish, :func:`_bspline_pieces`, the formula's
+floats). That equals the numpy step's node arithmetic to round-off (tested to 1e-12 relative over
+1,000 steps), not bit for bit.
 The point mass and the B-spline keep the row and the node sums of consecutive particles in
 registers (:func:`_project_point`, :func:`_move_point`, :func:`_project_bspline`,
 :func:`_move_bspline`); the particle-domain bases build their rows in a loop of their own, from
 scalars, before they scatter (:func:`_project_domain`): an inlined helper that takes arrays costs
-reference counting on every call, which made their pass 1 two to three times slower.
+reference counting on every call, which made their pass 1 two to three times slower. The grid
+volume reset of the point bases builds their domain rows the same way (:func:`_volume_reset`).
 A grid not uniform to round-off keeps the node arithmetic, bit for bit, in every basis.
 
 Threads (``threads > 1``): the particles are cut into ``threads`` contiguous chunks; each chunk
@@ -54,7 +56,8 @@ The plateau remedies of :class:`~mpm_fem.step.Stages`, with the numpy step's ope
               change at the end nodes); pass 2 then sets ``v_p = sum_i S_ip (v*_i + dt a_i)``
               (``consts[6] > 0``: its nodal field comes in place of ``a_i``). Per step and in the loop.
     basis     ``"bspline_gimp"`` (code 3): the B-splines averaged over the particle domain
-              (:func:`_bspline_domain_row`); rows stored and widened as GIMP's (``c_hi - c_lo + 4``).
+              (:func:`_bspline_domain_row`, :func:`_domain`); rows stored and widened as GIMP's
+              (``c_hi - c_lo + 4``).
     volume    ``"grid"``: after pass 1 (without the gas force) the volume reset of the numpy step
               (:func:`mpm_fem.volume.grid_volume_factor`, the model's ``with_volume``), compiled in
               two passes (:func:`_volume_reset`), then the gas force of the reset state
@@ -78,6 +81,7 @@ import types
 import numpy as np
 from numba import njit, objmode, prange
 
+from . import frame_chunks
 from .grid import Grid
 from .models.burgers import ViscousBurgers
 from .models.euler import IdealGas
@@ -87,6 +91,8 @@ from .shape import Shape, basis_integrals, make_shape
 from .step import SCHEMES, Dirichlet, GridState, Stages, Walls
 from .transfer import solve_consistent
 from .xpic import boundary_change_rule
+
+frame_chunks.install()  # numba's compiler crosses CPython 3.11's frame-chunk starts: reuse the chunks
 
 KERNELS = ("fused", "numpy")
 GAS, BURGERS = 0, 1
@@ -188,7 +194,7 @@ def _domain_ends(x0, b, top_cell, inv_spacing, x, V):
 
 @njit(cache=True, inline="always")
 def _gimp_entry(k, s_lo, c_lo, s_hi, c_hi, inv_w, inv_spacing, last):
-    """Node, ``S`` and ``G`` of column ``k`` of GIMP's row on a uniform grid (:func:`_gimp_uniform`):
+    """Node, ``S`` and ``G`` of column ``k`` of GIMP's row on a uniform grid (:func:`_domain_column`):
     a domain inside one cell has the hats' values at its midpoint, ``S = (1 - xi_m, xi_m)``, ``G =
     (-1, 1)/h`` (no division; ``inv_w`` unused); otherwise node ``i = min(c_- + k, last)``, ``S =
     (Psi(s_+ - i) - Psi(s_- - i)) inv_w``, ``G = (N(s_+ - i) - N(s_- - i)) inv_w / h``, with
@@ -206,21 +212,6 @@ def _gimp_entry(k, s_lo, c_lo, s_hi, c_hi, inv_w, inv_spacing, last):
     r_lo, r_hi = s_lo - i, s_hi - i
     return (i, (_hat_antiderivative(r_hi) - _hat_antiderivative(r_lo)) * inv_w,
             (max(1.0 - abs(r_hi), 0.0) - max(1.0 - abs(r_lo), 0.0)) * (inv_w * inv_spacing))
-
-
-@njit(cache=True, inline="always")
-def _gimp_uniform(nodes, inv_spacing, x, V, row, S, G):
-    """GIMP's row on a uniform grid (:func:`mpm_fem.shape.gimp_shape` to round-off), in the scaled
-    coordinate ``s``: the domain ``[s_-, s_+]`` (cut at the grid's ends, :func:`_domain_ends`),
-    ``S_i = (Psi(s_+ - i) - Psi(s_- - i)) / (s_+ - s_-)``, ``G_i = (N(s_+ - i) - N(s_- - i)) / (x_+ -
-    x_-)`` at the nodes ``i = c_- .. c_- + K - 1`` (:func:`_gimp_entry`). Returns the cell and the K
-    it needs (``c_+ - c_- + 2``; 2 for a domain inside one cell)."""
-    n_nodes = nodes.size
-    c, s_lo, c_lo, s_hi, c_hi = _domain_ends(nodes[0], nodes[n_nodes - 1], n_nodes - 2, inv_spacing, x, V)
-    inv_w = 1.0 / (s_hi - s_lo) if c_hi != c_lo else 0.0
-    for k in range(row.size):
-        row[k], S[k], G[k] = _gimp_entry(k, s_lo, c_lo, s_hi, c_hi, inv_w, inv_spacing, n_nodes - 1)
-    return c, c_hi - c_lo + 2
 
 
 @njit(cache=True, inline="always")
@@ -281,14 +272,13 @@ def _bspline_pieces(y, c):
 
     (left of them ``M = M(3/2)``, right of them 0; ``N = 0``; the pieces agree where they meet).
     Three divisions instead of the formula's fifteen at the five nodes of a row. Returns ``first``,
-    the three ``M``, then the three ``N`` (a flat tuple: a parallel variant's array analysis fails
-    on a tuple of tuples that holds ints)."""
+    the three ``M``, then the three ``N``, all floats (:func:`_domain`)."""
     first = 0 if y - c < 0.5 else 1
-    n = c + first
-    w = 1.5 - (y - (n - 1))
-    r = y - n
-    u = (y - (n + 1)) + 1.5
-    return (first, _M_ABOVE + (1.0 - w * w * w) / 6.0, _SIXTH + (0.75 * (r + 0.5) - (r * r * r + 0.125) / 3.0),
+    nearest = c + first
+    w = 1.5 - (y - (nearest - 1))
+    r = y - nearest
+    u = (y - (nearest + 1)) + 1.5
+    return (float(first), _M_ABOVE + (1.0 - w * w * w) / 6.0, _SIXTH + (0.75 * (r + 0.5) - (r * r * r + 0.125) / 3.0),
             u * u * u / 6.0, 0.5 * (w * w), 0.75 - r * r, 0.5 * (u * u))
 
 
@@ -300,16 +290,52 @@ def _piece(d, left, a, b, c):
 
 
 @njit(cache=True, inline="always")
-def _bspline_domain_entry(k, span, inv_w, inv_spacing, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo,
-                          d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi):
-    """``S`` and ``G`` of column ``k`` of the particle-domain B-spline row (the spline of node
-    ``j = c_lo - 1 + k``): ``(M(s_+ - j) - M(s_- - j)) / (s_+ - s_-)`` and ``(N(s_+ - j) - N(s_- - j))
-    / (x_+ - x_-)``, the ends' values from their :func:`_bspline_pieces` (``_lo``, ``_hi``; ``span =
-    c_+ - c_-``, ``inv_w = 1 / (s_+ - s_-)``)."""
-    d_hi += span  # the columns where each end's three splines start: d_lo, d_hi
+def _domain(basis, a, b, top_cell, inv_spacing, x, V):
+    """The row of a particle-domain basis (GIMP, ``basis`` 1; the particle-domain B-spline, 3) on a
+    uniform grid, in scalars, for :func:`_domain_column`: the particle's cell ``c``, the K its row
+    needs (GIMP ``c_+ - c_- + 2``, the B-spline ``c_+ - c_- + 4``), the domain's ends ``c_-, c_+,
+    s_-, s_+`` (:func:`_domain_ends`), ``inv_w = 1 / (s_+ - s_-)`` (GIMP: 0 for a domain inside one
+    cell, which needs no division) and the B-spline's pieces at both ends (:func:`_bspline_pieces`;
+    GIMP does not read them, and the compiler drops them). A flat tuple of floats (the integers
+    exact in them): no array is handed to a helper per particle (reference counting), and numba's
+    parallel array analysis mistakes a tuple holding integers for an array shape (a tuple of tuples
+    failed to compile; this tuple with integers in it compiled, and gave NaN particles in the
+    parallel volume reset called from the loop)."""
+    c, s_lo, c_lo, s_hi, c_hi = _domain_ends(a, b, top_cell, inv_spacing, x, V)
+    inv_w = 1.0 / (s_hi - s_lo) if basis == 3 or c_hi != c_lo else 0.0
+    need = c_hi - c_lo + (4 if basis == 3 else 2)
+    return ((float(c), float(need), float(c_lo), float(c_hi), s_lo, s_hi, inv_w)
+            + _bspline_pieces(s_lo, c_lo) + _bspline_pieces(s_hi, c_hi))
+
+
+@njit(cache=True, inline="always")
+def _domain_column(basis, k, inv_spacing, last, D):
+    """Node, ``S`` and ``G`` of column ``k`` of a particle-domain row from its :func:`_domain` scalars
+    ``D`` (``last``: the last node). GIMP: :func:`_gimp_entry`. The particle-domain B-spline: the
+    spline of node ``j = c_- - 1 + k`` (ghosts folded into the end nodes), ``S = (M(s_+ - j) -
+    M(s_- - j)) / (s_+ - s_-)``, ``G = (N(s_+ - j) - N(s_- - j)) / (x_+ - x_-)``, ``M`` and ``N`` at
+    each end from its pieces (:func:`_piece`: the columns where each end's three splines start are
+    ``d_-`` and ``d_+ + c_+ - c_-``)."""
+    (_, _, lo, hi, s_lo, s_hi, inv_w, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo,
+     d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi) = D
+    c_lo, c_hi = int(lo), int(hi)
+    if basis == 1:
+        return _gimp_entry(k, s_lo, c_lo, s_hi, c_hi, inv_w, inv_spacing, last)
+    d_hi += c_hi - c_lo
     S = (_piece(k - d_hi, _M_TOP, Ml_hi, M0_hi, Mr_hi) - _piece(k - d_lo, _M_TOP, Ml_lo, M0_lo, Mr_lo)) * inv_w
     G = (_piece(k - d_hi, 0.0, Nl_hi, N0_hi, Nr_hi) - _piece(k - d_lo, 0.0, Nl_lo, N0_lo, Nr_lo)) * (inv_w * inv_spacing)
-    return S, G
+    return min(max(c_lo - 1 + k, 0), last), S, G
+
+
+@njit(cache=True, inline="always")
+def _uniform_domain_row(basis, nodes, inv_spacing, x, V, row, S, G):
+    """The row of a particle-domain basis on a uniform grid into ``row``, ``S``, ``G`` (``row.size``
+    columns; :func:`_domain`, :func:`_domain_column`); returns the particle's cell and the K it needs."""
+    n_nodes = nodes.size
+    D = _domain(basis, nodes[0], nodes[n_nodes - 1], n_nodes - 2, inv_spacing, x, V)
+    for k in range(row.size):
+        row[k], S[k], G[k] = _domain_column(basis, k, inv_spacing, n_nodes - 1, D)
+    return int(D[0]), int(D[1])
 
 
 @njit(cache=True, inline="always")
@@ -318,22 +344,14 @@ def _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G):
     ``j = c_lo - 1 .. c_lo - 2 + K`` (ghosts folded into the end nodes) averaged over the domain
     ``[x - V/2, x + V/2]`` cut at the grid's ends; returns its cell and the K it needs
     (``c_hi - c_lo + 4``). On a uniform grid (``inv_spacing > 0``) from uniform-grid arithmetic
-    (:func:`_domain_ends`, :func:`_bspline_domain_entry`: ``M`` and ``N`` at each end of the domain
-    from the pieces that do not vanish, the formula's floats), else bit for bit."""
+    (:func:`_uniform_domain_row`: ``M`` and ``N`` at each end of the domain from the pieces that do
+    not vanish, the formula's floats), else bit for bit."""
     n_nodes = nodes.size
     K = row.size
     a, b = nodes[0], nodes[n_nodes - 1]
     h0 = h[0, 0]
     if inv_spacing > 0.0:  # uniform-grid arithmetic, the particle's one division
-        c, y_lo, c_lo, y_hi, c_hi = _domain_ends(a, b, n_nodes - 2, inv_spacing, x, V)
-        inv_w = 1.0 / (y_hi - y_lo)
-        d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo = _bspline_pieces(y_lo, c_lo)
-        d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi = _bspline_pieces(y_hi, c_hi)
-        for k in range(K):
-            row[k] = min(max(c_lo - 1 + k, 0), n_nodes - 1)
-            S[k], G[k] = _bspline_domain_entry(k, c_hi - c_lo, inv_w, inv_spacing, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo,
-                                               N0_lo, Nr_lo, d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi)
-        return c, c_hi - c_lo + 4
+        return _uniform_domain_row(3, nodes, inv_spacing, x, V, row, S, G)
     c, _ = _locate(nodes, inv_spacing, x)
     lo = max(x - 0.5 * V, a)
     hi = min(x + 0.5 * V, b)
@@ -394,7 +412,7 @@ def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
         return _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G)
     # GIMP: hats averaged over [x - V/2, x + V/2], cut at the ends of the grid
     if inv_spacing > 0.0:
-        return _gimp_uniform(nodes, inv_spacing, x, V, row, S, G)
+        return _uniform_domain_row(1, nodes, inv_spacing, x, V, row, S, G)
     a, b = nodes[0], nodes[n_nodes - 1]
     c, _ = _locate(nodes, inv_spacing, x)
     lo = max(x - 0.5 * V, a)
@@ -694,7 +712,7 @@ def _project_domain(basis, nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi,
     """Pass 1 of a particle-domain basis (GIMP, ``basis`` 1; the particle-domain B-spline, 3) on a
     uniform grid over particles ``lo .. hi-1``, as the generic loop of :func:`_project` (the same
     sums in the same order) in two loops: the rows first, straight into ``rows``, ``S``, ``G``
-    (:func:`_gimp_entry`, :func:`_bspline_domain_entry`: scalars in and out, no array handed to a
+    (:func:`_domain`, :func:`_domain_column`: scalars in and out, no array handed to a
     helper per particle), then ``buf[0..2]`` += ``m_p S_ip``, ``m_p v_p S_ip``, ``V_p p_p G_ip`` from
     the stored rows. Returns the first particle outside the grid, the first with ``V <= 0`` (-1 if
     none) and the K the rows need."""
@@ -711,24 +729,11 @@ def _project_domain(basis, nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi,
             if empty < 0:
                 empty = q
             continue
-        if basis == 3:
-            c, y_lo, c_lo, y_hi, c_hi = _domain_ends(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
-            need = max(need, c_hi - c_lo + 4)
-            inv_w = 1.0 / (y_hi - y_lo)
-            d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo = _bspline_pieces(y_lo, c_lo)
-            d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi = _bspline_pieces(y_hi, c_hi)
-            for k in range(K):
-                rows[q, k] = min(max(c_lo - 1 + k, 0), n_nodes - 1)
-                S[q, k], G[q, k] = _bspline_domain_entry(k, c_hi - c_lo, inv_w, inv_spacing, d_lo, Ml_lo, M0_lo, Mr_lo,
-                                                         Nl_lo, N0_lo, Nr_lo, d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi,
-                                                         Nr_hi)
-        else:
-            c, s_lo, c_lo, s_hi, c_hi = _domain_ends(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
-            need = max(need, c_hi - c_lo + 2)
-            inv_w = 1.0 / (s_hi - s_lo) if c_hi != c_lo else 0.0
-            for k in range(K):
-                rows[q, k], S[q, k], G[q, k] = _gimp_entry(k, s_lo, c_lo, s_hi, c_hi, inv_w, inv_spacing, n_nodes - 1)
-        cell[q] = c
+        D = _domain(basis, a, b, n_nodes - 2, inv_spacing, x[q], V[q])
+        need = max(need, int(D[1]))
+        for k in range(K):
+            rows[q, k], S[q, k], G[q, k] = _domain_column(basis, k, inv_spacing, n_nodes - 1, D)
+        cell[q] = int(D[0])
     for q in range(lo, hi):
         if not (x[q] >= a and x[q] <= b and V[q] > 0):
             continue
@@ -952,7 +957,8 @@ def _domain_row(basis, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl):
     the step's own stored row (GIMP, particle-domain B-spline), or the domain average of the point
     basis' grid functions at ``x_q``, ``V_q`` (point mass: GIMP; B-spline: the particle-domain
     B-spline), in ``r.size`` columns (columns past a domain's nodes have zero weight). Returns the
-    width the row needs (more than ``r.size``: the caller retries wider)."""
+    width the row needs (more than ``r.size``: the caller retries wider). On a uniform grid the
+    point bases' rows come from scalars instead (:func:`_volume_reset`)."""
     if basis == 1 or basis == 3:
         for j in range(r.size):
             r[j], Sl[j] = rows[q, j], S[q, j]
@@ -973,13 +979,27 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
     ``values[k, 0]`` that density or volume."""
     n = x.size
     gas = MODEL == GAS
+    # the point bases on a uniform grid: their domain rows (GIMP, the particle-domain B-spline) from
+    # scalars, in the loop (_domain, _domain_column), as pass 1 of those bases builds them. Both
+    # flags without a branch: in a parallel variant, a variable set in branches before a prange loop
+    # (`1 if BASIS == 0 else 3`, `... and ...`) gave NaN particles when the loop called it (numba 0.68.1)
+    fresh = (BASIS % 2 == 0) & (inv_spacing > 0.0)
+    domain = 1 + 2 * (BASIS // 2)
+    a, b, last = nodes[0], nodes[nodes.size - 1], nodes.size - 1
     buf = np.zeros((chunks, 1, V_i.size))
     for k in prange(chunks):
         r, Sl, Gl = _one_row(width)
         need = 0
         for q in range(*_chunk(n, chunks, k)):
-            need = max(need, _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl))
-            _scatter(buf, k, r, Sl, V[q], width)
+            if fresh:
+                D = _domain(domain, a, b, last - 1, inv_spacing, x[q], V[q])
+                need = max(need, int(D[1]))
+                for j in range(width):
+                    i, s, _ = _domain_column(domain, j, inv_spacing, last, D)
+                    buf[k, 0, i] += s * V[q]
+            else:
+                need = max(need, _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl))
+                _scatter(buf, k, r, Sl, V[q], width)
         flags[k, 1] = need
     _sum_chunks(buf, 0, V_i, 1.0)
     _divide_by_lumped(integrals, V_i, ratio)
@@ -988,8 +1008,16 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
         r, Sl, Gl = _one_row(width)
         bad, value = -1.0, 0.0
         for q in range(*_chunk(n, chunks, k)):
-            _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl)
-            V_r[q] = V[q] * _gather(Sl, ratio, r, width)
+            if fresh:  # sum_j Sbar_qj ratio_j, left to right (_gather's order)
+                D = _domain(domain, a, b, last - 1, inv_spacing, x[q], V[q])
+                f = 0.0
+                for j in range(width):
+                    i, s, _ = _domain_column(domain, j, inv_spacing, last, D)
+                    f = s * ratio[i] if j == 0 else f + s * ratio[i]
+                V_r[q] = V[q] * f
+            else:
+                _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl)
+                V_r[q] = V[q] * _gather(Sl, ratio, r, width)
             if gas:
                 rho_r[q] = m[q] / V_r[q]
                 viscosity = p[q] - gm1 * rho[q] * e[q]

@@ -3,8 +3,7 @@
 ``v_t + v v_x = eps v_xx`` on [0, 2] up to T, data from an exact solution; MPM takes the nodal
 acceleration from the particles ("calculated") or from the exact solution ("exact"), beside P1 FEM
 with consistent and lumped mass on the same mesh. Tables: ``errors``, ``orders`` (C13), ``norms``
-(which solution and norm match the source), ``timestep``, ``ppc`` (C3), ``lumping`` (C15), ``diagnosis``.
-"""
+(which solution and norm match the source), ``timestep``, ``ppc`` (C3), ``lumping`` (C15), ``diagnosis``."""
 
 from __future__ import annotations
 
@@ -62,7 +61,8 @@ QUICK = dict(solutions=(DEFAULT,), eps=(0.045, 0.01), H=H[:3], skip=("mpm_calcul
 def run_case(case: dict) -> dict:
     """One run. ``case["solver"]``: ``"mpm"`` (fields of ``BurgersSettings``) or ``"fem"``
     (``solution``, ``eps``, ``h``, ``mass``, ``cfl``, ``cfl_visc``). Velocity errors at T over
-    particles and nodes; the profile at T when ``case["profile"]``."""
+    particles and nodes; the profile at T when ``case["profile"]``. ``dt`` is the run's step, the
+    largest it took: the last step, which lands on T, can be a round-off sliver (``dt_min``)."""
     if case["solver"] == "fem":
         solution = make_solution(case["solution"], case["eps"])
         r = fem_burgers.solve(solution, case["h"], T=T, mass=case["mass"], cfl=case["cfl"], cfl_visc=case["cfl_visc"])
@@ -74,8 +74,6 @@ def run_case(case: dict) -> dict:
     except (ArithmeticError, ValueError) as err:
         return {"ok": False, "error": str(err)}
     e = burgers.errors(settings, r)["velocity"]
-    # "dt": the run's step, the largest it took (the last step, which lands on T, can be shorter: a
-    # sliver of round-off when t falls just short of T; the smallest would report that sliver)
     out = {"ok": True, "particles": e["particles"], "nodes": e["nodes"], "steps": r.steps, "dt": r.dt_max,
            "dt_min": r.dt_min, "n_p": int(r.particles.n), "wall_s": round(r.wall_s, 2)}
     if case.get("profile"):

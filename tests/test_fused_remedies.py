@@ -223,3 +223,20 @@ def test_threads_with_the_remedies_agree_to_round_off_and_repeat_exactly():
         u, v = getattr(one.particles, name), getattr(two.particles, name)
         assert float(np.max(np.abs(u - v))) <= 1e-12 * float(np.max(np.abs(u))), name
         assert np.array_equal(v, getattr(again.particles, name)), f"{name} changes from run to run"
+
+
+def test_the_grid_volume_on_two_threads_in_the_loop_agrees_with_one_thread_and_leaves_the_input_alone():
+    """The point mass with the grid volume reset, between walls (the compiled loop), on two threads:
+    a parallel variant of the reset once wrote out of bounds when the loop called it (NaN particles,
+    the caller's particles corrupted), though the per-step path and one thread were right."""
+    problem, particles = _gas("walls", 50)
+    kept = {name: getattr(particles, name).copy() for name in FIELDS}
+    stages = Stages(volume="grid")
+    one = run(problem, GRID, particles, stages, progress=False)
+    two, again = (run(problem, GRID, particles, stages, progress=False, threads=2) for _ in range(2))
+    assert one.steps == two.steps == again.steps == 50
+    for name in FIELDS:
+        u, v = getattr(one.particles, name), getattr(two.particles, name)
+        assert float(np.max(np.abs(u - v))) <= TOLERANCE * float(np.max(np.abs(u))), name
+        assert np.array_equal(v, getattr(again.particles, name)), f"{name} changes from run to run"
+        assert np.array_equal(getattr(particles, name), kept[name]), f"the caller's {name} changed"
