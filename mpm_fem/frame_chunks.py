@@ -115,24 +115,30 @@ def reused() -> int:
 
 def install() -> bool:
     """Put the chunk cache in front of the arena allocator (once per process; only where
-    ``NEEDED``, unless ``MPM_FEM_FRAME_CHUNKS=0``). Returns whether it is in place. The replaced allocator is put back at exit, before
-    the interpreter tears down, and the compiled code is never freed."""
+    ``NEEDED``, unless ``MPM_FEM_FRAME_CHUNKS=0``, and only if llvmlite compiles it: otherwise
+    nothing changes). Returns whether it is in place. The replaced allocator is put back at exit,
+    before the interpreter tears down, and the compiled code is never freed."""
     if _installed or not NEEDED or os.environ.get("MPM_FEM_FRAME_CHUNKS", "1") == "0":
         return installed()
-    import llvmlite.binding as llvm
+    try:  # an optimisation only: without llvmlite's JIT the interpreter keeps its own allocator
+        import llvmlite.binding as llvm
 
-    llvm.initialize_native_target()
-    llvm.initialize_native_asmprinter()
-    module = llvm.parse_assembly(_IR)
-    module.verify()
-    engine = llvm.create_mcjit_compiler(module, llvm.Target.from_default_triple().create_target_machine())
-    engine.finalize_object()
+        llvm.initialize_native_target()
+        llvm.initialize_native_asmprinter()
+        module = llvm.parse_assembly(_IR)
+        module.verify()
+        engine = llvm.create_mcjit_compiler(module, llvm.Target.from_default_triple().create_target_machine())
+        engine.finalize_object()
+        functions = engine.get_function_address("chunk_alloc"), engine.get_function_address("chunk_free")
+    except Exception:  # noqa: BLE001 - any failure leaves the interpreter as it was
+        return False
+    if not all(functions):
+        return False
     replaced = _ArenaAllocator()
     ctypes.pythonapi.PyObject_GetArenaAllocator(ctypes.byref(replaced))
     state = (ctypes.c_uint64 * (_FIRST + SLOTS))()
     state[_CTX], state[_ALLOC], state[_FREE] = replaced.ctx or 0, replaced.alloc, replaced.free
-    cache = _ArenaAllocator(ctypes.addressof(state), engine.get_function_address("chunk_alloc"),
-                            engine.get_function_address("chunk_free"))
+    cache = _ArenaAllocator(ctypes.addressof(state), *functions)
     _installed.update(engine=engine, module=module, state=state, replaced=replaced, cache=cache)
     ctypes.pythonapi.Py_IncRef(ctypes.py_object(engine))  # never freed: a chunk may be freed through it late
     ctypes.pythonapi.PyObject_SetArenaAllocator(ctypes.byref(cache))

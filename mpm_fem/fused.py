@@ -297,10 +297,9 @@ def _domain(basis, a, b, top_cell, inv_spacing, x, V):
     s_-, s_+`` (:func:`_domain_ends`), ``inv_w = 1 / (s_+ - s_-)`` (GIMP: 0 for a domain inside one
     cell, which needs no division) and the B-spline's pieces at both ends (:func:`_bspline_pieces`;
     GIMP does not read them, and the compiler drops them). A flat tuple of floats (the integers
-    exact in them): no array is handed to a helper per particle (reference counting), and numba's
-    parallel array analysis mistakes a tuple holding integers for an array shape (a tuple of tuples
-    failed to compile; this tuple with integers in it compiled, and gave NaN particles in the
-    parallel volume reset called from the loop)."""
+    exact in them), as the loop's tally: no array is handed to a helper per particle (reference
+    counting), and numba's parallel array analysis can take a tuple holding integers for an array
+    shape (a tuple of tuples holding integers failed to compile)."""
     c, s_lo, c_lo, s_hi, c_hi = _domain_ends(a, b, top_cell, inv_spacing, x, V)
     inv_w = 1.0 / (s_hi - s_lo) if basis == 3 or c_hi != c_lo else 0.0
     need = c_hi - c_lo + (4 if basis == 3 else 2)

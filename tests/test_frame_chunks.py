@@ -76,3 +76,16 @@ def test_it_stays_out_when_the_environment_says_so(monkeypatch):
         monkeypatch.delenv("MPM_FEM_FRAME_CHUNKS")
         if was:
             frame_chunks.install()
+
+
+def test_ir_that_does_not_compile_leaves_the_allocator_alone(monkeypatch):
+    was = frame_chunks.installed()
+    frame_chunks.uninstall()
+    monkeypatch.setattr(frame_chunks, "_IR", "define i8* @chunk_alloc(")
+    try:
+        assert not frame_chunks.install() and not frame_chunks.installed()
+        assert _deep(300, 2) == 2
+    finally:
+        monkeypatch.undo()
+        if was:
+            frame_chunks.install()
