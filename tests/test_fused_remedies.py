@@ -228,8 +228,8 @@ def test_threads_with_the_remedies_agree_to_round_off_and_repeat_exactly():
 @pytest.mark.slow  # compiles the parallel passes and loop of the point mass with the volume reset
 def test_the_grid_volume_on_two_threads_in_the_loop_agrees_with_one_thread_and_leaves_the_input_alone():
     """The point mass with the grid volume reset, between walls (the compiled loop), on two threads:
-    a parallel variant of the reset once wrote out of bounds when the loop called it (NaN particles,
-    the caller's particles corrupted), though the per-step path and one thread were right."""
+    a parallel variant of the reset once gave NaN particles when the loop called it (after 45 steps,
+    then at the first step of every later run), though the per-step path and one thread were right."""
     problem, particles = _gas("walls", 50)
     kept = {name: getattr(particles, name).copy() for name in FIELDS}
     stages = Stages(volume="grid")
