@@ -272,13 +272,13 @@ def _bspline_pieces(y, c):
 
     (left of them ``M = M(3/2)``, right of them 0; ``N = 0``; the pieces agree where they meet).
     Three divisions instead of the formula's fifteen at the five nodes of a row. Returns ``first``,
-    the three ``M``, then the three ``N``, all floats (:func:`_domain`)."""
+    the three ``M``, then the three ``N``."""
     first = 0 if y - c < 0.5 else 1
     nearest = c + first
     w = 1.5 - (y - (nearest - 1))
     r = y - nearest
     u = (y - (nearest + 1)) + 1.5
-    return (float(first), _M_ABOVE + (1.0 - w * w * w) / 6.0, _SIXTH + (0.75 * (r + 0.5) - (r * r * r + 0.125) / 3.0),
+    return (first, _M_ABOVE + (1.0 - w * w * w) / 6.0, _SIXTH + (0.75 * (r + 0.5) - (r * r * r + 0.125) / 3.0),
             u * u * u / 6.0, 0.5 * (w * w), 0.75 - r * r, 0.5 * (u * u))
 
 
@@ -296,14 +296,13 @@ def _domain(basis, a, b, top_cell, inv_spacing, x, V):
     needs (GIMP ``c_+ - c_- + 2``, the B-spline ``c_+ - c_- + 4``), the domain's ends ``c_-, c_+,
     s_-, s_+`` (:func:`_domain_ends`), ``inv_w = 1 / (s_+ - s_-)`` (GIMP: 0 for a domain inside one
     cell, which needs no division) and the B-spline's pieces at both ends (:func:`_bspline_pieces`;
-    GIMP does not read them, and the compiler drops them). A flat tuple of floats (the integers
-    exact in them), as the loop's tally: no array is handed to a helper per particle (reference
-    counting), and numba's parallel array analysis can take a tuple holding integers for an array
-    shape (a tuple of tuples holding integers failed to compile)."""
+    GIMP does not read them, and the compiler drops them). A flat tuple, so that no array is handed
+    to a helper per particle (reference counting); a tuple of tuples failed to compile in numba's
+    parallel variants."""
     c, s_lo, c_lo, s_hi, c_hi = _domain_ends(a, b, top_cell, inv_spacing, x, V)
     inv_w = 1.0 / (s_hi - s_lo) if basis == 3 or c_hi != c_lo else 0.0
     need = c_hi - c_lo + (4 if basis == 3 else 2)
-    return ((float(c), float(need), float(c_lo), float(c_hi), s_lo, s_hi, inv_w)
+    return ((c, need, c_lo, c_hi, s_lo, s_hi, inv_w)
             + _bspline_pieces(s_lo, c_lo) + _bspline_pieces(s_hi, c_hi))
 
 
@@ -315,9 +314,8 @@ def _domain_column(basis, k, inv_spacing, last, D):
     M(s_- - j)) / (s_+ - s_-)``, ``G = (N(s_+ - j) - N(s_- - j)) / (x_+ - x_-)``, ``M`` and ``N`` at
     each end from its pieces (:func:`_piece`: the columns where each end's three splines start are
     ``d_-`` and ``d_+ + c_+ - c_-``)."""
-    (_, _, lo, hi, s_lo, s_hi, inv_w, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo,
+    (_, _, c_lo, c_hi, s_lo, s_hi, inv_w, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo,
      d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi) = D
-    c_lo, c_hi = int(lo), int(hi)
     if basis == 1:
         return _gimp_entry(k, s_lo, c_lo, s_hi, c_hi, inv_w, inv_spacing, last)
     d_hi += c_hi - c_lo
@@ -334,7 +332,7 @@ def _uniform_domain_row(basis, nodes, inv_spacing, x, V, row, S, G):
     D = _domain(basis, nodes[0], nodes[n_nodes - 1], n_nodes - 2, inv_spacing, x, V)
     for k in range(row.size):
         row[k], S[k], G[k] = _domain_column(basis, k, inv_spacing, n_nodes - 1, D)
-    return int(D[0]), int(D[1])
+    return D[0], D[1]
 
 
 @njit(cache=True, inline="always")
@@ -729,10 +727,10 @@ def _project_domain(basis, nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi,
                 empty = q
             continue
         D = _domain(basis, a, b, n_nodes - 2, inv_spacing, x[q], V[q])
-        need = max(need, int(D[1]))
+        need = max(need, D[1])
         for k in range(K):
             rows[q, k], S[q, k], G[q, k] = _domain_column(basis, k, inv_spacing, n_nodes - 1, D)
-        cell[q] = int(D[0])
+        cell[q] = D[0]
     for q in range(lo, hi):
         if not (x[q] >= a and x[q] <= b and V[q] > 0):
             continue
@@ -992,7 +990,7 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
         for q in range(*_chunk(n, chunks, k)):
             if fresh:
                 D = _domain(domain, a, b, last - 1, inv_spacing, x[q], V[q])
-                need = max(need, int(D[1]))
+                need = max(need, D[1])
                 for j in range(width):
                     i, s, _ = _domain_column(domain, j, inv_spacing, last, D)
                     buf[k, 0, i] += s * V[q]
