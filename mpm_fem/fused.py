@@ -366,12 +366,14 @@ def _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G):
 
 
 @njit(cache=True, inline="always")
-def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
-    """``S_ip``, ``G_ip`` of one particle into ``row``, ``S``, ``G`` (length K); returns its cell and
-    the K it needs (GIMP: ``c_hi - c_lo + 2``; the caller reruns with that K if it differs). ``h``
-    holds the cell sizes ``h_c`` and ``1 / h_c`` (the numpy step's ``1 / h_c``, computed once)."""
+def _point_row(basis, nodes, h, inv_spacing, x, row, S, G):
+    """``S_ip``, ``G_ip`` of one particle of a point basis (point mass, ``basis`` 0; the B-spline, 2)
+    into ``row``, ``S``, ``G``; returns its cell and the K it needs (2, 4). ``h`` holds the cell
+    sizes ``h_c`` and ``1 / h_c`` (the numpy step's ``1 / h_c``, computed once). The passes pick
+    this or :func:`_domain_shape_row` by the compile-time ``BASIS``, so that a variant never holds
+    the other's code: a branch on a helper's argument is pruned only after the helpers are inlined,
+    and the dead rows of the other bases made the cold compile of a pass up to 14 times longer."""
     n_nodes = nodes.size
-    K = row.size
     if basis == 0:  # point mass: S = (1 - xi, xi), G = (-1, 1)/h_c
         c, xi, inv_h = _point(nodes, h, inv_spacing, x)
         row[0], row[1] = c, c + 1
@@ -389,22 +391,31 @@ def _shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
         S[first], S[first + 1], S[first + 2] = w_l, w_0, w_r
         G[first], G[first + 1], G[first + 2] = (t - 0.5) * inv_spacing, (-2.0 * t) * inv_spacing, (t + 0.5) * inv_spacing
         return c, 4
-    if basis == 2:  # quadratic B-spline at the nodes c-1 .. c+2, ghosts folded into the ends
-        c, xi = _locate(nodes, inv_spacing, x)
-        for k in range(4):
-            r = xi - (k - 1)
-            a = abs(r)
-            if a <= 0.5:
-                value, slope = 0.75 - r * r, -2.0 * r
-            elif a < 1.5:
-                value = 0.5 * ((1.5 - a) * (1.5 - a))
-                slope = -(1.5 - a) * (1.0 if r > 0 else (-1.0 if r < 0 else 0.0))
-            else:
-                value, slope = 0.0, 0.0
-            row[k] = min(max(c + k - 1, 0), n_nodes - 1)
-            S[k] = value
-            G[k] = slope / h[0, 0]
-        return c, 4
+    # a grid not uniform: the quadratic B-spline at the nodes c-1 .. c+2, ghosts folded into the ends
+    c, xi = _locate(nodes, inv_spacing, x)
+    for k in range(4):
+        r = xi - (k - 1)
+        a = abs(r)
+        if a <= 0.5:
+            value, slope = 0.75 - r * r, -2.0 * r
+        elif a < 1.5:
+            value = 0.5 * ((1.5 - a) * (1.5 - a))
+            slope = -(1.5 - a) * (1.0 if r > 0 else (-1.0 if r < 0 else 0.0))
+        else:
+            value, slope = 0.0, 0.0
+        row[k] = min(max(c + k - 1, 0), n_nodes - 1)
+        S[k] = value
+        G[k] = slope / h[0, 0]
+    return c, 4
+
+
+@njit(cache=True, inline="always")
+def _domain_shape_row(basis, nodes, h, inv_spacing, x, V, row, S, G):
+    """``S_ip``, ``G_ip`` of one particle of a particle-domain basis (GIMP, ``basis`` 1; the
+    particle-domain B-spline, 3) into ``row``, ``S``, ``G`` (length K); returns its cell and the K
+    it needs (GIMP: ``c_hi - c_lo + 2``; the caller reruns with that K if it differs)."""
+    n_nodes = nodes.size
+    K = row.size
     if basis == 3:
         return _bspline_domain_row(nodes, h, inv_spacing, x, V, row, S, G)
     # GIMP: hats averaged over [x - V/2, x + V/2], cut at the ends of the grid
@@ -477,16 +488,21 @@ _chunk = njit(cache=True, inline="always")(_chunk)
 
 
 @njit(cache=True, inline="always")
-def _row(basis, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl):
-    """Particle q's nodes and weights into ``r``, ``Sl``, ``Gl``, and its cell: recomputed from
-    ``x_q^n`` (point mass, B-spline: the same numbers as pass 1, and cheaper than reading them back)
-    or read from pass 1's rows (GIMP)."""
-    if basis == 1 or basis == 3:
-        for j in range(r.size):
-            r[j], Sl[j], Gl[j] = rows[q, j], S[q, j], G[q, j]
-        return cell[q]
-    c, _ = _shape_row(basis, nodes, h, inv_spacing, x[q], 0.0, r, Sl, Gl)
+def _recomputed_row(basis, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl):
+    """Particle q's nodes and weights into ``r``, ``Sl``, ``Gl``, and its cell, recomputed from
+    ``x_q^n`` (point mass, B-spline: the same numbers as pass 1, and cheaper than reading them back).
+    ``ROW`` of the point bases' passes (:func:`_compile`)."""
+    c, _ = _point_row(basis, nodes, h, inv_spacing, x[q], r, Sl, Gl)
     return c
+
+
+@njit(cache=True, inline="always")
+def _stored_row(basis, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl):
+    """Particle q's nodes and weights into ``r``, ``Sl``, ``Gl``, and its cell, read from pass 1's
+    rows (GIMP, the particle-domain B-spline). ``ROW`` of the domain bases' passes (:func:`_compile`)."""
+    for j in range(r.size):
+        r[j], Sl[j], Gl[j] = rows[q, j], S[q, j], G[q, j]
+    return cell[q]
 
 
 # --------------------------------------------------------------------------- the passes
@@ -651,7 +667,7 @@ def _project_bspline(nodes, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi
         n, t, w_l, w_0, w_r = _bspline_nearest(s, top)
         g_l, g_0, g_r = (t - 0.5) * inv_spacing, (-2.0 * t) * inv_spacing, (t + 0.5) * inv_spacing
         cell[q] = c
-        if store:  # the row c-1 .. c+2, as _shape_row stores it
+        if store:  # the row c-1 .. c+2, as _point_row stores it
             first = n - c
             for k in range(4):
                 rows[q, k], S[q, k], G[q, k] = min(max(c + k - 1, 0), top), 0.0, 0.0
@@ -782,7 +798,10 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
                 if empty < 0:
                     empty = q
                 continue
-            c, kq = _shape_row(BASIS, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
+            if BASIS == 0 or BASIS == 2:
+                c, kq = _point_row(BASIS, nodes, h, inv_spacing, x[q], r, Sl, Gl)
+            else:
+                c, kq = _domain_shape_row(BASIS, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
             cell[q] = c
             need = max(need, kq)
             if store:
@@ -822,7 +841,7 @@ def _scatter_pass(nodes, h, inv_spacing, x, rows, S, G, cell, f_i, a, b, coef, c
     for k in prange(chunks):
         r, Sl, Gl = _one_row(K)
         for q in range(*_chunk(n, chunks, k)):
-            _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             if WEIGHT == PRESSURE:
                 _scatter(buf, k, r, Gl, a[q] * b[q], K)
             elif WEIGHT == VISCOUS_STRESS:
@@ -845,7 +864,7 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
         tally = _NO_TALLY
         r, Sl, Gl = _one_row(K)
         for q in range(*_chunk(n, chunks, k)):
-            c = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            c = ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             L = _gather(Gl, v_i, r, K)
             tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts,
                                tally)
@@ -920,7 +939,7 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
                                   x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally)
             lo = hi
         for q in range(lo, hi):
-            cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            cq = ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             acc = Sl[0] * a_i[r[0]]
             vel = Sl[0] * v_n[r[0]]
             for j in range(1, K):
@@ -949,19 +968,26 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
 
 
 @njit(cache=True, inline="always")
-def _domain_row(basis, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl):
-    """Particle q's row ``Sbar_ip`` of the volume reset (:mod:`mpm_fem.volume`) into ``r``, ``Sl``:
-    the step's own stored row (GIMP, particle-domain B-spline), or the domain average of the point
-    basis' grid functions at ``x_q``, ``V_q`` (point mass: GIMP; B-spline: the particle-domain
-    B-spline), in ``r.size`` columns (columns past a domain's nodes have zero weight). Returns the
-    width the row needs (more than ``r.size``: the caller retries wider). On a uniform grid the
-    point bases' rows come from scalars instead (:func:`_volume_reset`)."""
-    if basis == 1 or basis == 3:
-        for j in range(r.size):
-            r[j], Sl[j] = rows[q, j], S[q, j]
-        return r.size
-    _, need = _shape_row(1 if basis == 0 else 3, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
-    return need
+def _domain_volume(basis, a, b, last, inv_spacing, x, V, width, buf, k):
+    """``buf[k, 0, i] += Sbar_i V_p`` over the ``width`` columns of a particle's domain row on a
+    uniform grid (:func:`_domain`, :func:`_domain_column`); returns the K the row needs."""
+    D = _domain(basis, a, b, last - 1, inv_spacing, x, V)
+    for j in range(width):
+        i, s, _ = _domain_column(basis, j, inv_spacing, last, D)
+        buf[k, 0, i] += s * V
+    return D[1]
+
+
+@njit(cache=True, inline="always")
+def _domain_factor(basis, a, b, last, inv_spacing, x, V, width, ratio):
+    """``sum_j Sbar_j ratio_{i_j}`` over a particle's domain row on a uniform grid, left to right
+    (:func:`_gather`'s order)."""
+    D = _domain(basis, a, b, last - 1, inv_spacing, x, V)
+    f = 0.0
+    for j in range(width):
+        i, s, _ = _domain_column(basis, j, inv_spacing, last, D)
+        f = s * ratio[i] if j == 0 else f + s * ratio[i]
+    return f
 
 
 def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks, width,
@@ -976,26 +1002,26 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
     ``values[k, 0]`` that density or volume."""
     n = x.size
     gas = MODEL == GAS
-    # the point bases on a uniform grid: their domain rows (GIMP, the particle-domain B-spline) from
-    # scalars, in the loop (_domain, _domain_column), as pass 1 of those bases builds them. Both
-    # flags without a branch: in a parallel variant, a variable set in branches before a prange loop
-    # (`1 if BASIS == 0 else 3`, `... and ...`) gave NaN particles when the loop called it (numba 0.68.1)
-    fresh = (BASIS % 2 == 0) & (inv_spacing > 0.0)
-    domain = 1 + 2 * (BASIS // 2)
+    # Sbar_ip: the step's stored rows (the domain bases), or the rows of DOMAIN (the point bases: GIMP
+    # for the point mass, the particle-domain B-spline for the B-spline; _compile), on a uniform grid
+    # from scalars as pass 1 of those bases builds them. The basis is tested in the loop, on the
+    # compile-time constants: flags set in branches before a prange loop (`fresh = ... and ...`)
+    # gave NaN particles in a parallel variant called by the loop (numba 0.68.1)
     a, b, last = nodes[0], nodes[nodes.size - 1], nodes.size - 1
     buf = np.zeros((chunks, 1, V_i.size))
     for k in prange(chunks):
         r, Sl, Gl = _one_row(width)
         need = 0
         for q in range(*_chunk(n, chunks, k)):
-            if fresh:
-                D = _domain(domain, a, b, last - 1, inv_spacing, x[q], V[q])
-                need = max(need, D[1])
+            if BASIS == 1 or BASIS == 3:  # the step's own rows
+                need = width
                 for j in range(width):
-                    i, s, _ = _domain_column(domain, j, inv_spacing, last, D)
-                    buf[k, 0, i] += s * V[q]
+                    r[j], Sl[j] = rows[q, j], S[q, j]
+                _scatter(buf, k, r, Sl, V[q], width)
+            elif inv_spacing > 0.0:
+                need = max(need, _domain_volume(DOMAIN, a, b, last, inv_spacing, x[q], V[q], width, buf, k))
             else:
-                need = max(need, _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl))
+                need = max(need, _domain_shape_row(DOMAIN, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)[1])
                 _scatter(buf, k, r, Sl, V[q], width)
         flags[k, 1] = need
     _sum_chunks(buf, 0, V_i, 1.0)
@@ -1005,15 +1031,14 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
         r, Sl, Gl = _one_row(width)
         bad, value = -1.0, 0.0
         for q in range(*_chunk(n, chunks, k)):
-            if fresh:  # sum_j Sbar_qj ratio_j, left to right (_gather's order)
-                D = _domain(domain, a, b, last - 1, inv_spacing, x[q], V[q])
-                f = 0.0
+            if BASIS == 1 or BASIS == 3:
                 for j in range(width):
-                    i, s, _ = _domain_column(domain, j, inv_spacing, last, D)
-                    f = s * ratio[i] if j == 0 else f + s * ratio[i]
-                V_r[q] = V[q] * f
+                    r[j], Sl[j] = rows[q, j], S[q, j]
+                V_r[q] = V[q] * _gather(Sl, ratio, r, width)
+            elif inv_spacing > 0.0:
+                V_r[q] = V[q] * _domain_factor(DOMAIN, a, b, last, inv_spacing, x[q], V[q], width, ratio)
             else:
-                _domain_row(BASIS, nodes, h, inv_spacing, x, V, q, rows, S, r, Sl, Gl)
+                _domain_shape_row(DOMAIN, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
                 V_r[q] = V[q] * _gather(Sl, ratio, r, width)
             if gas:
                 rho_r[q] = m[q] / V_r[q]
@@ -1045,7 +1070,7 @@ def _taylor_force(nodes, h, inv_spacing, x, rows, S, G, cell, p, v_i, eps, point
             if gas:
                 sigma = -p[q]
             else:
-                _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+                ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
                 sigma = eps * _gather(Gl, v_i, r, K)
             c, xi = _locate(nodes, inv_spacing, x[q])
             d = xi - 0.5
@@ -1083,7 +1108,7 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
         r, Sl, Gl = _one_row(K)
         tally = _NO_TALLY
         for q in range(*_chunk(n, chunks, k)):
-            cq = _row(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            cq = ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[0, cq], V, m, rho, e, p,
                                V_new, m_new, rho_new, e_new, p_new, consts, tally)
             tally = _checked(gas, q, tally[6], x_new, v, rho_new, e_new, p_new, V_new, tally)
@@ -1307,6 +1332,9 @@ def _compile(fn, parallel, passes=None, **constants):
     the loop calls)."""
     suffix = "".join(f"_{k.lower()}{v}" for k, v in constants.items()) + ("_parallel" if parallel else "")
     scope = dict(fn.__globals__, **constants, **(passes or {}))
+    if "BASIS" in constants:  # ROW: pass 2's row, read back or recomputed; DOMAIN: the domain basis whose
+        basis = constants["BASIS"]  # rows the grid volume reset averages over (the point bases': GIMP, the
+        scope.update(ROW=_stored_row if basis % 2 else _recomputed_row, DOMAIN=basis | 1)  # particle-domain B-spline)
     variant = types.FunctionType(fn.__code__, scope, fn.__name__ + suffix, fn.__defaults__)
     variant.__qualname__ = variant.__name__
     return njit(cache=True, parallel=parallel)(variant)
@@ -1321,6 +1349,7 @@ def _nodal_rows(xpic_on, volume_on):
     MUSL's ``P_i``; XPIC's ``P``, term, ``v*`` and target if it runs; the volume reset's ``V_i`` and
     ratio if it runs (a plain run allocates 7; the reset's first is ``_nodal_rows(XPIC_ON, 0)``)."""
     return 7 + 4 * xpic_on + 2 * volume_on
+ROW = DOMAIN = None  # per compiled variant of a basis (_compile)
 PROJECT = VISCOUS = UPDATE = MOVE = FINISH = GAS_FORCE = XPIC = VOLUME = TAYLOR = None  # the passes a compiled _advance calls
 _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
 _FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")  # Particles' names, same order
