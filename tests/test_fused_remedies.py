@@ -225,7 +225,8 @@ def test_threads_with_the_remedies_agree_to_round_off_and_repeat_exactly():
         assert np.array_equal(v, getattr(again.particles, name)), f"{name} changes from run to run"
 
 
-@pytest.mark.slow  # compiles the parallel passes and loop of the point mass with the volume reset
+# fast: the one two-thread run of the fast set (the parallel passes of the point mass and its volume
+# reset compile in about a minute); the other thread tests are slow
 def test_the_grid_volume_on_two_threads_in_the_loop_agrees_with_one_thread_and_leaves_the_input_alone():
     """The point mass with the grid volume reset, between walls (the compiled loop), on two threads:
     a parallel variant of the reset once gave NaN particles when the loop called it (after 45 steps,
