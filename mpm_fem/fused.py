@@ -967,29 +967,6 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
         _sum_chunks(buf, 0, P_i, 1.0)
 
 
-@njit(cache=True, inline="always")
-def _domain_volume(basis, a, b, last, inv_spacing, x, V, width, buf, k):
-    """``buf[k, 0, i] += Sbar_i V_p`` over the ``width`` columns of a particle's domain row on a
-    uniform grid (:func:`_domain`, :func:`_domain_column`); returns the K the row needs."""
-    D = _domain(basis, a, b, last - 1, inv_spacing, x, V)
-    for j in range(width):
-        i, s, _ = _domain_column(basis, j, inv_spacing, last, D)
-        buf[k, 0, i] += s * V
-    return D[1]
-
-
-@njit(cache=True, inline="always")
-def _domain_factor(basis, a, b, last, inv_spacing, x, V, width, ratio):
-    """``sum_j Sbar_j ratio_{i_j}`` over a particle's domain row on a uniform grid, left to right
-    (:func:`_gather`'s order)."""
-    D = _domain(basis, a, b, last - 1, inv_spacing, x, V)
-    f = 0.0
-    for j in range(width):
-        i, s, _ = _domain_column(basis, j, inv_spacing, last, D)
-        f = s * ratio[i] if j == 0 else f + s * ratio[i]
-    return f
-
-
 def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks, width,
                   V_i, ratio, V_r, rho_r, p_r, flags, values):
     """The grid volume reset (:func:`mpm_fem.volume.grid_volume_factor`, then the model's
@@ -1006,7 +983,8 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
     # for the point mass, the particle-domain B-spline for the B-spline; _compile), on a uniform grid
     # from scalars as pass 1 of those bases builds them. The basis is tested in the loop, on the
     # compile-time constants: flags set in branches before a prange loop (`fresh = ... and ...`)
-    # gave NaN particles in a parallel variant called by the loop (numba 0.68.1)
+    # gave NaN particles in a parallel variant called by the loop (numba 0.68.1). The scalar rows
+    # are written out here: an inlined helper handed `buf` or `ratio` cost 16 ns per particle-step
     a, b, last = nodes[0], nodes[nodes.size - 1], nodes.size - 1
     buf = np.zeros((chunks, 1, V_i.size))
     for k in prange(chunks):
@@ -1019,7 +997,11 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
                     r[j], Sl[j] = rows[q, j], S[q, j]
                 _scatter(buf, k, r, Sl, V[q], width)
             elif inv_spacing > 0.0:
-                need = max(need, _domain_volume(DOMAIN, a, b, last, inv_spacing, x[q], V[q], width, buf, k))
+                D = _domain(DOMAIN, a, b, last - 1, inv_spacing, x[q], V[q])
+                need = max(need, D[1])
+                for j in range(width):
+                    i, s, _ = _domain_column(DOMAIN, j, inv_spacing, last, D)
+                    buf[k, 0, i] += s * V[q]
             else:
                 need = max(need, _domain_shape_row(DOMAIN, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)[1])
                 _scatter(buf, k, r, Sl, V[q], width)
@@ -1035,8 +1017,13 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
                 for j in range(width):
                     r[j], Sl[j] = rows[q, j], S[q, j]
                 V_r[q] = V[q] * _gather(Sl, ratio, r, width)
-            elif inv_spacing > 0.0:
-                V_r[q] = V[q] * _domain_factor(DOMAIN, a, b, last, inv_spacing, x[q], V[q], width, ratio)
+            elif inv_spacing > 0.0:  # sum_j Sbar_qj ratio_j, left to right (_gather's order)
+                D = _domain(DOMAIN, a, b, last - 1, inv_spacing, x[q], V[q])
+                f = 0.0
+                for j in range(width):
+                    i, s, _ = _domain_column(DOMAIN, j, inv_spacing, last, D)
+                    f = s * ratio[i] if j == 0 else f + s * ratio[i]
+                V_r[q] = V[q] * f
             else:
                 _domain_shape_row(DOMAIN, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
                 V_r[q] = V[q] * _gather(Sl, ratio, r, width)
