@@ -44,6 +44,8 @@ def grid_mesh(grid: Grid, state: GridState) -> meshio.Mesh:
 class FieldWriter:
     """Observer writing snapshots every ``every`` steps (and at the first step) into ``folder``."""
 
+    keeps_particles = False  # it writes what it is handed at once (mpm_fem.solve.run may reuse the arrays)
+
     def __init__(self, folder, grid: Grid, every: int = 20):
         if every < 1:
             raise ValueError(f"fields are written every EVERY >= 1 steps, got {every}")

@@ -33,6 +33,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from .grid import Grid
 from .particles import Particles
@@ -137,8 +138,32 @@ def strict_extrema(q: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
     return out
 
 
-def _cell(grid: Grid, x: np.ndarray) -> np.ndarray:
-    return np.clip(np.searchsorted(grid.nodes, x, side="right") - 1, 0, grid.n_cells - 1)
+def cells(nodes: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The cell of every point, ``clip(searchsorted(nodes, x, "right") - 1, 0, n_cells - 1)``
+    (the readable form; :func:`_cells` is the one a run calls per step)."""
+    return np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, nodes.size - 2)
+
+
+@njit(cache=True)
+def _cells(nodes, x):
+    """:func:`cells` compiled: for each point the last node ``j`` with ``nodes[j] <= x`` (-1 if
+    none; the last node for NaN, where ``searchsorted`` sorts it), clipped to the cells, found by
+    walking from the previous point's node. The particles are nearly in position order, so a step
+    costs O(particles + nodes), not a binary search per particle: the same integers."""
+    m = nodes.size
+    out = np.empty(x.size, np.intp)
+    j = -1  # the last node <= the previous point
+    for p in range(x.size):
+        y = x[p]
+        if y != y:
+            j = m - 1
+        else:
+            while j + 1 < m and nodes[j + 1] <= y:
+                j += 1
+            while j >= 0 and not (nodes[j] <= y):
+                j -= 1
+        out[p] = min(max(j, 0), m - 2)
+    return out
 
 
 def _in_order(q: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
@@ -149,9 +174,23 @@ def _in_order(q: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | No
     return q[order], order
 
 
+@njit(cache=True)
+def _strict_extrema(q, rtol):
+    """:func:`strict_extrema` of ordered finite values, compiled (one pass, no temporaries): the same
+    comparisons of the same floats, so the same mask (a run's particles are finite: it stops on the
+    first that is not)."""
+    n = q.size
+    out = np.zeros(n, np.bool_)
+    for k in range(1, n - 1):
+        left, mid, right = q[k - 1], q[k], q[k + 1]
+        tol = rtol * max(max(abs(left), abs(mid)), abs(right))
+        out[k] = mid > max(left, right) + tol or mid < min(left, right) - tol
+    return out
+
+
 def _extrema_in_particle_order(q: np.ndarray, x: np.ndarray, rtol: float) -> np.ndarray:
     ordered, order = _in_order(q, x)
-    mask = strict_extrema(ordered, rtol)
+    mask = _strict_extrema(np.ascontiguousarray(ordered, dtype=float), float(rtol))
     if order is None:
         return mask
     out = np.empty_like(mask)
@@ -162,7 +201,10 @@ def _extrema_in_particle_order(q: np.ndarray, x: np.ndarray, rtol: float) -> np.
 @dataclass(eq=False)
 class ExtremaCounter:
     """An observer for :func:`mpm_fem.solve.run` that counts new extrema of density and energy
-    per step (module docstring). After the run, :meth:`summary` gives the totals."""
+    per step (module docstring). After the run, :meth:`summary` gives the totals. It keeps no
+    particles (``keeps_particles``): a run may hand it arrays it overwrites two steps later."""
+
+    keeps_particles = False  # a class attribute, not a field: what solve.run asks of an observer
 
     grid: Grid
     rtol: float = 1e-9
@@ -180,9 +222,9 @@ class ExtremaCounter:
         if self._last is not None and self._last[0] is old:
             old_cell, before = self._last[1], self._last[2]
         else:
-            old_cell = _cell(self.grid, old.x)
+            old_cell = _cells(self.grid.nodes, old.x)
             before = {n: _extrema_in_particle_order(getattr(old, n), old.x, self.rtol) for n in self.fields}
-        new_cell = _cell(self.grid, new.x)
+        new_cell = _cells(self.grid.nodes, new.x)
         after = {n: _extrema_in_particle_order(getattr(new, n), new.x, self.rtol) for n in self.fields}
         self._last = (new, new_cell, after)
         crossed = old_cell != new_cell

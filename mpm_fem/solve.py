@@ -114,6 +114,14 @@ def _particle_boundary(problem: Problem, grid: Grid, particles: Particles, t: fl
     return new
 
 
+def _keeps_particles(observer: Observer | None) -> bool:
+    """Whether ``observer`` may keep the particles it is handed beyond its call: yes unless it says
+    otherwise (``keeps_particles = False``, as :class:`~mpm_fem.regions.ExtremaCounter`). The fused
+    step then writes into two alternating sets of arrays (:class:`~mpm_fem.fused.FusedStep`'s
+    ``reuse``) instead of fresh ones, which cost a page fault per page on every step."""
+    return observer is not None and getattr(observer, "keeps_particles", True) is not False
+
+
 def run(
     problem: Problem,
     grid: Grid,
@@ -130,12 +138,14 @@ def run(
     ``kernel="fused"`` steps with the compiled :class:`~mpm_fem.fused.FusedStep` (on ``threads``
     threads) wherever it supports the model and stages, the numpy :func:`explicit_step` otherwise;
     ``kernel="numpy"`` always steps with :func:`explicit_step`. Both take the same steps (bit for
-    bit on one thread)."""
+    bit on one thread). ``observer(step, t, old, new, state)`` is called after every step, which
+    then runs one at a time rather than in compiled loops; the particles it is handed stay valid
+    only for the call if it says it keeps none (:func:`_keeps_particles`)."""
     check_kernel(kernel, threads)
     fused = None
     if kernel == "fused" and supported(problem.model, stages) is None:
         fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads,
-                          reuse=observer is None)  # an observer may keep the particles of every step
+                          reuse=not _keeps_particles(observer))
     # walls or Dirichlet ends, lumped mass, no observer, and no particle boundary or one that says
     # when it acts: steps in compiled loops of about LOOP_WORK particle-steps each (the bar and
     # Ctrl-C are served between them); a loop stops after a step the particle boundary acts on
