@@ -1419,7 +1419,8 @@ class FusedStep:
     and ``finite`` whether their state is finite, for the time step and the run's checks. With
     ``reuse`` the step writes into two alternating sets of arrays instead of fresh ones (no page
     faults on a new 8 MB array per field and step): the particles a step returns are overwritten
-    two steps later, so a run that hands them to an observer does not reuse."""
+    two steps later, so a run that hands them to an observer reuses only if the observer keeps none
+    of them (:func:`mpm_fem.solve._keeps_particles`)."""
 
     def __init__(self, grid: Grid, model, boundary, stages: Stages = Stages(), exact_acceleration=None,
                  threads: int = 1, reuse: bool = False):

@@ -152,6 +152,8 @@ class Recorder:
     not leave, with inflow particles appended at the end).
     """
 
+    keeps_particles = False  # it copies the particle's numbers and the nodal accelerations at once
+
     def __init__(self, index: int):
         self.index = index
         self.rows: list[tuple] = []

@@ -1,6 +1,6 @@
-"""The new-extrema observer's compiled kernels (mpm_fem/regions.py) equal to their numpy forms, and a
-run handing the observer reused arrays (``keeps_particles = False``) counting what a run with fresh
-arrays counts."""
+"""The new-extrema observer's compiled kernels (mpm_fem/regions.py) equal to their numpy forms, and
+runs handing an observer reused arrays (``keeps_particles = False``: the extrema counter, the time
+study's recorder) seeing what runs with fresh arrays see."""
 
 import numpy as np
 import pytest
@@ -8,9 +8,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mpm_fem.grid import Grid, uniform_grid
-from mpm_fem.problems import sod
+from mpm_fem.problems import burgers, sod
 from mpm_fem.regions import ExtremaCounter, _cells, _strict_extrema, cells, strict_extrema
 from mpm_fem.solve import _keeps_particles
+from mpm_fem.timing import Recorder
 
 NODES = uniform_grid(0.0, 1.0, 0.1).nodes
 STRETCHED = np.array([0.0, 0.05, 0.3, 0.31, 0.7, 1.0])
@@ -38,13 +39,14 @@ def test_only_an_observer_that_says_so_is_handed_reused_arrays():
     assert _keeps_particles(lambda *args: None)
     assert not _keeps_particles(None)
     assert not _keeps_particles(ExtremaCounter(uniform_grid(0.0, 1.0, 0.1)))
+    assert not _keeps_particles(Recorder(3))
 
 
 class _Keeping:
-    """The same counter behind an observer that does not say it keeps no particles: fresh arrays."""
+    """The same observer behind one that does not say it keeps no particles: fresh arrays."""
 
-    def __init__(self, grid: Grid):
-        self.counter = ExtremaCounter(grid)
+    def __init__(self, observer):
+        self.counter = observer
 
     def __call__(self, *args):
         self.counter(*args)
@@ -55,7 +57,7 @@ def test_a_run_on_reused_arrays_counts_the_extrema_a_run_on_fresh_arrays_counts(
     are the same whether the fused step reuses its arrays or not."""
     settings_ = sod.SodSettings(h=0.01, ppc=16, cfl=0.05)
     grid = uniform_grid(0.0, 1.0, 0.01)
-    reused, fresh = ExtremaCounter(grid), _Keeping(grid)
+    reused, fresh = ExtremaCounter(grid), _Keeping(ExtremaCounter(grid))
     a = sod.simulate(settings_, progress=False, observer=reused)
     b = sod.simulate(settings_, progress=False, observer=fresh)
     assert reused.summary() == fresh.counter.summary()
@@ -63,3 +65,16 @@ def test_a_run_on_reused_arrays_counts_the_extrema_a_run_on_fresh_arrays_counts(
     assert reused.summary()["density"]["new_at_crossing"] > 0  # it counts something
     for name in ("x", "velocity", "density", "energy", "pressure", "volume"):
         assert np.array_equal(getattr(a.particles, name), getattr(b.particles, name)), name
+
+
+def test_the_recorder_on_reused_arrays_records_what_it_records_on_fresh_arrays():
+    """Burgers with its Dirichlet ends and reservoir (the time study's case, shortened): the same
+    track, the particle's numbers and the nodal accelerations of every step."""
+    settings_ = burgers.BurgersSettings(h=0.02, T=0.05)
+    reused, fresh = Recorder(7), _Keeping(Recorder(7))
+    burgers.simulate(settings_, progress=False, observer=reused)
+    burgers.simulate(settings_, progress=False, observer=fresh)
+    a, b = reused.track(), fresh.counter.track()
+    assert a.t.size == b.t.size > 20
+    for name in ("t", "x", "v", "a_nodes"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
