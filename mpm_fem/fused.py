@@ -325,6 +325,34 @@ def _domain_column(basis, k, inv_spacing, last, D):
 
 
 @njit(cache=True, inline="always")
+def _five(d, left, a, b, c):
+    """:func:`_piece` at columns 0 .. 4 for a start ``d`` in 0 .. 2, by selecting (``left`` before
+    the three values, 0 after them): the same floats, without :func:`_piece`'s four compares per
+    column. A larger ``d`` (a row wider than five, which the caller rejects) gives a finite row."""
+    return (a if d == 0 else left, b if d == 0 else (a if d == 1 else left), c if d == 0 else (b if d == 1 else a),
+            0.0 if d == 0 else (c if d == 1 else b), c if d == 2 else 0.0)
+
+
+@njit(cache=True, inline="always")
+def _bspline_domain_five(inv_spacing, D):
+    """``S`` and ``G`` of the particle-domain B-spline's five columns (K = 5: a domain within two
+    cells) from its :func:`_domain` scalars ``D``, as a flat tuple ``S_0 .. S_4, G_0 .. G_4`` (a tuple
+    of tuples fails to compile in the parallel variants): :func:`_domain_column`'s values, column for column
+    the same floats, with :func:`_five` placing each end's three pieces (the low end's start ``d_-``
+    is 0 or 1, the high end's ``d_+ + c_+ - c_-`` is 0 .. 2)."""
+    (_, _, c_lo, c_hi, _, _, inv_w, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo,
+     d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi) = D
+    d_hi += c_hi - c_lo
+    A0, A1, A2, A3, A4 = _five(d_lo, _M_TOP, Ml_lo, M0_lo, Mr_lo)
+    B0, B1, B2, B3, B4 = _five(d_hi, _M_TOP, Ml_hi, M0_hi, Mr_hi)
+    a0, a1, a2, a3, a4 = _five(d_lo, 0.0, Nl_lo, N0_lo, Nr_lo)
+    b0, b1, b2, b3, b4 = _five(d_hi, 0.0, Nl_hi, N0_hi, Nr_hi)
+    g = inv_w * inv_spacing
+    return ((B0 - A0) * inv_w, (B1 - A1) * inv_w, (B2 - A2) * inv_w, (B3 - A3) * inv_w, (B4 - A4) * inv_w,
+            (b0 - a0) * g, (b1 - a1) * g, (b2 - a2) * g, (b3 - a3) * g, (b4 - a4) * g)
+
+
+@njit(cache=True, inline="always")
 def _uniform_domain_row(basis, nodes, inv_spacing, x, V, row, S, G):
     """The row of a particle-domain basis on a uniform grid into ``row``, ``S``, ``G`` (``row.size``
     columns; :func:`_domain`, :func:`_domain_column`); returns the particle's cell and the K it needs."""
@@ -724,14 +752,16 @@ def _project_bspline(nodes, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi
 def _project_domain(basis, nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi, rows, S, G, cell, buf):
     """Pass 1 of a particle-domain basis (GIMP, ``basis`` 1; the particle-domain B-spline, 3) on a
     uniform grid over particles ``lo .. hi-1``, as the generic loop of :func:`_project` (the same
-    sums in the same order) in two loops: the rows first, straight into ``rows``, ``S``, ``G``
-    (:func:`_domain`, :func:`_domain_column`: scalars in and out, no array handed to a
-    helper per particle), then ``buf[0..2]`` += ``m_p S_ip``, ``m_p v_p S_ip``, ``V_p p_p G_ip`` from
-    the stored rows. Returns the first particle outside the grid, the first with ``V <= 0`` (-1 if
-    none) and the K the rows need."""
+    sums in the same order) in one loop over the particles: the row from scalars (:func:`_domain`,
+    then :func:`_domain_column`, or for the B-spline's five columns :func:`_bspline_domain_five`; no
+    array handed to a helper per particle), stored in ``rows``, ``S``, ``G`` for pass 2 and added at
+    once to ``buf[0..2]``: ``m_p S_ip``, ``m_p v_p S_ip``, ``V_p p_p G_ip`` (a second loop reading the
+    stored rows back cost the B-spline's pass 1 a third more). Returns the first particle outside the
+    grid, the first with ``V <= 0`` (-1 if none) and the K the rows need."""
     n_nodes = nodes.size
     K = rows.shape[1]
-    a, b = nodes[0], nodes[n_nodes - 1]
+    last = n_nodes - 1
+    a, b = nodes[0], nodes[last]
     outside, empty, need = -1, -1, 0
     for q in range(lo, hi):
         if not (x[q] >= a and x[q] <= b):
@@ -744,22 +774,33 @@ def _project_domain(basis, nodes, inv_spacing, x, V, m, v, p, gas_force, lo, hi,
             continue
         D = _domain(basis, a, b, n_nodes - 2, inv_spacing, x[q], V[q])
         need = max(need, D[1])
-        for k in range(K):
-            rows[q, k], S[q, k], G[q, k] = _domain_column(basis, k, inv_spacing, n_nodes - 1, D)
         cell[q] = D[0]
-    for q in range(lo, hi):
-        if not (x[q] >= a and x[q] <= b and V[q] > 0):
-            continue
         mq = m[q]
         mv = mq * v[q]
         Vp = V[q] * p[q]
+        if basis == 3 and K == 5:
+            S0, S1, S2, S3, S4, G0, G1, G2, G3, G4 = _bspline_domain_five(inv_spacing, D)
+            first = D[2] - 1  # the columns' nodes c_- - 1 + j, ghosts folded into the end nodes
+            _put(q, 0, min(max(first, 0), last), S0, G0, mq, mv, Vp, gas_force, rows, S, G, buf)
+            _put(q, 1, min(max(first + 1, 0), last), S1, G1, mq, mv, Vp, gas_force, rows, S, G, buf)
+            _put(q, 2, min(first + 2, last), S2, G2, mq, mv, Vp, gas_force, rows, S, G, buf)
+            _put(q, 3, min(first + 3, last), S3, G3, mq, mv, Vp, gas_force, rows, S, G, buf)
+            _put(q, 4, min(first + 4, last), S4, G4, mq, mv, Vp, gas_force, rows, S, G, buf)
+            continue
         for j in range(K):
-            i = rows[q, j]
-            buf[0, i] += S[q, j] * mq
-            buf[1, i] += S[q, j] * mv
-            if gas_force:
-                buf[2, i] += G[q, j] * Vp
+            i, Sj, Gj = _domain_column(basis, j, inv_spacing, last, D)
+            _put(q, j, i, Sj, Gj, mq, mv, Vp, gas_force, rows, S, G, buf)
     return outside, empty, need
+
+
+@njit(cache=True, inline="always")
+def _put(q, j, i, Sj, Gj, mq, mv, Vp, gas_force, rows, S, G, buf):
+    """Column ``j`` (node ``i``) of particle ``q``'s row: stored, and its terms added to ``buf``."""
+    rows[q, j], S[q, j], G[q, j] = i, Sj, Gj
+    buf[0, i] += Sj * mq
+    buf[1, i] += Sj * mv
+    if gas_force:
+        buf[2, i] += Gj * Vp
 
 
 def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,

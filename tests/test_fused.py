@@ -351,3 +351,28 @@ def test_particle_domain_bspline_row_is_the_formula_float_for_float():
     assert np.array_equal(S, S_formula), f"S differs by {np.abs(S - S_formula).max():.3g}"
     assert np.array_equal(G, G_formula), f"G differs by {np.abs(G - G_formula).max():.3g}"
     assert np.abs(S.sum(axis=1) - 1).max() < 1e-12  # the partition of unity
+
+
+def test_the_five_column_bspline_row_is_the_column_rows_float_for_float():
+    """Pass 1's five-column row of the particle-domain B-spline (``_bspline_domain_five``: each end's
+    three pieces placed by selects, ``_five``) gives ``_domain_column``'s floats at every column, for
+    domains within two cells placed at random, on nodes and at the grid's ends; ``_five`` is
+    ``_piece`` at every start it is used for."""
+    from mpm_fem.fused import _bspline_domain_five, _domain, _domain_column, _five, _piece
+
+    for d in range(3):
+        assert _five(d, 7.0, 1.0, 2.0, 3.0) == tuple(_piece(k - d, 7.0, 1.0, 2.0, 3.0) for k in range(5))
+    nodes = np.linspace(0.0, 1.0, 41)
+    inv_spacing, n_cells = 1.0 / (nodes[1] - nodes[0]), nodes.size - 1
+    rng = np.random.default_rng(12)
+    x = np.concatenate([rng.uniform(0, 1, 3000), nodes, [1e-17, 1 - 1e-16]])
+    V = rng.uniform(1e-6, 1.0, x.size) / n_cells
+    starts = set()
+    for xq, Vq in zip(x, V):
+        D = _domain(3, 0.0, 1.0, n_cells - 1, inv_spacing, xq, Vq)
+        assert D[1] <= 5
+        starts.add(D[14] + D[3] - D[2])
+        columns = [_domain_column(3, k, inv_spacing, n_cells, D) for k in range(5)]
+        S, G = np.array(_bspline_domain_five(inv_spacing, D)).reshape(2, 5)
+        assert np.array_equal(S, [c[1] for c in columns]) and np.array_equal(G, [c[2] for c in columns])
+    assert starts == {0, 1, 2}  # every start of the high end met
