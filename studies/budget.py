@@ -22,16 +22,18 @@ terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) -
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.00125 for P1, 0.01 ... 0.005 for GIMP and both B-splines; Burgers 0.04 ...
-0.01. A Sod case (16 runs; the fourteen with an exact stage take the numpy step, whose exact fields
-are compiled, :mod:`mpm_fem.exact_kernels`, and whose quadrature rows are cached per grid; the two
+Meshes: Sod h = 0.01 ... 0.00125 for P1, 0.01 ... 0.0025 for GIMP and both B-splines (0.0025 added
+once the fused step made their all-MPM runs and E2 cheaper: a third mesh gives each basis's budget a
+trend, not only a change); Burgers 0.04 ... 0.01. A Sod case (16 runs; the fourteen with an exact
+stage take the numpy step, whose exact fields are compiled, :mod:`mpm_fem.exact_kernels`, and whose quadrature rows are cached per grid; the two
 all-MPM runs take the fused step) measured in CPU seconds on the shared 2-core machine: P1 at
 h = 0.0025 110 (164 before the compiled exact fields, the same numbers bit for bit); GIMP at 0.005
 83 (91 before: the GIMP rows at the particles dominate). A halving costs about 4x (twice the
 particles, twice the steps): P1 at 0.00125 359 (measured), at 0.000625 ~1450; GIMP and the B-splines at
 0.0025 ~200-330 each. The study (E1 with E2) took ~20 CPU-minutes; E2's smooth bases now run ~2-3x
 faster (uniform-grid arithmetic in the fused step), which pays for P1 at 0.00125, the one mesh added
-(the projection's share of the particle error is the trend E1 follows).
+(the projection's share of the particle error is the trend E1 follows). GIMP and the B-splines at
+0.0025 add an estimated ~10 CPU-minutes (four times their cases at 0.005, 32-65 s of runs each).
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125, the Sod study's meshes but
 its single finest: each halving costs 4x; at 0.00125 the three bases took 2.8 / 8.9 / 7.0 s (P1 /
 GIMP / B-spline), so the two finest meshes add ~6 CPU-minutes.
@@ -66,7 +68,7 @@ SOD = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", sch
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}
-FINEST = {("sod", "gimp"): 0.005, ("sod", "bspline"): 0.005, ("sod", "bspline_gimp"): 0.005}
+FINEST = {("sod", "gimp"): 0.0025, ("sod", "bspline"): 0.0025, ("sod", "bspline_gimp"): 0.0025}
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
