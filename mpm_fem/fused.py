@@ -1030,9 +1030,7 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
             x_new[q] = x[q] + dt * vel
             if musl:
                 if BASIS == 1 or BASIS == 3:
-                    w = m[q] * v_new[q]
-                    for j in range(K):
-                        buf[k, 0, rows[q, j]] += S[q, j] * w
+                    _scatter_stored(buf, k, rows, q, S, m[q] * v_new[q], K)
                 else:
                     _scatter(buf, k, r, Sl, m[q] * v_new[q], K)
                 continue
