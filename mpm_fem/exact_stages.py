@@ -320,6 +320,56 @@ def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float, with
     return GridData(shape, mass, m_i, nodal_momentum(shape, mass, v), nodal_internal_force(shape, w, sigma), M)
 
 
+class ExactGridStage:
+    """The grid stage of a step with exact stages (:func:`mpm_fem.step.explicit_step`), written once
+    for the numpy step and the fused one (:mod:`mpm_fem.fused`), which differ in how the particle
+    sums ``mpm`` (``m_i``, ``P_i``) and ``F_i`` are made, not in what the grid does with them.
+
+    Built at the start of a step it holds the exact nodal data and ``v_i``:
+
+        projection exact   the quadrature data ``quad`` (:func:`exact_projection`) replace the particles'
+        mass exact         v_i = v*_i + [solve(MPM data) - solve(exact data)] (``solve``: the lumped
+                           division; exact data with the FE mass when the projection is MPM)
+        both exact         v_i = v*_i
+
+    and the exact nodal values with the grid's boundary rule, ``star_v = BC(v*_i)``,
+    ``star_a = BC(a*_i)``, which the exact interpolation corrects against. :meth:`acceleration`
+    gives ``a_i`` from the particles' force ``F_i`` the same way."""
+
+    def __init__(self, grid: Grid, boundary, stages, exact: ExactFields, mpm: GridData, t: float, dt: float):
+        self.grid, self.boundary, self.stages, self.mpm, self.t, self.dt = grid, boundary, stages, mpm, t, dt
+        fe_mass_stage = stages.mass == "exact" and stages.projection == "mpm"  # solves exact data with the FE mass
+        self.quad = (exact_projection(grid, stages.basis, exact, t, with_fe_mass=fe_mass_stage)
+                     if stages.projection == "exact" or stages.mass == "exact" else None)
+        self.source = self.quad if stages.projection == "exact" else mpm
+        self.kind = "lumped" if stages.mass == "exact" else stages.mass
+        ref_v, _, self.ref_a = exact.reference(grid.nodes, t)
+        P_exact = self.quad.P_i if self.quad is not None else None
+        self.v_i = boundary.velocity(grid, self.solve(self.source.P_i, P_exact, ref_v), t)
+        self.star_v = boundary.velocity(grid, ref_v, t)
+        self.star_a = boundary.acceleration(grid, self.ref_a, self.star_v, t, dt)
+
+    def solve(self, rhs: np.ndarray, exact_rhs: np.ndarray | None, reference: np.ndarray) -> np.ndarray:
+        """Nodal values of a projected right-hand side, the mass stage's form (class docstring)."""
+        if self.stages.mass != "exact":
+            return nodal_values(self.source, rhs, self.kind)
+        if self.stages.projection == "exact":
+            return reference.copy()
+        return reference + nodal_values(self.mpm, rhs, self.kind) - nodal_values(self.quad, exact_rhs, self.kind)
+
+    def acceleration(self, F_mpm: np.ndarray | None) -> np.ndarray:
+        """``a_i`` from the particles' force ``F_mpm`` (the quadrature's when the projection is exact,
+        where ``F_mpm`` may be None), the boundary rule applied."""
+        F_i = F_mpm if self.stages.projection == "mpm" else self.quad.F_i
+        a_i = self.solve(F_i, self.quad.F_i if self.quad is not None else None, self.ref_a)
+        return self.boundary.acceleration(self.grid, a_i, self.v_i, self.t, self.dt)
+
+    @property
+    def star_new(self) -> np.ndarray:
+        """``star_v + dt star_a``: the exact nodal ``v^{n+1}`` the exact interpolation corrects against."""
+        return self.star_v + self.dt * self.star_a
+
+
 @dataclass(frozen=True)
 class SmoothBurgersFields:
     """Viscous Burgers ``Dv/Dt = eps v_xx`` from a smooth exact solution (point values).

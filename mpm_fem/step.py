@@ -24,7 +24,7 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from .exact_stages import ExactFields, GridData, exact_projection, nodal_values
+from .exact_stages import ExactFields, ExactGridStage, GridData
 from .grid import Grid
 from .particles import Particles
 from .reconstruction import RECONSTRUCTIONS, reconstructed_force
@@ -280,26 +280,8 @@ def _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exa
     h_p = grid.h[shape.cell]
     m = particles.mass
     mpm = GridData(shape, m, nodal_mass(shape, m), nodal_momentum(shape, m, particles.velocity))
-    fe_mass_stage = stages.mass == "exact" and stages.projection == "mpm"  # solves exact data with the FE mass
-    quad = (exact_projection(grid, stages.basis, exact, t, with_fe_mass=fe_mass_stage)
-            if stages.projection == "exact" or stages.mass == "exact" else None)
-    source = quad if stages.projection == "exact" else mpm
-    kind = "lumped" if stages.mass == "exact" else stages.mass
-    ref_v, _, ref_a = exact.reference(grid.nodes, t)
-
-    def solve(rhs: np.ndarray, exact_rhs: np.ndarray | None, reference: np.ndarray) -> np.ndarray:
-        if stages.mass != "exact":
-            return nodal_values(source, rhs, kind)
-        if stages.projection == "exact":
-            return reference.copy()
-        return reference + nodal_values(mpm, rhs, kind) - nodal_values(quad, exact_rhs, kind)
-
-    P_exact = quad.P_i if quad is not None else None
-    v_i = boundary.velocity(grid, solve(source.P_i, P_exact, ref_v), t)
-
-    # the exact nodal values, with the grid's boundary rule: what the interpolation is exact for
-    star_v = boundary.velocity(grid, ref_v, t)
-    star_a = boundary.acceleration(grid, ref_a, star_v, t, dt)
+    stage = ExactGridStage(grid, boundary, stages, exact, mpm, t, dt)
+    v_i, star_v, star_a = stage.v_i, stage.star_v, stage.star_a
     exact_at_particles = stages.interpolation == "exact"
     if exact_at_particles:
         p_v, p_vx, p_a = exact.reference(particles.x, t)
@@ -316,16 +298,15 @@ def _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exa
     if stages.acceleration == "exact":
         if exact_acceleration is None:
             raise ValueError("this problem has no exact acceleration to use")
-        a_i = exact_acceleration(grid.nodes, t)
+        a_i = boundary.acceleration(grid, exact_acceleration(grid.nodes, t), v_i, t, dt)
     else:
         stress = model.stress(particles, gradient(v_i, star_v, t))
-        F_i = nodal_internal_force(shape, particles.volume, stress) if stages.projection == "mpm" else quad.F_i
-        a_i = solve(F_i, quad.F_i if quad is not None else None, ref_a)
-    a_i = boundary.acceleration(grid, a_i, v_i, t, dt)
+        a_i = stage.acceleration(nodal_internal_force(shape, particles.volume, stress)
+                                 if stages.projection == "mpm" else None)
     v_new = v_i + dt * a_i
 
     if exact_at_particles:
-        star_new = star_v + dt * star_a
+        star_new = stage.star_new
         acceleration = p_a + shape.gather(a_i - star_a)
         moving = p_v + dt * p_a + shape.gather(v_new - star_new)
     else:
