@@ -70,8 +70,20 @@ The plateau remedies of :class:`~mpm_fem.step.Stages`, with the numpy step's ope
 Supported: the four bases (``"mpm"``, ``"gimp"``, ``"bspline"``, ``"bspline_gimp"``), USL, USF,
 MUSL, lumped and consistent mass, calculated or exact acceleration, the ideal gas and viscous
 Burgers (both its forces), and every remedy: the PIC/FLIP blend, XPIC(m), the grid volume and the
-Taylor reconstruction. Stages with an exact projection, mass or interpolation run the numpy step
-(:func:`supported` says which), as does any ``kernel="numpy"`` run.
+Taylor reconstruction. The exact stages of the error budget (an exact projection, mass or
+interpolation) run compiled for the gas with USL, the lumped mass and the calculated acceleration
+(:meth:`FusedStep._exact_step`): pass 1 gives the particles' sums; the grid stage is the numpy
+step's own (:class:`~mpm_fem.exact_stages.ExactGridStage`: the quadrature, the FE mass, the exact
+nodal values); pass 2 is the plain one with the MPM interpolation, else
+
+    pass 2   v_p += dt (a*_p + sum_i S_ip (a_i - a*_i)),  x_p += dt ((v*_p + dt a*_p) + sum_i S_ip (v_i^{n+1} - v*_i^{n+1}))
+             (:func:`_move_exact`, the exact fields at x_p^n), then
+             L_p = v*_x(x_p^{n+1}, t + dt) + sum_i G_ip (v_i^{n+1} - v*_i^{n+1}) and the state update
+             (:func:`_update_exact`),
+
+with the numpy step's operations in its order (bit for bit off a uniform grid). The other exact
+stages (USF, the consistent mass, Burgers) run the numpy step (:func:`supported` says which), as
+does any ``kernel="numpy"`` run.
 """
 
 from __future__ import annotations
@@ -88,6 +100,7 @@ from .models.euler import IdealGas
 from .particles import Particles, PositivityError
 from .reconstruction import OFFSETS, force_quadrature
 from .shape import Shape, basis_integrals, make_shape
+from .exact_stages import ExactFields, ExactGridStage, GridData
 from .step import SCHEMES, Dirichlet, GridState, Stages, Walls
 from .transfer import solve_consistent
 from .xpic import boundary_change_rule
@@ -102,10 +115,12 @@ _DOMAIN_BASES = (1, 3)  # the bases averaged over the particle domain: rows of v
 
 def supported(model, stages: Stages) -> str | None:
     """``None`` if the fused step implements this model and these stages, else the reason."""
-    if stages.uses_exact_fields:
-        return "the exact projection, mass and interpolation stages run the numpy step"
     if not isinstance(model, (IdealGas, ViscousBurgers)):
         return f"the fused step has no kernel for the model {type(model).__name__}"
+    if stages.uses_exact_fields and not (isinstance(model, IdealGas) and stages.scheme == "usl"
+                                         and stages.mass in ("lumped", "exact") and stages.acceleration == "calculated"):
+        return ("the exact projection, mass and interpolation stages run compiled for the gas, USL, the lumped "
+                "mass and the calculated acceleration; the others run the numpy step")
     return None
 
 
@@ -1179,6 +1194,43 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
         speed[k] = _flags(k, tally, flags, values)
 
 
+def _move_exact(nodes, h, inv_spacing, rows, S, G, cell, a_c, v_c, p_v, p_a, x, v, dt, chunks, x_new, v_new, L_c):
+    """Pass 2 of a step with the exact interpolation (:func:`mpm_fem.step.explicit_step`), before its
+    state update: with ``a_c = a_i - a*_i`` and ``v_c = v_i^{n+1} - v*_i^{n+1}`` (the nodal values
+    less the exact ones, the boundary rule applied to both) and ``p_v = v*(x_p^n)``, ``p_a = a*(x_p^n)``,
+
+        v_p <- v_p + dt (p_a + sum_i S_ip a_c,i),
+        x_p <- x_p + dt ((p_v + dt p_a) + sum_i S_ip v_c,i),       L_c,p = sum_i G_ip v_c,i,
+
+    the numpy step's operations in its order (``L_p = v*_x(x_p^{n+1}, t + dt) + L_c,p`` follows)."""
+    n = x.size
+    K = WIDTH  # nodes per particle
+    for k in prange(chunks):
+        r, Sl, Gl = _one_row(K)
+        for q in range(*_chunk(n, chunks, k)):
+            ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            acc = p_a[q] + _gather(Sl, a_c, r, K)
+            moving = p_v[q] + dt * p_a[q] + _gather(Sl, v_c, r, K)
+            v_new[q] = v[q] + dt * acc
+            x_new[q] = x[q] + dt * moving
+            L_c[q] = _gather(Gl, v_c, r, K)
+
+
+def _update_exact(h, cell, L, x_new, v_new, V, m, rho, e, p, dt, consts, chunks, V_new, m_new, rho_new, e_new,
+                  p_new, flags, values, speed):
+    """The state update of :func:`_move_exact`'s particles from their ``L_p`` (USL, the cell of
+    ``x_p^n``), with pass 2's checks: ``speed[k]``, ``flags[k]``, ``values[k]`` as :func:`_move`'s."""
+    n = x_new.size
+    gas = MODEL == GAS
+    for k in prange(chunks):
+        tally = _NO_TALLY
+        for q in range(*_chunk(n, chunks, k)):
+            tally = _new_state(gas, q, L[q], dt, h[0, cell[q]], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new,
+                               consts, tally)
+            tally = _checked(gas, q, tally[6], x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+        speed[k] = _flags(k, tally, flags, values)
+
+
 @njit(cache=True, inline="always")
 def _pymin(a, b):
     """Python's ``min(a, b)``: ``b`` only if ``b < a`` (NaN and ties as in :func:`mpm_fem.solve.run`)."""
@@ -1483,10 +1535,13 @@ class FusedStep:
     of them (:func:`mpm_fem.solve._keeps_particles`)."""
 
     def __init__(self, grid: Grid, model, boundary, stages: Stages = Stages(), exact_acceleration=None,
-                 threads: int = 1, reuse: bool = False):
+                 threads: int = 1, reuse: bool = False, exact: ExactFields | None = None):
         reason = supported(model, stages)
         if reason is not None:
             raise ValueError(reason)
+        if stages.uses_exact_fields and exact is None:
+            raise ValueError("the exact projection, mass and interpolation stages need the problem's exact fields")
+        self.exact = exact
         check_kernel("fused", threads)
         if stages.scheme not in SCHEMES:
             raise ValueError(f"unknown scheme {stages.scheme!r}")
@@ -1569,7 +1624,8 @@ class FusedStep:
                                                    and problem.boundary is self.boundary)
         exact = (self.stages.acceleration == "exact" and self.exact_acceleration is not None
                  and problem.exact_acceleration is self.exact_acceleration)
-        return (ends and self.stages.mass == "lumped" and (self.stages.acceleration == "calculated" or exact)
+        return (ends and self.stages.mass == "lumped" and not self.stages.uses_exact_fields
+                and (self.stages.acceleration == "calculated" or exact)
                 and not self.slides and (problem.particle_boundary is None or self._window(problem) is not None))
 
     def _window(self, problem):
@@ -1668,19 +1724,14 @@ class FusedStep:
             v_star += term
         return v_star + dt * a_i
 
-    def step(self, particles: Particles, t: float, dt: float) -> tuple[Particles, GridState]:
-        grid = self.grid
-        n, chunks = particles.n, max(1, min(self.threads, particles.n))
-        x, V, m, v = particles.x, particles.volume, particles.mass, particles.velocity
-        rho, e, p = particles.density, particles.energy, particles.pressure
-        gas = self.kind == GAS
-        scheme, exact = self.stages.scheme, self.stages.acceleration == "exact"
-        grid_volume, taylor = self.stages.volume == "grid", self.stages.reconstruct == "taylor"
-        gas_force = gas and scheme != "usf" and not exact and not grid_volume and not taylor
-        store = self.basis in _DOMAIN_BASES or self.stages.mass == "consistent"
-        geometry = (self.nodes, self.h, self.inv_spacing)
+    def _pass1(self, particles: Particles, gas_force: bool, store: bool, chunks: int):
+        """Pass 1 (:func:`_project`): ``(shape, m_i, P_i, F_i, flags)``, the rows in ``shape`` if
+        ``store`` (the domain bases store theirs always), the cells always; raises the numpy step's
+        error for a particle outside the grid or without volume."""
+        grid, n = self.grid, particles.n
+        x, V, m, v, p = particles.x, particles.volume, particles.mass, particles.velocity, particles.pressure
+        store = store or self.basis in _DOMAIN_BASES
         n_nodes = grid.n_nodes
-        self._turn = 1 - self._turn
         empty = self._empty
         m_i, P_i, F_i = empty("m_i", n_nodes), empty("P_i", n_nodes), empty("F_i", n_nodes)
         flags = np.empty((chunks, 3), np.int64)
@@ -1689,7 +1740,8 @@ class FusedStep:
             rows_n = n if store else 0
             rows, S, G = (empty("rows", (rows_n, self.K), self._index), empty("S", (rows_n, self.K)),
                           empty("G", (rows_n, self.K)))
-            self.project(*geometry, x, V, m, v, p, gas_force, store, chunks, rows, S, G, cell, m_i, P_i, F_i, flags)
+            self.project(self.nodes, self.h, self.inv_spacing, x, V, m, v, p, gas_force, store, chunks,
+                         rows, S, G, cell, m_i, P_i, F_i, flags)
             if (flags[:, :2] >= 0).any():
                 make_shape(grid, x, V, self.stages.basis)  # raises the numpy step's error
                 raise ValueError("a particle lies outside the grid or has no volume")  # not reached
@@ -1697,7 +1749,25 @@ class FusedStep:
             if self.basis not in _DOMAIN_BASES or need == self.K or n == 0:
                 break
             self._width(need)  # GIMP: a particle domain spans another cell; redo with the wider rows
-        shape = Shape(rows, S, G, n_nodes, cell)
+        return Shape(rows, S, G, n_nodes, cell), m_i, P_i, F_i, flags
+
+    def step(self, particles: Particles, t: float, dt: float) -> tuple[Particles, GridState]:
+        if self.stages.uses_exact_fields:
+            return self._exact_step(particles, t, dt)
+        grid = self.grid
+        n, chunks = particles.n, max(1, min(self.threads, particles.n))
+        x, V, m, v = particles.x, particles.volume, particles.mass, particles.velocity
+        rho, e, p = particles.density, particles.energy, particles.pressure
+        gas = self.kind == GAS
+        scheme, exact = self.stages.scheme, self.stages.acceleration == "exact"
+        grid_volume, taylor = self.stages.volume == "grid", self.stages.reconstruct == "taylor"
+        gas_force = gas and scheme != "usf" and not exact and not grid_volume and not taylor
+        geometry = (self.nodes, self.h, self.inv_spacing)
+        n_nodes = grid.n_nodes
+        self._turn = 1 - self._turn
+        empty = self._empty
+        shape, m_i, P_i, F_i, flags = self._pass1(particles, gas_force, self.stages.mass == "consistent", chunks)
+        rows, S, G, cell = shape.nodes, shape.S, shape.G, shape.cell
         v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
         shape_args = (*geometry, x, rows, S, G, cell)
         if grid_volume:  # the volume reset (mpm_fem.volume), then the force of the reset state
@@ -1751,8 +1821,50 @@ class FusedStep:
         if usl or musl:
             if (flags[:, :2] >= 0).any():
                 self._positivity(flags[:, :2], values, x_new)
+        return self._new_particles(x_new, vel_new, V_new, m_new, rho_new, e_new, p_new, flags, speed), \
+            GridState(m_i, v_i, a_i, v_n)
+
+    def _new_particles(self, x, v, V, m, rho, e, p, flags, speed) -> Particles:
+        """The step's particles; :attr:`speed` and :attr:`finite` from pass 2's tallies."""
         self.speed = float(speed.max())
         self.finite = bool((flags[:, 2] < 0).all())
-        new = Particles(x=x_new, volume=V_new, mass=m_new, velocity=vel_new, density=rho_new, energy=e_new,
-                        pressure=p_new)
-        return new, GridState(m_i, v_i, a_i, v_n)
+        return Particles(x=x, volume=V, mass=m, velocity=v, density=rho, energy=e, pressure=p)
+
+    def _exact_step(self, particles: Particles, t: float, dt: float) -> tuple[Particles, GridState]:
+        """The step with exact stages (:func:`mpm_fem.step.explicit_step`; the gas, USL): pass 1 for
+        the particles' ``m_i``, ``P_i`` and (MPM projection) ``F_i``; the grid stage of the numpy step
+        (:class:`~mpm_fem.exact_stages.ExactGridStage`); pass 2 as the plain step's with the MPM
+        interpolation, else :func:`_move_exact` with the exact fields at ``x_p^n``, then ``L_p = v*_x(x_p^{n+1},
+        t + dt) + sum_i G_ip (v_i^{n+1} - v*_i^{n+1})`` and the state update (:func:`_update_exact`)."""
+        n, chunks = particles.n, max(1, min(self.threads, particles.n))
+        x, V, m, v = particles.x, particles.volume, particles.mass, particles.velocity
+        rho, e, p = particles.density, particles.energy, particles.pressure
+        self._turn = 1 - self._turn
+        empty = self._empty
+        interpolate = self.stages.interpolation == "exact"
+        shape, m_i, P_i, F_i, flags = self._pass1(particles, self.stages.projection == "mpm", False, chunks)
+        stage = ExactGridStage(self.grid, self.boundary, self.stages, self.exact, GridData(shape, m, m_i, P_i), t, dt)
+        a_i = stage.acceleration(F_i)
+        v_n = stage.v_i + dt * a_i
+        x_new, vel_new = empty("x", n), empty("v", n)
+        V_new, rho_new, e_new, p_new = (empty(name, n) for name in ("V", "rho", "e", "p"))
+        values, speed = np.zeros((chunks, 2)), np.empty(chunks)
+        geometry = (self.nodes, self.h, self.inv_spacing, shape.nodes, shape.S, shape.G, shape.cell)
+        if interpolate:
+            p_v, _, p_a = self.exact.reference(x, t)
+            star_new = stage.star_new
+            L = empty("L", n)
+            self._passes.get(_move_exact, BASIS=self.basis, WIDTH=self.K)(
+                *geometry, a_i - stage.star_a, v_n - star_new, p_v, p_a, x, v, dt, chunks, x_new, vel_new, L)
+            L = self.exact.velocity_gradient(x_new, t + dt) + L
+            self._passes.get(_update_exact, MODEL=self.kind)(
+                self.h, shape.cell, L, x_new, vel_new, V, m, rho, e, p, dt, self.consts, chunks,
+                V_new, m, rho_new, e_new, p_new, flags, values, speed)
+        else:
+            state = (V, m, rho, e, p, V_new, m, rho_new, e_new, p_new)
+            self.move(*geometry[:3], *geometry[3:], a_i, v_n, x, *state[:2], v, *state[2:5], dt, self.consts, True, False,
+                      chunks, x_new, vel_new, *state[5:], empty("P_musl", self.grid.n_nodes), flags, values, speed)
+        if (flags[:, :2] >= 0).any():
+            self._positivity(flags[:, :2], values, x_new)
+        return self._new_particles(x_new, vel_new, V_new, m, rho_new, e_new, p_new, flags, speed), \
+            GridState(m_i, stage.v_i, a_i, v_n)

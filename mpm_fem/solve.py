@@ -145,7 +145,7 @@ def run(
     fused = None
     if kernel == "fused" and supported(problem.model, stages) is None:
         fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads,
-                          reuse=not _keeps_particles(observer))
+                          reuse=not _keeps_particles(observer), exact=problem.exact)
     # walls or Dirichlet ends, lumped mass, no observer, and no particle boundary or one that says
     # when it acts: steps in compiled loops of about LOOP_WORK particle-steps each (the bar and
     # Ctrl-C are served between them); a loop stops after a step the particle boundary acts on

@@ -298,11 +298,11 @@ def test_what_the_fused_step_refuses():
         E: float = 1.0
 
     assert supported(Elastic(), Stages()) is not None
-    assert supported(IdealGas(), Stages(projection="exact")) is not None
+    assert supported(IdealGas(), Stages(projection="exact", scheme="usf")) is not None  # tests/test_fused_exact.py
     assert supported(IdealGas(), Stages(basis="gimp", scheme="musl", mass="consistent")) is None
     assert supported(IdealGas(), Stages(reconstruct="taylor", volume="grid", basis="bspline_gimp")) is None  # every remedy
     with pytest.raises(ValueError, match="exact projection"):
-        FusedStep(GRID, IdealGas(), Walls(), Stages(interpolation="exact"))
+        FusedStep(GRID, IdealGas(), Walls(), Stages(interpolation="exact", scheme="usf"))
     with pytest.raises(ValueError, match="threads"):
         SodSettings(threads=0)
     with pytest.raises(ValueError, match="unknown kernel"):
