@@ -22,18 +22,21 @@ terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) -
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.00125 for P1, 0.01 ... 0.0025 for GIMP and both B-splines (0.0025 added
-once the fused step made their all-MPM runs and E2 cheaper: a third mesh gives each basis's budget a
-trend, not only a change); Burgers 0.04 ... 0.01. A Sod case (16 runs; the fourteen with an exact
-stage take the numpy step, whose exact fields are compiled, :mod:`mpm_fem.exact_kernels`, and whose quadrature rows are cached per grid; the two
-all-MPM runs take the fused step) measured in CPU seconds on the shared 2-core machine: P1 at
-h = 0.0025 110 (164 before the compiled exact fields, the same numbers bit for bit); GIMP at 0.005
-83 (91 before: the GIMP rows at the particles dominate). A halving costs about 4x (twice the
-particles, twice the steps): P1 at 0.00125 359 (measured), at 0.000625 ~1450; GIMP and the B-splines at
-0.0025 ~200-330 each. The study (E1 with E2) took ~20 CPU-minutes; E2's smooth bases now run ~2-3x
-faster (uniform-grid arithmetic in the fused step), which pays for P1 at 0.00125, the one mesh added
-(the projection's share of the particle error is the trend E1 follows). GIMP and the B-splines at
-0.0025 add an estimated ~10 CPU-minutes (four times their cases at 0.005, 32-65 s of runs each).
+Meshes: Sod h = 0.01 ... 0.00125 for every basis (GIMP and both B-splines gained 0.0025 once the fused
+step made their all-MPM runs and E2 cheaper, and 0.00125 once it ran their exact stages: four meshes
+give each basis's budget a trend, not only a change); Burgers 0.04 ... 0.01. A Sod case is 16 runs, all on the fused step
+(:mod:`mpm_fem.fused`): the fourteen with an exact stage run its compiled particle passes around the
+numpy step's grid stage (the quadrature projection, the FE mass and the exact nodal values, now about
+half of a P1 step; the exact fields compiled, :mod:`mpm_fem.exact_kernels`, the quadrature rows cached
+per grid). Four exact-stage runs (every stage exact, the exact interpolation, projection, mass alone),
+CPU seconds on the shared 2-core machine, the numpy step -> the fused one: P1 at h = 0.0025 8.9 -> 5.8;
+GIMP at 0.005 8.3 -> 2.4; the particle-domain B-spline at 0.005 9.6 -> 3.4. A halving costs about 4x
+(twice the particles, twice the steps). What each run cost is in ``runs.csv`` (``wall_s``).
+Round-off: the subsets with the exact mass stage and the MPM projection (``v_i = v*_i + solve(MPM) -
+solve(exact)``) amplify it. At h = 0.005 a 1-ulp shift of every particle position grows to 5e-9 of the
+velocity in the numpy step with the exact mass (1.7e-13 with every stage MPM), and the fused step's
+uniform-grid arithmetic differs from the numpy step's by 2.6e-8 there (5.7e-14); at h = 0.0025 the
+particle density L1 of that run differs by 0.4% between the two. The budget's numbers carry that spread.
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125, the Sod study's meshes but
 its single finest: each halving costs 4x; at 0.00125 the three bases took 2.8 / 8.9 / 7.0 s (P1 /
 GIMP / B-spline), so the two finest meshes add ~6 CPU-minutes.
@@ -68,7 +71,7 @@ SOD = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", sch
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}
-FINEST = {("sod", "gimp"): 0.0025, ("sod", "bspline"): 0.0025, ("sod", "bspline_gimp"): 0.0025}
+FINEST = {}  # (problem, basis): the finest mesh of a basis whose budget stops above H's finest (none now)
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
@@ -87,8 +90,8 @@ def plan(quick: bool) -> dict:
     return {"budget": budget, "bases": e2}
 
 
-#: CPU time per particle-step of the exact-stage (numpy) step relative to P1's, measured (Sod, h = 0.01)
-STEP_COST = {"mpm": 1.0, "gimp": 1.9, "bspline": 1.4, "bspline_gimp": 2.1}
+#: CPU time of a case relative to P1's (the four exact-stage runs of the docstring, fused, Sod, h = 0.005)
+STEP_COST = {"mpm": 1.0, "gimp": 1.1, "bspline": 1.6, "bspline_gimp": 1.6}
 
 
 def cost(case: dict) -> float:
