@@ -109,3 +109,17 @@ def test_which_exact_stages_run_compiled():
     assert "numpy step" in supported(gas, Stages(projection="exact", mass="consistent"))
     with pytest.raises(ValueError, match="exact fields"):
         FusedStep(uniform_grid(0.0, 1.0, 0.1), gas, Walls(), Stages(interpolation="exact"))
+
+
+@pytest.mark.slow
+def test_exact_stages_on_two_threads_agree_to_round_off_and_repeat_exactly():
+    """``threads=2``: each chunk scatters into its own buffer (pass 1) and the exact pass 2 splits
+    the particles; equal to one thread to round-off, and the same on every run (deterministic)."""
+    grid = uniform_grid(0.0, 1.0, 0.05)
+    problem, particles = _sod(grid, 200)
+    for basis in ("mpm", "bspline_gimp"):
+        stages = Stages(basis=basis, **SUBSETS[0])  # the exact interpolation: _move_exact, _update_exact
+        one = run(problem, grid, particles, stages, progress=False)
+        two = [run(problem, grid, particles, stages, progress=False, threads=2) for _ in range(2)]
+        _assert_same(two[0], two[1])
+        _assert_same(one, two[0], TOLERANCE)
