@@ -605,8 +605,26 @@ def _e1(problem: str) -> Criterion:
         dominated = sum(f["dominant"] is not None for f in found.values())
         verdict = ("refuted" if not closes else "confirmed" if dominated == len(found) else "partly")
         return verdict, f"{norms[0]} L1, largest Shapley share: " + "; ".join(parts) + (
-            "" if closes else "; the shares do not add up to one")
+            "" if closes else "; the shares do not add up to one") + _roundoff_text(t, problem)
     return criterion
+
+
+ROUNDOFF = "budget/roundoff"
+
+
+def _roundoff_text(t: Tables, problem: str) -> str:
+    """How far round-off moves the shares (``budget/roundoff``, where the budget ran on both
+    arithmetics): the largest change of any share per mesh, in percentage points; informative, not
+    part of the verdict."""
+    rows = select(t.get(ROUNDOFF) or [], problem=problem)
+    if not rows:
+        return ""
+    hs = sorted({num(r, "h") for r in rows}, reverse=True)
+    worst = [max(abs(num(r, "change_pp")) for r in rows if num(r, "h") == h) for h in hs]
+    bases = ", ".join(dict.fromkeys(r["basis"] for r in rows))
+    return (f"; round-off ({bases}, the numpy step's arithmetic against the fused step's, `{ROUNDOFF}.csv`) moves "
+            f"the shares by at most {' / '.join(f'{w:.2g}' for w in worst)} percentage points at h = "
+            + " / ".join(f"{h:g}" for h in hs))
 
 
 _E1_RULE = (f"the Shapley shares of every mesh add up to one (within {CLOSURE:g}) and at the finest mesh one stage "

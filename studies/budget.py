@@ -36,7 +36,10 @@ Round-off: the subsets with the exact mass stage and the MPM projection (``v_i =
 solve(exact)``) amplify it. At h = 0.005 a 1-ulp shift of every particle position grows to 5e-9 of the
 velocity in the numpy step with the exact mass (1.7e-13 with every stage MPM), and the fused step's
 uniform-grid arithmetic differs from the numpy step's by 2.6e-8 there (5.7e-14); at h = 0.0025 the
-particle density L1 of that run differs by 0.4% between the two. The budget's numbers carry that spread.
+particle density L1 of that run differs by 0.4% between the two. The budget's numbers carry that spread,
+and ``roundoff.csv`` measures it in every run: P1's Sod budget runs a second time on the numpy step
+(the reference arithmetic; its sixteen runs cost about 1.5x the fused ones), and each Shapley share
+is given from both with the change in percentage points.
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125, the Sod study's meshes but
 its single finest: each halving costs 4x; at 0.00125 the three bases took 2.8 / 8.9 / 7.0 s (P1 /
 GIMP / B-spline), so the two finest meshes add ~6 CPU-minutes.
@@ -77,6 +80,8 @@ REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
 QUICK = {"h": {"sod": (0.02,), "burgers": (0.04, 0.02)}, "bases": ("mpm",), "bases_h": ()}
 GAP = "all MPM - all exact"
+#: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring)
+ROUNDOFF = ("sod", "mpm")
 COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:green", "time": "tab:red"}
 
 
@@ -87,7 +92,8 @@ def plan(quick: bool) -> dict:
     budget = {(p, h, b): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K}
               for p, meshes in hs.items() for h in meshes for b in bases if h >= FINEST.get((p, b), 0)}
     e2 = {(h, b): {"kind": "bases", "h": h, "basis": b} for h in (QUICK["bases_h"] if quick else BASES_H) for b in BASES}
-    return {"budget": budget, "bases": e2}
+    roundoff = {key: {**case, "kernel": "numpy"} for key, case in budget.items() if key[::2] == ROUNDOFF}
+    return {"budget": budget, "bases": e2, "roundoff": roundoff}
 
 
 #: CPU time of a case relative to P1's (the four exact-stage runs of the docstring, fused, Sod, h = 0.005)
@@ -157,7 +163,7 @@ def budget_case(case: dict) -> dict:
     """One (problem, h, basis): v(S) per norm and subset, the runs, the Shapley error fields
     (sampled for the figure) and, for Sod, their L1 by region."""
     problem, h, basis = case["problem"], case["h"], case["basis"]
-    fields, weights, points, runs = subset_fields(problem, h, basis)
+    fields, weights, points, runs = subset_fields(problem, h, basis, {"kernel": case["kernel"]} if "kernel" in case else None)
     if fields is None:
         return {"ok": False, "runs": runs}
     out = {"ok": True, "runs": runs, "subsets": {norm: {label(S): float(np.sum(w * np.abs(f[norm])))
@@ -197,9 +203,11 @@ def run(options: StudyOptions) -> None:
     ok = {key: r for key, r in got["budget"].items() if r["ok"]}  # in the plan's order
     rows = subset_rows(ok)
     shapley, interactions = decomposition_rows(rows)
+    reference = decomposition_rows(subset_rows({k: r for k, r in got["roundoff"].items() if r["ok"] and k in ok}))[0]
     publish(folder, {"subsets": rows, "shapley": shapley, "interactions": interactions, "regions": region_rows(ok),
                      "runs": [{"problem": p, "h": h, "basis": b, **x} for (p, h, b), r in got["budget"].items() for x in r["runs"]],
-                     "bases": [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()]}, settings, figures=(BASES_PLOT,))
+                     "bases": [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()],
+                     "roundoff": roundoff_rows(shapley, reference)}, settings, figures=(BASES_PLOT,))
     for problem in sorted({r["problem"] for r in shapley}):
         shapley_figure(folder / f"shapley_{problem}.png", [r for r in shapley if r["problem"] == problem])
         finest = {b: min(h for p, h, bb in ok if p == problem and bb == b) for p, _, b in ok if p == problem}
@@ -228,6 +236,23 @@ def decomposition_rows(rows: list[dict]) -> tuple[list, list]:
         interactions += [{**key, "stages": label(S), "order": len(S), "term": m, "share": m / d.gap}
                          for S, m in d.interactions().items()]
     return shapley, interactions
+
+
+def roundoff_rows(shapley: list[dict], reference: list[dict]) -> list[dict]:
+    """``roundoff.csv``: per Shapley row of the budget that also ran on the numpy step, both values:
+    ``v(all MPM)``, ``v(all exact)`` and the stage's share, and the share's change in percentage
+    points (the round-off of the two arithmetics, grown over the run: module docstring)."""
+    keys = ("problem", "h", "basis", "norm", "stage")
+    at = {tuple(r[k] for k in keys): r for r in reference}
+    out = []
+    for r in shapley:
+        x = at.get(tuple(r[k] for k in keys))
+        if x is not None:
+            out.append({**{k: r[k] for k in keys}, "share": r["share"], "share_numpy": x["share"],
+                        "change_pp": 100 * (r["share"] - x["share"]), "mpm_error": r["mpm_error"],
+                        "mpm_error_numpy": x["mpm_error"], "exact_error": r["exact_error"],
+                        "exact_error_numpy": x["exact_error"]})
+    return out
 
 
 def region_rows(got: dict) -> list[dict]:

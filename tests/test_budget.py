@@ -246,3 +246,27 @@ def test_the_particle_domain_bspline_runs_every_subset_and_its_shapley_values_ad
                                   fields[ALL]["particles"])
     plan = study.plan(quick=False)["budget"]
     assert {h for p, h, b in plan if (p, b) == ("sod", "bspline_gimp")} == {h for p, h, b in plan if (p, b) == ("sod", "bspline")}
+
+
+def test_the_roundoff_table_compares_the_two_arithmetics():
+    """``roundoff.csv``: P1's Sod budget runs again on the numpy step; each share from both, the
+    change in percentage points; E1's evidence names the largest change per mesh."""
+    from mpm_fem.claims import _roundoff_text
+    from studies.budget import ROUNDOFF, plan, roundoff_rows
+
+    cases = plan(quick=False)["roundoff"]
+    assert cases and all(key[::2] == ROUNDOFF and case["kernel"] == "numpy" for key, case in cases.items())
+    assert set(cases) == {k for k in plan(quick=False)["budget"] if k[::2] == ROUNDOFF}
+    key = {"problem": "sod", "h": 0.01, "basis": "mpm", "norm": "particles"}
+    fused = [{**key, "stage": "mass", "share": -0.5, "mpm_error": 2.0, "exact_error": 1.0},
+             {**key, "stage": "time", "share": 0.25, "mpm_error": 2.0, "exact_error": 1.0},
+             {**key, "basis": "gimp", "stage": "mass", "share": 0.1, "mpm_error": 2.0, "exact_error": 1.0}]
+    numpy = [{**key, "stage": "mass", "share": -0.48, "mpm_error": 2.1, "exact_error": 1.0},
+             {**key, "stage": "time", "share": 0.25, "mpm_error": 2.1, "exact_error": 1.0}]
+    rows = roundoff_rows(fused, numpy)
+    assert [r["stage"] for r in rows] == ["mass", "time"]  # the GIMP row ran on one arithmetic only
+    assert rows[0]["change_pp"] == pytest.approx(-2.0) and rows[1]["change_pp"] == 0.0
+    assert rows[0]["mpm_error_numpy"] == 2.1
+    text = _roundoff_text({"budget/roundoff": [{k: str(v) for k, v in r.items()} for r in rows]}, "sod")
+    assert "at most 2 percentage points at h = 0.01" in text
+    assert _roundoff_text({}, "sod") == "" and _roundoff_text({"budget/roundoff": rows}, "burgers") == ""
