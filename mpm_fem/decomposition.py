@@ -123,3 +123,21 @@ def _number_or_array(a: np.ndarray):
 
 def _unwrap(d: dict) -> dict:
     return {k: _number_or_array(a) for k, a in d.items()}
+
+
+def share_changes(shapley: list[dict], reference: list[dict], key=("problem", "h", "basis", "norm", "stage")) -> list[dict]:
+    """Two decompositions of the same runs made with two arithmetics (a budget's Shapley rows and
+    its rerun's, each with ``share``, ``mpm_error`` = v(N) and ``exact_error`` = v({})): per row
+    present in both, both values (the reference's as ``*_numpy``: the budget's reference arithmetic is
+    the numpy step) and the share's change in percentage points, ``100 (share - share_numpy)``: how far
+    round-off, grown over the runs, moves the decomposition."""
+    at = {tuple(r[k] for k in key): r for r in reference}
+    out = []
+    for r in shapley:
+        x = at.get(tuple(r[k] for k in key))
+        if x is not None:
+            out.append({**{k: r[k] for k in key}, "share": r["share"], "share_numpy": x["share"],
+                        "change_pp": 100 * (r["share"] - x["share"]), "mpm_error": r["mpm_error"],
+                        "mpm_error_numpy": x["mpm_error"], "exact_error": r["exact_error"],
+                        "exact_error_numpy": x["exact_error"]})
+    return out

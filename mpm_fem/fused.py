@@ -1862,7 +1862,7 @@ class FusedStep:
                 V_new, m, rho_new, e_new, p_new, flags, values, speed)
         else:
             state = (V, m, rho, e, p, V_new, m, rho_new, e_new, p_new)
-            self.move(*geometry[:3], *geometry[3:], a_i, v_n, x, *state[:2], v, *state[2:5], dt, self.consts, True, False,
+            self.move(*geometry, a_i, v_n, x, *state[:2], v, *state[2:5], dt, self.consts, True, False,
                       chunks, x_new, vel_new, *state[5:], empty("P_musl", self.grid.n_nodes), flags, values, speed)
         if (flags[:, :2] >= 0).any():
             self._positivity(flags[:, :2], values, x_new)

@@ -53,7 +53,7 @@ from pathlib import Path
 import numpy as np
 
 from baselines.exact import riemann
-from mpm_fem.decomposition import decompose, label, subsets
+from mpm_fem.decomposition import decompose, label, share_changes, subsets
 from mpm_fem.grid import uniform_grid
 from mpm_fem.particles import PositivityError
 from mpm_fem.plots import Curve, Plot, plt, save
@@ -207,7 +207,7 @@ def run(options: StudyOptions) -> None:
     publish(folder, {"subsets": rows, "shapley": shapley, "interactions": interactions, "regions": region_rows(ok),
                      "runs": [{"problem": p, "h": h, "basis": b, **x} for (p, h, b), r in got["budget"].items() for x in r["runs"]],
                      "bases": [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()],
-                     "roundoff": roundoff_rows(shapley, reference)}, settings, figures=(BASES_PLOT,))
+                     "roundoff": share_changes(shapley, reference)}, settings, figures=(BASES_PLOT,))
     for problem in sorted({r["problem"] for r in shapley}):
         shapley_figure(folder / f"shapley_{problem}.png", [r for r in shapley if r["problem"] == problem])
         finest = {b: min(h for p, h, bb in ok if p == problem and bb == b) for p, _, b in ok if p == problem}
@@ -236,23 +236,6 @@ def decomposition_rows(rows: list[dict]) -> tuple[list, list]:
         interactions += [{**key, "stages": label(S), "order": len(S), "term": m, "share": m / d.gap}
                          for S, m in d.interactions().items()]
     return shapley, interactions
-
-
-def roundoff_rows(shapley: list[dict], reference: list[dict]) -> list[dict]:
-    """``roundoff.csv``: per Shapley row of the budget that also ran on the numpy step, both values:
-    ``v(all MPM)``, ``v(all exact)`` and the stage's share, and the share's change in percentage
-    points (the round-off of the two arithmetics, grown over the run: module docstring)."""
-    keys = ("problem", "h", "basis", "norm", "stage")
-    at = {tuple(r[k] for k in keys): r for r in reference}
-    out = []
-    for r in shapley:
-        x = at.get(tuple(r[k] for k in keys))
-        if x is not None:
-            out.append({**{k: r[k] for k in keys}, "share": r["share"], "share_numpy": x["share"],
-                        "change_pp": 100 * (r["share"] - x["share"]), "mpm_error": r["mpm_error"],
-                        "mpm_error_numpy": x["mpm_error"], "exact_error": r["exact_error"],
-                        "exact_error_numpy": x["exact_error"]})
-    return out
 
 
 def region_rows(got: dict) -> list[dict]:

@@ -252,7 +252,8 @@ def test_the_roundoff_table_compares_the_two_arithmetics():
     """``roundoff.csv``: P1's Sod budget runs again on the numpy step; each share from both, the
     change in percentage points; E1's evidence names the largest change per mesh."""
     from mpm_fem.claims import _roundoff_text
-    from studies.budget import ROUNDOFF, plan, roundoff_rows
+    from mpm_fem.decomposition import share_changes
+    from studies.budget import ROUNDOFF, plan
 
     cases = plan(quick=False)["roundoff"]
     assert cases and all(key[::2] == ROUNDOFF and case["kernel"] == "numpy" for key, case in cases.items())
@@ -263,7 +264,7 @@ def test_the_roundoff_table_compares_the_two_arithmetics():
              {**key, "basis": "gimp", "stage": "mass", "share": 0.1, "mpm_error": 2.0, "exact_error": 1.0}]
     numpy = [{**key, "stage": "mass", "share": -0.48, "mpm_error": 2.1, "exact_error": 1.0},
              {**key, "stage": "time", "share": 0.25, "mpm_error": 2.1, "exact_error": 1.0}]
-    rows = roundoff_rows(fused, numpy)
+    rows = share_changes(fused, numpy)
     assert [r["stage"] for r in rows] == ["mass", "time"]  # the GIMP row ran on one arithmetic only
     assert rows[0]["change_pp"] == pytest.approx(-2.0) and rows[1]["change_pp"] == 0.0
     assert rows[0]["mpm_error_numpy"] == 2.1
