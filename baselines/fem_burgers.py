@@ -41,7 +41,11 @@ from scipy.sparse.linalg import splu
 
 from mpm_fem.grid import Grid
 
+from baselines import fem_burgers_kernel
 from baselines.galerkin import P1Cells, check_settings, mesh, p1_cells
+
+KERNELS = ("fused", "numpy")  # the compiled loop, the numpy reference (:func:`solve`)
+PROGRESS_EVERY = 1000  # steps per compiled call, and between progress lines
 
 
 @dataclass(frozen=True)
@@ -63,6 +67,7 @@ class _Operators(P1Cells):
     interior: np.ndarray
     boundary: np.ndarray
     M_IB: object = None
+    M_II: object = None
     solve_II: object = None
 
 
@@ -72,10 +77,8 @@ def _operators(grid: Grid, mass: str) -> _Operators:
     if mass == "consistent":
         M = grid.consistent_mass.tocsr()
         interior = ops["interior"]
-        ops.update(
-            M_IB=M[interior][:, boundary],
-            solve_II=splu(M[interior][:, interior].tocsc()).solve,
-        )
+        M_II = M[interior][:, interior].tocsc()
+        ops.update(M_IB=M[interior][:, boundary], M_II=M_II, solve_II=splu(M_II).solve)
     return _Operators(**ops)
 
 
@@ -110,15 +113,24 @@ def solve(
     cfl: float = 0.5,
     cfl_visc: float = 0.3,
     progress: bool = False,
+    kernel: str = "fused",
 ) -> BurgersFEMResult:
     """Galerkin P1 solution of Burgers' equation with the data of ``solution`` (an exact solution
     from :mod:`baselines.exact.burgers`: ``.eps``, ``.domain``, ``.v(x, t)``, ``.v_t(x, t)``) on a
     uniform mesh of size ``h``, up to time ``T`` (module docstring for the equations).
 
+    ``kernel="fused"`` takes the steps in blocks of ``PROGRESS_EVERY`` with the compiled loop of
+    :mod:`baselines.fem_burgers_kernel` (bit for bit with the numpy step for the lumped mass, to
+    round-off for the consistent one: a Thomas solve in place of SuperLU); ``"numpy"`` is the
+    readable reference below.
+
     Raises ValueError for bad input (``h`` not dividing the domain, ``cfl`` or ``cfl_visc``
-    outside (0, 1], unknown ``mass``) and ArithmeticError if the solution becomes non-finite.
+    outside (0, 1], unknown ``mass`` or ``kernel``) and ArithmeticError if the solution becomes
+    non-finite.
     """
     check_settings(mass, T, cfl=cfl, cfl_visc=cfl_visc)
+    if kernel not in KERNELS:
+        raise ValueError(f"unknown kernel {kernel!r}; choose one of {', '.join(KERNELS)}")
     eps = float(solution.eps)
     lo, hi = solution.domain
     grid = mesh(lo, hi, h)
@@ -140,25 +152,15 @@ def solve(
     g = np.asarray(solution.v(x_b[None, :], half_times), dtype=float)
     g_t = np.asarray(solution.v_t(x_b[None, :], half_times), dtype=float)
 
-    def L(w, k):
-        return time_derivative(w, g_t[k], ops, eps)
-
-    def with_boundary(w, k):
-        w[ops.boundary] = g[k]
-        return w
-
-    for n in range(steps):
-        k = 2 * n  # t = k dt / 2
-        v1 = with_boundary(v + dt * L(v, k), k + 2)
-        v2 = with_boundary(0.75 * v + 0.25 * (v1 + dt * L(v1, k + 2)), k + 1)
-        v = with_boundary(v / 3.0 + 2.0 / 3.0 * (v2 + dt * L(v2, k + 1)), k + 2)
-        if not np.all(np.isfinite(v)):
-            bad = int(np.flatnonzero(~np.isfinite(v))[0])
-            raise ArithmeticError(
-                f"v became non-finite at step {n + 1}, node {bad} (x = {x[bad]:.6g})"
-            )
-        if progress and (n + 1) % 1000 == 0:
-            print(f"fem_burgers h={h} {mass}: step {n + 1}/{steps}", flush=True)
+    take = _compiled_steps(ops, eps, dt, g, g_t) if kernel == "fused" else _numpy_steps(ops, eps, dt, g, g_t)
+    for first in range(0, steps, PROGRESS_EVERY):  # blocks of steps, not nodes
+        done = min(steps, first + PROGRESS_EVERY)
+        v, bad = take(v, first, done - first)
+        if bad is not None:
+            step, node = bad
+            raise ArithmeticError(f"v became non-finite at step {step}, node {node} (x = {x[node]:.6g})")
+        if progress and done % PROGRESS_EVERY == 0:
+            print(f"fem_burgers h={h} {mass}: step {done}/{steps}", flush=True)
 
     settings = dict(
         problem="burgers",
@@ -180,6 +182,50 @@ def solve(
     return BurgersFEMResult(
         nodes=x.copy(), v=v, t=steps * dt, steps=steps, dt=dt, settings=settings
     )
+
+
+def _numpy_steps(ops: _Operators, eps: float, dt: float, g: np.ndarray, g_t: np.ndarray):
+    """``take(v, first, count)``: steps ``first ... first + count - 1`` of SSP-RK3 in numpy (the
+    reference); returns the new ``v`` and None, or ``(step, node)`` where ``v`` stopped being finite."""
+
+    def L(w, k):
+        return time_derivative(w, g_t[k], ops, eps)
+
+    def with_boundary(w, k):
+        w[ops.boundary] = g[k]
+        return w
+
+    def take(v, first, count):
+        for n in range(first, first + count):
+            k = 2 * n  # t = k dt / 2
+            v1 = with_boundary(v + dt * L(v, k), k + 2)
+            v2 = with_boundary(0.75 * v + 0.25 * (v1 + dt * L(v1, k + 2)), k + 1)
+            v = with_boundary(v / 3.0 + 2.0 / 3.0 * (v2 + dt * L(v2, k + 1)), k + 2)
+            if not np.all(np.isfinite(v)):
+                return v, (n + 1, int(np.flatnonzero(~np.isfinite(v))[0]))
+        return v, None
+
+    return take
+
+
+def _compiled_steps(ops: _Operators, eps: float, dt: float, g: np.ndarray, g_t: np.ndarray):
+    """``take(v, first, count)`` of :func:`_numpy_steps` with the compiled loop (:mod:`baselines.fem_burgers_kernel`)."""
+    consistent = ops.mass == "consistent"
+    if consistent:
+        l, w, u = fem_burgers_kernel.tridiagonal_factors(ops.M_II)
+        M_IB = np.ascontiguousarray(ops.M_IB.toarray())
+    else:
+        l = w = u = np.zeros(0)
+        M_IB = np.zeros((0, ops.boundary.size))
+    fixed = (dt, np.ascontiguousarray(g), np.ascontiguousarray(g_t), ops.a, ops.b, ops.h, eps, ops.interior,
+             ops.boundary, ops.lumped, consistent, l, w, u, M_IB)
+
+    def take(v, first, count):
+        v = v.copy()
+        step, node = fem_burgers_kernel.steps(v, first, count, *fixed)
+        return v, (None if step < 0 else (int(step), int(node)))
+
+    return take
 
 
 def errors(result: BurgersFEMResult, solution) -> dict[str, float]:

@@ -1,5 +1,6 @@
 """Fixed-mesh Galerkin FEM for viscous Burgers (baselines/fem_burgers.py): convergence against
-the exact viscous rarefaction, boundary data, the kernel against scikit-fem, and bad input."""
+the exact viscous rarefaction, boundary data, the kernel against scikit-fem, the compiled loop
+(baselines/fem_burgers_kernel.py) against the numpy step, and bad input."""
 
 from functools import lru_cache
 
@@ -8,7 +9,10 @@ import pytest
 from skfem import Basis, ElementLineP1, LinearForm, asm
 
 from baselines.exact.burgers import make_solution
+import scipy.sparse as sp
+
 from baselines.fem_burgers import _operators, errors, residual, solve
+from baselines.fem_burgers_kernel import tridiagonal_factors
 from mpm_fem.grid import grid_from_nodes
 
 EPS = 0.045
@@ -101,3 +105,64 @@ def test_residual_kernel_matches_scikit_fem_linear_form():
 def test_bad_input_raises_value_error(kwargs, message):
     with pytest.raises(ValueError, match=message):
         solve(make_solution("rarefaction", EPS), **kwargs)
+
+
+@pytest.mark.parametrize("solution_name", ["rarefaction", "cole_hopf"])
+def test_compiled_loop_equals_the_numpy_step(solution_name):
+    """6,000 SSP-RK3 steps at h = 0.005: the lumped mass bit for bit (the same operations in the same
+    order), the consistent mass to round-off (a Thomas solve where numpy uses SuperLU)."""
+    solution = make_solution(solution_name, EPS)
+    for mass, tol in (("lumped", 0.0), ("consistent", 1e-13)):
+        a = solve(solution, 0.005, mass=mass, kernel="numpy")
+        b = solve(solution, 0.005, mass=mass, kernel="fused")
+        assert a.steps == b.steps == 6000 and a.dt == b.dt
+        scale = np.abs(a.v).max()
+        assert np.abs(a.v - b.v).max() <= tol * scale, (mass, np.abs(a.v - b.v).max() / scale)
+        if mass == "lumped":
+            assert np.array_equal(a.v, b.v)
+
+
+def test_tridiagonal_factors_reproduce_the_interior_mass():
+    ops = _operators(grid_from_nodes(np.linspace(0.0, 2.0, 41)), "consistent")
+    l, w, u = tridiagonal_factors(ops.M_II)
+    n = w.size
+    lower = sp.diags([np.ones(n), l[1:]], [0, -1])
+    upper = sp.diags([1.0 / w, u[:-1]], [0, 1])
+    assert abs(lower @ upper - ops.M_II).max() <= 1e-15 * abs(ops.M_II).max()
+    full = ops.M_II.toarray()
+    full[0, 2] = 0.1
+    with pytest.raises(ValueError, match="tridiagonal"):
+        tridiagonal_factors(sp.csr_matrix(full))
+
+
+class _BlowsUp:
+    """The rarefaction, but its right boundary value is NaN from t = 0.1 on."""
+
+    def __init__(self):
+        self._s = make_solution("rarefaction", EPS)
+        self.eps, self.domain = self._s.eps, self._s.domain
+
+    def v(self, x, t):
+        out = np.array(self._s.v(x, t), dtype=float)
+        return np.where((np.asarray(t) >= 0.1) & (np.asarray(x) >= self.domain[1]), np.nan, out)
+
+    def v_t(self, x, t):
+        return self._s.v_t(x, t)
+
+
+def test_non_finite_values_raise_arithmetic_error_naming_the_step():
+    """Both loops stop at the same step and node, the first step after the data turned NaN."""
+    dt = solve(make_solution("rarefaction", EPS), 0.02, mass="lumped").dt
+    messages = []
+    for kernel in ("numpy", "fused"):
+        with pytest.raises(ArithmeticError, match=r"non-finite at step \d+, node \d+") as err:
+            solve(_BlowsUp(), 0.02, mass="lumped", kernel=kernel)
+        messages.append(str(err.value))
+    assert messages[0] == messages[1]
+    step = int(messages[0].split("step ")[1].split(",")[0])
+    assert 0.1 <= step * dt <= 0.1 + 2 * dt, (step, dt)
+
+
+def test_unknown_kernel_raises_value_error():
+    with pytest.raises(ValueError, match="unknown kernel"):
+        solve(make_solution("rarefaction", EPS), 0.02, kernel="cuda")
