@@ -13,7 +13,7 @@ combinations that promise most, errors over grid nodes and over particles:
   time, for MPM with each remedy, fixed-mesh P1 FEM (lumped mass) and FV. Wall time is the last
   column: it varies from run to run and no verdict uses it.
 
-Meshes: Sod h = 0.01 ... 0.00015625, the convergence study's seven. Every remedy runs the first six
+Meshes: Sod h = 0.01 ... 0.00015625, the convergence study's first seven. Every remedy runs the first six
 (to 0.0003125); the finest, 0.00015625, runs plain MPM and the three remedies that removed the
 plateau on the six coarser meshes in the last full run (``FINEST``: the B-spline domain, alone, with
 Taylor + volume and with XPIC(5)); E5 counts a remedy as removing the plateau only if it ran on every

@@ -24,7 +24,7 @@ from mpm_fem.plots import Curve, Plot
 from mpm_fem.study import StudyOptions, publish, script_main
 
 NAME = "sod"
-H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625)  # the source's meshes and one finer
+H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625, 0.000078125)  # the source's meshes and two finer
 SOURCE = source.SOD
 T = sod.SodSettings.T
 # One set of MPM settings for every h (never tuned per mesh); why these: ppc.csv and plateau.csv
