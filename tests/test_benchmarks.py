@@ -1,0 +1,24 @@
+"""The benchmark scripts run and print what their docstrings promise (benchmarks/)."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_fem_cost_reports_numpy_compiled_and_mpm_per_mesh():
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fem_cost.py"), "--T", "0.01", "--finest", "0.0025"],
+                          capture_output=True, text=True, timeout=600, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    rows = [line.split() for line in proc.stdout.splitlines() if line.split() and line.split()[0].startswith("0.00")]
+    assert [(r[0], r[1]) for r in rows] == [(h, m) for h in ("0.005000", "0.002500") for m in ("lumped", "consistent")]
+    for r in rows:  # numpy, compiled, speed-up, MPM, two ratios: positive and finite
+        numpy_us, fused_us, speedup = float(r[2]), float(r[3]), float(r[4].rstrip("x"))
+        assert numpy_us > 0 and fused_us > 0 and abs(speedup - numpy_us / fused_us) <= 0.05 * speedup + 0.05
+
+
+def test_fem_cost_rejects_bad_arguments():
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fem_cost.py"), "--T", "0"],
+                          capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert proc.returncode == 2 and "--T must lie in (0, 0.5]" in proc.stderr
