@@ -170,7 +170,18 @@ class QuadratureRule:
         return self.splice(self.cuts(breakpoints))
 
     def cuts(self, breakpoints) -> Cuts:
-        """The pieces cut by ``breakpoints`` (those inside the domain) and their sub-pieces."""
+        """The pieces cut by ``breakpoints`` (those inside the domain) and their sub-pieces: the
+        compiled :func:`~mpm_fem.grid_kernels.cut_pieces`, equal bit for bit to :meth:`cuts_numpy`."""
+        bp = np.ascontiguousarray(breakpoints, dtype=float).ravel()
+        grid = self.grid
+        inv_spacing = 1.0 / grid.uniform_spacing if grid.uniform_spacing is not None else 0.0
+        cut, first, x, w, nodes, S, G, cell = grid_kernels.cut_pieces(
+            self.edges, bp, _XI, _W, grid.nodes, grid.h, inv_spacing, self.functions == "bspline")
+        return Cuts(cut, first, x, w, Shape(nodes, S, G, grid.n_nodes, cell))
+
+    def cuts_numpy(self, breakpoints) -> Cuts:
+        """The readable reference of :meth:`cuts`: :func:`_gauss` and :func:`~mpm_fem.shape.make_shape`
+        on the sub-pieces."""
         bp = np.asarray(breakpoints, dtype=float).ravel()
         n = self.x.shape[0]
         piece = np.searchsorted(self.edges, bp, side="right") - 1

@@ -11,8 +11,14 @@ the readable reference.
                 F_i = - sum_q (w_q sigma_q) G_qi,
                 each sum in the order of the points and of a row's columns, as ``np.bincount``
                 adds its weights (one after the other, from 0).
+    cut_pieces  the pieces (nodes and half cells) that breakpoints cut, their sub-pieces' Gauss
+                points ``x = (a + w/2) + (w/2) xi_g`` and weights ``(w/2) w_g`` and the rows of the
+                grid functions there (:meth:`~mpm_fem.exact_stages.QuadratureRule.cuts`): P1 hats
+                ``S = (1 - xi, xi)``, ``G = (-1, 1)/h_c`` or quadratic B-splines (:func:`mpm_fem.shape.
+                point_shape`, :func:`~mpm_fem.shape.bspline_shape`, their point location
+                :func:`~mpm_fem.shape.locate` included).
     splice      the rows of the fixed pieces with each cut piece replaced by its sub-pieces
-                (:meth:`~mpm_fem.exact_stages.QuadratureRule.__call__`): copies only.
+                (:meth:`~mpm_fem.exact_stages.QuadratureRule.splice`): copies only.
     fe_entries  the entries of the FE mass, ``M_e = sum_q A_eq (dx_q rho_q)`` (scipy's CSR
                 matrix-vector product: each row summed from 0 in its stored order), the cut pieces'
                 points weighted 0, then the sub-pieces' products ``(dx_q rho_q) S_qi S_qj`` summed
@@ -47,28 +53,105 @@ def project(nodes, S, G, w, rho, v, sigma, n_nodes, with_mass):
     return m_i, P_i, -F_i
 
 
+@njit(cache=True, inline="always")
+def _locate(nodes, inv_spacing, x):
+    """:func:`mpm_fem.shape.locate` of one point inside the grid (``inv_spacing``: ``1 / h`` on a
+    uniform grid, else 0): its cell ``c`` and ``xi = (x - x_c)/(x_{c+1} - x_c)``."""
+    last = nodes.size - 2
+    if inv_spacing > 0.0:
+        c = min(max(int((x - nodes[0]) * inv_spacing), 0), last)
+        if x < nodes[c] or (x >= nodes[c + 1] and c < last):
+            c = min(np.searchsorted(nodes, x, side="right") - 1, last)
+    else:
+        c = min(np.searchsorted(nodes, x, side="right") - 1, last)
+    x0 = nodes[c]
+    return c, (x - x0) / (nodes[c + 1] - x0)
+
+
+@njit(cache=True, inline="always")
+def _bspline(r):
+    """``N(r)``, ``N'(r)`` of :func:`mpm_fem.shape._quadratic_bspline` at one ``r``."""
+    a = abs(r)
+    if a <= 0.5:
+        return 0.75 - r * r, -2.0 * r
+    if a < 1.5:
+        u = 1.5 - a
+        return 0.5 * (u * u), -u * np.sign(r)
+    return 0.0, 0.0
+
+
+@njit(cache=True)
+def cut_pieces(edges, bp, xi, wq, nodes, h, inv_spacing, bspline):
+    """The pieces ``edges`` (n_pieces + 1,) that the breakpoints ``bp`` inside them cut, and their
+    sub-pieces (module docstring; :meth:`~mpm_fem.exact_stages.QuadratureRule.cuts_numpy`):
+    ``(cut, first, x, w, rows, S, G, cell)`` with ``first`` each cut piece's first sub-piece and
+    then their number, ``x``, ``w``, ``cell`` (n_sub, n_gauss) and ``rows``, ``S``, ``G`` (n_sub,
+    n_gauss, k), ``k = 4`` for the B-splines (``bspline``) and 2 for the hats."""
+    n = edges.size - 1
+    piece = np.searchsorted(edges, bp, side="right") - 1
+    inside = np.zeros(bp.size, np.bool_)
+    for j in range(bp.size):
+        inside[j] = piece[j] >= 0 and piece[j] < n and bp[j] > edges[min(max(piece[j], 0), n)]
+    cut = np.unique(piece[inside])
+    ends = np.unique(np.concatenate((edges[cut], edges[cut + 1], bp[inside])))
+    owner = np.searchsorted(edges, 0.5 * (ends[:-1] + ends[1:])) - 1
+    keep = np.zeros(owner.size, np.bool_)
+    for j in range(owner.size):
+        c = np.searchsorted(cut, owner[j])
+        keep[j] = c < cut.size and cut[c] == owner[j]
+    left, width = ends[:-1][keep], (ends[1:] - ends[:-1])[keep]
+    first = np.append(np.searchsorted(owner[keep], cut), left.size)
+    g, k = xi.size, 4 if bspline else 2
+    x, w, cell = np.empty((left.size, g)), np.empty((left.size, g)), np.empty((left.size, g), np.intp)
+    rows, S, G = np.empty((left.size, g, k), np.intp), np.empty((left.size, g, k)), np.empty((left.size, g, k))
+    top = nodes.size - 1
+    for p in range(left.size):
+        for q in range(g):
+            x[p, q] = (left[p] + 0.5 * width[p]) + 0.5 * width[p] * xi[q]
+            w[p, q] = 0.5 * width[p] * wq[q]
+            c, t = _locate(nodes, inv_spacing, x[p, q])
+            cell[p, q] = c
+            if bspline:
+                for j in range(4):
+                    rows[p, q, j] = min(max(c + j - 1, 0), top)
+                    value, slope = _bspline(t - (j - 1))
+                    S[p, q, j] = value
+                    G[p, q, j] = slope / h[0]
+            else:
+                inv_h = 1.0 / h[c]
+                rows[p, q, 0], rows[p, q, 1] = c, c + 1
+                S[p, q, 0], S[p, q, 1] = 1.0 - t, t
+                G[p, q, 0], G[p, q, 1] = -inv_h, inv_h
+    return cut, first, x, w, rows, S, G, cell
+
+
 @njit(cache=True)
 def _splice_into(out, fixed, sub, cut, first):
-    """``out``: the pieces of ``fixed`` (n_pieces, ...) in order, each cut piece ``cut[j]`` replaced
-    by the sub-pieces ``first[j] ... first[j + 1] - 1`` of ``sub``."""
+    """``out``: the pieces (rows) of ``fixed`` (n_pieces, m) in order, each cut piece ``cut[j]``
+    replaced by the sub-pieces ``first[j] ... first[j + 1] - 1`` of ``sub`` (n_sub, m)."""
     o, start = 0, 0
-    for j in range(cut.size):
-        for p in range(start, cut[j]):
-            out[o] = fixed[p]
+    m = fixed.shape[1]
+    for j in range(cut.size + 1):
+        stop = cut[j] if j < cut.size else fixed.shape[0]
+        for p in range(start, stop):
+            for c in range(m):
+                out[o, c] = fixed[p, c]
             o += 1
-        for p in range(first[j], first[j + 1]):
-            out[o] = sub[p]
-            o += 1
-        start = cut[j] + 1
-    for p in range(start, fixed.shape[0]):
-        out[o] = fixed[p]
-        o += 1
+        if j < cut.size:
+            for p in range(first[j], first[j + 1]):
+                for c in range(m):
+                    out[o, c] = sub[p, c]
+                o += 1
+            start = cut[j] + 1
 
 
 def splice(fixed: np.ndarray, sub: np.ndarray, cut: np.ndarray, first: np.ndarray) -> np.ndarray:
-    """:func:`_splice_into` a new array of ``fixed.shape[0] - cut.size + sub.shape[0]`` pieces."""
+    """:func:`_splice_into` a new array of ``fixed.shape[0] - cut.size + sub.shape[0]`` pieces (the
+    trailing axes of ``fixed`` and ``sub`` alike)."""
     out = np.empty((fixed.shape[0] - cut.size + sub.shape[0], *fixed.shape[1:]), fixed.dtype)
-    _splice_into(out, fixed, sub, cut, first)
+    m = out[0].size if out.size else 1
+    _splice_into(out.reshape(-1, m), np.ascontiguousarray(fixed).reshape(-1, m),
+                 np.ascontiguousarray(sub).reshape(-1, m), cut, first)
     return out
 
 

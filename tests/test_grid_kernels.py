@@ -59,3 +59,31 @@ def test_the_lumped_fe_mass_assembles_its_matrix_only_on_demand():
     assert (build() != M).nnz == 0
     data = exact_projection(grid, "bspline", SOD, 0.1, with_fe_mass=True)
     assert np.array_equal(data.m_i, m) and callable(data.matrix)
+
+
+def test_cut_pieces_equal_numpy_bit_for_bit():
+    """Random breakpoints (outside the domain, on nodes, on half cells, repeated) on uniform grids and,
+    for the hats, a random one: the cut pieces, the sub-pieces' points, weights and rows."""
+    from mpm_fem.grid import grid_from_nodes
+
+    rng = np.random.default_rng(1)
+    grids = [(uniform_grid(0.0, 1.0, h), ("mpm", "bspline")) for h in (0.05, 0.01)]
+    grids += [(uniform_grid(-0.3, 1.7, 0.0125), ("mpm", "bspline"))]
+    grids += [(grid_from_nodes(np.sort(np.concatenate(([0.0, 1.0], rng.uniform(0, 1, 60))))), ("mpm",))]
+    for grid, functions in grids:
+        for kind in functions:
+            rule = quadrature_rule(grid, kind)
+            a, b = grid.domain
+            for trial in range(100):
+                bp = rng.uniform(a - 0.1, b + 0.1, rng.integers(0, 8))
+                if trial % 3 == 0:
+                    bp = np.concatenate((bp, grid.nodes[rng.integers(0, grid.n_nodes, 2)], bp[:1]))
+                if trial % 5 == 0:
+                    bp = np.concatenate((bp, rule.edges[rng.integers(0, rule.edges.size, 2)]))
+                got, want = rule.cuts(bp), rule.cuts_numpy(bp)
+                for name in ("cut", "first", "x", "w"):
+                    u, v = getattr(got, name), getattr(want, name)
+                    assert u.shape == v.shape and np.array_equal(u, v), name
+                for name in ("nodes", "S", "G", "cell"):
+                    u, v = getattr(got.rows, name), getattr(want.rows, name)
+                    assert u.shape == v.shape and np.array_equal(u, v), name
