@@ -208,11 +208,9 @@ class QuadratureRule:
         :meth:`splice_numpy`)."""
         fixed = (self.x, self.w, self.rows.nodes, self.rows.S, self.rows.G, self.rows.cell)
         if cuts.cut.size == 0:
-            parts = fixed
-        else:
-            sub = (cuts.x, cuts.w, cuts.rows.nodes, cuts.rows.S, cuts.rows.G, cuts.rows.cell)
-            parts = [grid_kernels.splice(f, s, cuts.cut, cuts.first) for f, s in zip(fixed, sub)]
-        return self._flat(parts)
+            return self._flat(fixed)
+        sub = (cuts.x, cuts.w, cuts.rows.nodes, cuts.rows.S, cuts.rows.G, cuts.rows.cell)
+        return self._flat(grid_kernels.splice(*fixed, *sub, cuts.cut, cuts.first))
 
     def splice_numpy(self, cuts: Cuts) -> tuple[np.ndarray, np.ndarray, Shape]:
         """The readable reference of :meth:`splice`: runs of fixed pieces and of sub-pieces, concatenated."""
@@ -368,7 +366,7 @@ def fe_mass_operator(grid: Grid, functions: str) -> FEMass:
     assemble = sp.csr_matrix(((vals[:, :, None] * vals[:, None, :]).ravel(),
                               (entry.ravel(), np.repeat(np.arange(n), k * k))), shape=(key.size, n))
     pattern.data = key
-    return FEMass(grid, functions, edges, points, np.asarray(pieces.dx), assemble, pattern)
+    return FEMass(grid, functions, edges, points, np.ascontiguousarray(pieces.dx), assemble, pattern)
 
 
 def fe_mass(grid: Grid, basis: str, fields: ExactFields, t: float, cuts: Cuts | None = None,

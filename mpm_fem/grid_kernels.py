@@ -126,33 +126,50 @@ def cut_pieces(edges, bp, xi, wq, nodes, h, inv_spacing, bspline):
 
 
 @njit(cache=True)
-def _splice_into(out, fixed, sub, cut, first):
-    """``out``: the pieces (rows) of ``fixed`` (n_pieces, m) in order, each cut piece ``cut[j]``
-    replaced by the sub-pieces ``first[j] ... first[j + 1] - 1`` of ``sub`` (n_sub, m)."""
+def _order(n, cut, first):
+    """Where each piece of the spliced rule comes from: ``p >= 0`` the fixed piece ``p``, ``-1 - s``
+    the sub-piece ``s`` (each cut piece ``cut[j]`` replaced by the sub-pieces ``first[j] ...
+    first[j + 1] - 1``)."""
+    order = np.empty(n - cut.size + first[-1], np.int64)
     o, start = 0, 0
-    m = fixed.shape[1]
     for j in range(cut.size + 1):
-        stop = cut[j] if j < cut.size else fixed.shape[0]
+        stop = cut[j] if j < cut.size else n
         for p in range(start, stop):
-            for c in range(m):
-                out[o, c] = fixed[p, c]
+            order[o] = p
             o += 1
         if j < cut.size:
             for p in range(first[j], first[j + 1]):
-                for c in range(m):
-                    out[o, c] = sub[p, c]
+                order[o] = -1 - p
                 o += 1
             start = cut[j] + 1
+    return order
 
 
-def splice(fixed: np.ndarray, sub: np.ndarray, cut: np.ndarray, first: np.ndarray) -> np.ndarray:
-    """:func:`_splice_into` a new array of ``fixed.shape[0] - cut.size + sub.shape[0]`` pieces (the
-    trailing axes of ``fixed`` and ``sub`` alike)."""
-    out = np.empty((fixed.shape[0] - cut.size + sub.shape[0], *fixed.shape[1:]), fixed.dtype)
-    m = out[0].size if out.size else 1
-    _splice_into(out.reshape(-1, m), np.ascontiguousarray(fixed).reshape(-1, m),
-                 np.ascontiguousarray(sub).reshape(-1, m), cut, first)
+@njit(cache=True)
+def _spliced(fixed, sub, order):
+    """The pieces of ``fixed`` and ``sub`` (C-contiguous, the trailing axes alike) in ``order``."""
+    out = np.empty((order.size,) + fixed.shape[1:], fixed.dtype)
+    m = fixed[0].size
+    o2, f2, s2 = out.reshape((order.size, m)), fixed.reshape((fixed.shape[0], m)), sub.reshape((sub.shape[0], m))
+    for o in range(order.size):
+        src = order[o]
+        if src >= 0:
+            for c in range(m):
+                o2[o, c] = f2[src, c]
+        else:
+            for c in range(m):
+                o2[o, c] = s2[-1 - src, c]
     return out
+
+
+@njit(cache=True)
+def splice(x, w, nodes, S, G, cell, sub_x, sub_w, sub_nodes, sub_S, sub_G, sub_cell, cut, first):
+    """The fixed pieces' points ``x``, weights ``w`` (n_pieces, n_gauss), rows ``nodes``, ``S``,
+    ``G`` (n_pieces, n_gauss, k) and ``cell`` with each cut piece replaced by its sub-pieces (the
+    ``sub_`` arrays; :func:`_order`), in order along the domain."""
+    order = _order(x.shape[0], cut, first)
+    return (_spliced(x, sub_x, order), _spliced(w, sub_w, order), _spliced(nodes, sub_nodes, order),
+            _spliced(S, sub_S, order), _spliced(G, sub_G, order), _spliced(cell, sub_cell, order))
 
 
 @njit(cache=True)
@@ -163,10 +180,13 @@ def fe_entries(indptr, indices, data, dx, rho, cut, keys, n_nodes, sub_nodes, su
     ``indptr``, ``indices``, ``data``: the CSR operator ``A`` (entries x points); ``dx``, ``rho``:
     the fixed pieces' (n_pieces, n_gauss) weights and densities; ``cut``: the cut pieces; the sub-
     pieces' rows ``sub_nodes``, ``sub_S`` (n_sub, k), weights ``sub_w`` and densities ``sub_rho``."""
-    q = dx * rho
+    g = dx.shape[1]
+    q = np.empty(dx.size)
+    for p in range(dx.shape[0]):
+        for j in range(g):
+            q[p * g + j] = dx[p, j] * rho[p, j]
     for c in cut:
-        q[c, :] = 0.0
-    q = q.ravel()
+        q[c * g: (c + 1) * g] = 0.0
     n = indptr.size - 1
     out = np.zeros(n)
     for e in range(n):
