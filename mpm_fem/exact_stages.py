@@ -276,6 +276,7 @@ class FEMass:
     dx: np.ndarray  # (n_pieces, GAUSS_POINTS) its weights dx_q
     assemble: sp.csr_matrix  # (nnz of M, n_points): S_qi S_qj in the row of the entry (i, j)
     pattern: sp.csr_matrix  # M's sparsity pattern, data: the keys i n_nodes + j of its entries
+    mirror: np.ndarray  # per entry (i, j): (j, i) where i > j and their rows of assemble are equal, else itself
 
     def __call__(self, fields: ExactFields, t: float, cuts: Cuts | None = None,
                  assembled: bool = True) -> tuple[sp.csr_matrix, np.ndarray]:
@@ -303,7 +304,7 @@ class FEMass:
         k = cuts.rows.nodes.shape[-1]
         n = self.points.size
         data, outside = grid_kernels.fe_entries(
-            self.assemble.indptr, self.assemble.indices, self.assemble.data, self.dx,
+            self.assemble.indptr, self.assemble.indices, self.assemble.data, self.mirror, self.dx,
             rho[:n].reshape(self.dx.shape), cuts.cut, self.keys, self.grid.n_nodes,
             cuts.rows.nodes.reshape(-1, k), cuts.rows.S.reshape(-1, k), cuts.w.ravel(), rho[n:])
         if outside:
@@ -366,7 +367,30 @@ def fe_mass_operator(grid: Grid, functions: str) -> FEMass:
     assemble = sp.csr_matrix(((vals[:, :, None] * vals[:, None, :]).ravel(),
                               (entry.ravel(), np.repeat(np.arange(n), k * k))), shape=(key.size, n))
     pattern.data = key
-    return FEMass(grid, functions, edges, points, np.ascontiguousarray(pieces.dx), assemble, pattern)
+    return FEMass(grid, functions, edges, points, np.ascontiguousarray(pieces.dx), assemble, pattern,
+                  _mirror(assemble, key, grid.n_nodes))
+
+
+def _mirror(assemble: sp.csr_matrix, key: np.ndarray, n: int) -> np.ndarray:
+    """Per entry ``(i, j)`` of ``M``: the entry ``(j, i)`` where ``i > j`` and its row of ``assemble``
+    holds the same points and values, bit for bit (``S_qi S_qj = S_qj S_qi``: ``M_ij`` is then
+    ``M_ji`` bit for bit, summed once), else the entry itself."""
+    entry = np.arange(key.size)
+    i, j = key // n, key % n
+    transposed = np.minimum(np.searchsorted(key, j * n + i), key.size - 1)
+    lengths = np.diff(assemble.indptr)
+    cand = np.flatnonzero((i > j) & (key[transposed] == j * n + i))
+    cand = cand[lengths[cand] == lengths[transposed[cand]]]
+    size = lengths[cand]
+    offset = np.arange(size.sum()) - np.repeat(np.cumsum(size) - size, size)
+    here = np.repeat(assemble.indptr[cand], size) + offset
+    there = np.repeat(assemble.indptr[transposed[cand]], size) + offset
+    bits = assemble.data.view(np.int64)
+    differ = (assemble.indices[here] != assemble.indices[there]) | (bits[here] != bits[there])
+    same = np.bincount(np.repeat(np.arange(cand.size), size), differ, cand.size) == 0
+    mirror = entry.copy()
+    mirror[cand[same]] = transposed[cand[same]]
+    return mirror
 
 
 def fe_mass(grid: Grid, basis: str, fields: ExactFields, t: float, cuts: Cuts | None = None,

@@ -20,8 +20,8 @@ the readable reference.
     splice      the rows of the fixed pieces with each cut piece replaced by its sub-pieces
                 (:meth:`~mpm_fem.exact_stages.QuadratureRule.splice`): copies only.
     fe_entries  the entries of the FE mass, ``M_e = sum_q A_eq (dx_q rho_q)`` (scipy's CSR
-                matrix-vector product: each row summed from 0 in its stored order), the cut pieces'
-                points weighted 0, then the sub-pieces' products ``(dx_q rho_q) S_qi S_qj`` summed
+                matrix-vector product: each row summed from 0 in its stored order; ``M_ji`` copied
+                from ``M_ij`` where their rows of ``A`` are equal), the cut pieces' points weighted 0, then the sub-pieces' products ``(dx_q rho_q) S_qi S_qj`` summed
                 from 0 into their entries in the order of ``np.bincount`` and added.
 """
 
@@ -173,11 +173,13 @@ def splice(x, w, nodes, S, G, cell, sub_x, sub_w, sub_nodes, sub_S, sub_G, sub_c
 
 
 @njit(cache=True)
-def fe_entries(indptr, indices, data, dx, rho, cut, keys, n_nodes, sub_nodes, sub_S, sub_w, sub_rho):
+def fe_entries(indptr, indices, data, mirror, dx, rho, cut, keys, n_nodes, sub_nodes, sub_S, sub_w, sub_rho):
     """The entries of the FE mass (module docstring) and whether a sub-piece product that is not 0
     falls outside the pattern ``keys`` (``i n_nodes + j`` of each stored entry, increasing).
 
-    ``indptr``, ``indices``, ``data``: the CSR operator ``A`` (entries x points); ``dx``, ``rho``:
+    ``indptr``, ``indices``, ``data``: the CSR operator ``A`` (entries x points); ``mirror``: an
+    earlier entry whose row of ``A`` is the same, stored and valued (the transposed entry of a
+    symmetric ``M``), whose sum is then copied, else the entry itself; ``dx``, ``rho``:
     the fixed pieces' (n_pieces, n_gauss) weights and densities; ``cut``: the cut pieces; the sub-
     pieces' rows ``sub_nodes``, ``sub_S`` (n_sub, k), weights ``sub_w`` and densities ``sub_rho``."""
     g = dx.shape[1]
@@ -190,6 +192,9 @@ def fe_entries(indptr, indices, data, dx, rho, cut, keys, n_nodes, sub_nodes, su
     n = indptr.size - 1
     out = np.zeros(n)
     for e in range(n):
+        if mirror[e] < e:  # the same products summed in the same order
+            out[e] = out[mirror[e]]
+            continue
         total = 0.0
         for jj in range(indptr[e], indptr[e + 1]):
             total += data[jj] * q[indices[jj]]

@@ -87,3 +87,17 @@ def test_cut_pieces_equal_numpy_bit_for_bit():
                 for name in ("nodes", "S", "G", "cell"):
                     u, v = getattr(got.rows, name), getattr(want.rows, name)
                     assert u.shape == v.shape and np.array_equal(u, v), name
+
+
+@pytest.mark.parametrize("functions", ["mpm", "bspline"])
+def test_the_fe_mass_sums_a_symmetric_entry_once(functions):
+    """``M_ji`` is copied from ``M_ij`` only where their rows of the operator are the same bit for bit."""
+    op = fe_mass_operator(uniform_grid(0.0, 1.0, 0.01), functions)
+    n, A = op.grid.n_nodes, op.assemble
+    shared = np.flatnonzero(op.mirror != np.arange(op.keys.size))
+    assert shared.size > 0.3 * op.keys.size
+    for e in shared:
+        f = op.mirror[e]
+        assert f < e and op.keys[f] == (op.keys[e] % n) * n + op.keys[e] // n
+        assert np.array_equal(A.indices[A.indptr[e]:A.indptr[e + 1]], A.indices[A.indptr[f]:A.indptr[f + 1]])
+        assert np.array_equal(A.data[A.indptr[e]:A.indptr[e + 1]], A.data[A.indptr[f]:A.indptr[f + 1]])
