@@ -451,7 +451,7 @@ class ExactGridStage:
         projection exact   the quadrature data ``quad`` (:func:`exact_projection`) replace the particles'
         mass exact         v_i = v*_i + [solve(MPM data) - solve(exact data)] (``solve``: the lumped
                            division; exact data with the FE mass when the projection is MPM)
-        both exact         v_i = v*_i
+        both exact         v_i = v*_i (and a_i = a*_i: no quadrature data are made)
 
     and the exact nodal values with the grid's boundary rule, ``star_v = BC(v*_i)``,
     ``star_a = BC(a*_i)``, which the exact interpolation corrects against. :meth:`acceleration`
@@ -460,13 +460,15 @@ class ExactGridStage:
     def __init__(self, grid: Grid, boundary, stages, exact: ExactFields, mpm: GridData, t: float, dt: float):
         self.grid, self.boundary, self.stages, self.mpm, self.t, self.dt = grid, boundary, stages, mpm, t, dt
         fe_mass_stage = stages.mass == "exact" and stages.projection == "mpm"  # solves exact data with the FE mass
+        # the quadrature data where a solve reads them (both exact: v_i = v*_i reads none)
         self.quad = (exact_projection(grid, stages.basis, exact, t, with_fe_mass=fe_mass_stage)
-                     if stages.projection == "exact" or stages.mass == "exact" else None)
+                     if (stages.projection == "exact") != (stages.mass == "exact") else None)
         self.source = self.quad if stages.projection == "exact" else mpm
         self.kind = "lumped" if stages.mass == "exact" else stages.mass
         ref_v, _, self.ref_a = exact.reference(grid.nodes, t)
         P_exact = self.quad.P_i if self.quad is not None else None
-        self.v_i = boundary.velocity(grid, self.solve(self.source.P_i, P_exact, ref_v), t)
+        self.v_i = boundary.velocity(grid, self.solve(self.source.P_i if self.source is not None else None,
+                                                      P_exact, ref_v), t)
         self.star_v = boundary.velocity(grid, ref_v, t)
         self.star_a = boundary.acceleration(grid, self.ref_a, self.star_v, t, dt)
 
@@ -476,12 +478,20 @@ class ExactGridStage:
             return nodal_values(self.source, rhs, self.kind)
         if self.stages.projection == "exact":
             return reference.copy()
-        return reference + nodal_values(self.mpm, rhs, self.kind) - nodal_values(self.quad, exact_rhs, self.kind)
+        # the lumped solves (the mass stage's form) in one compiled pass
+        return grid_kernels.corrected(reference, rhs, self.mpm.m_i, exact_rhs, self.quad.m_i)
+
+    def solve_numpy(self, rhs: np.ndarray, exact_rhs: np.ndarray | None, reference: np.ndarray) -> np.ndarray:
+        """The readable reference of :meth:`solve` (equal bit for bit): the mass exact and the
+        projection MPM give ``v*_i + rhs_i / m_i - rhs*_i / m*_i`` with :func:`nodal_values`."""
+        if self.stages.mass == "exact" and self.stages.projection == "mpm":
+            return reference + nodal_values(self.mpm, rhs, self.kind) - nodal_values(self.quad, exact_rhs, self.kind)
+        return self.solve(rhs, exact_rhs, reference)
 
     def acceleration(self, F_mpm: np.ndarray | None) -> np.ndarray:
         """``a_i`` from the particles' force ``F_mpm`` (the quadrature's when the projection is exact,
         where ``F_mpm`` may be None), the boundary rule applied."""
-        F_i = F_mpm if self.stages.projection == "mpm" else self.quad.F_i
+        F_i = F_mpm if self.stages.projection == "mpm" else (self.quad.F_i if self.quad is not None else None)
         a_i = self.solve(F_i, self.quad.F_i if self.quad is not None else None, self.ref_a)
         return self.boundary.acceleration(self.grid, a_i, self.v_i, self.t, self.dt)
 

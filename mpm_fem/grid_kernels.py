@@ -23,6 +23,9 @@ the readable reference.
                 matrix-vector product: each row summed from 0 in its stored order; ``M_ji`` copied
                 from ``M_ij`` where their rows of ``A`` are equal), the cut pieces' points weighted 0, then the sub-pieces' products ``(dx_q rho_q) S_qi S_qj`` summed
                 from 0 into their entries in the order of ``np.bincount`` and added.
+    corrected   the exact mass stage's nodal value ``u*_i + rhs_i / m_i - rhs*_i / m*_i``, each
+                lumped division 0 where its mass is not positive
+                (:func:`~mpm_fem.transfer.divide_by_lumped`), added in that order.
 """
 
 from __future__ import annotations
@@ -216,3 +219,14 @@ def fe_entries(indptr, indices, data, mirror, dx, rho, cut, keys, n_nodes, sub_n
                     extra[entry] += product
         out = out + extra
     return out, outside
+
+
+@njit(cache=True)
+def corrected(reference, rhs, m, exact_rhs, exact_m):
+    """``(reference_i + rhs_i / m_i) - exact_rhs_i / exact_m_i`` (module docstring)."""
+    out = np.empty(reference.size)
+    for i in range(reference.size):
+        a = rhs[i] / m[i] if m[i] > 0 else 0.0
+        b = exact_rhs[i] / exact_m[i] if exact_m[i] > 0 else 0.0
+        out[i] = (reference[i] + a) - b
+    return out

@@ -101,3 +101,23 @@ def test_the_fe_mass_sums_a_symmetric_entry_once(functions):
         assert f < e and op.keys[f] == (op.keys[e] % n) * n + op.keys[e] // n
         assert np.array_equal(A.indices[A.indptr[e]:A.indptr[e + 1]], A.indices[A.indptr[f]:A.indptr[f + 1]])
         assert np.array_equal(A.data[A.indptr[e]:A.indptr[e + 1]], A.data[A.indptr[f]:A.indptr[f + 1]])
+
+
+@pytest.mark.parametrize("basis", ["mpm", "bspline"])
+def test_the_exact_mass_stage_solve_equals_numpy_bit_for_bit(basis):
+    """``v*_i + P_i / m_i - P*_i / m*_i`` compiled, against :func:`nodal_values` (a node without mass included)."""
+    from mpm_fem.exact_stages import ExactGridStage, GridData
+    from mpm_fem.step import Stages, Walls
+
+    grid = uniform_grid(0.0, 1.0, 0.01)
+    rng = np.random.default_rng(2)
+    m_i, P_i = rng.uniform(0.5, 1.5, grid.n_nodes), rng.normal(size=grid.n_nodes)
+    m_i[[0, 7]] = 0.0
+    mpm = GridData(None, None, m_i, P_i)
+    for t in (0.0, 0.1):
+        stage = ExactGridStage(grid, Walls(), Stages(mass="exact", basis=basis), SOD, mpm, t, 1e-3)
+        F = rng.normal(size=grid.n_nodes)
+        for rhs, exact_rhs, ref in ((P_i, stage.quad.P_i, stage.star_v), (F, stage.quad.F_i, stage.ref_a)):
+            assert np.array_equal(stage.solve(rhs, exact_rhs, ref), stage.solve_numpy(rhs, exact_rhs, ref))
+    both = ExactGridStage(grid, Walls(), Stages(mass="exact", projection="exact", basis=basis), SOD, mpm, 0.1, 1e-3)
+    assert both.quad is None and np.array_equal(both.v_i, both.star_v)  # v_i = v*_i: no quadrature made
