@@ -75,10 +75,12 @@ def _left_wave_point(s, w, p_star, u_star, gamma):
 
 @njit(cache=True)
 def _sample_pass(x, t, x0, gamma, p_star, u_star, left, right):
-    """One pass over the points: ``rho, u, p`` outside the fans, ``rho_K, u, p_K`` and ``c`` inside."""
+    """One pass over the points: ``rho, u, p`` outside the fans, ``rho_K, u, p_K`` inside, and the
+    fan points' indices with their ``c``, in order."""
     n = x.size
-    rho, u, p, c = np.empty(n), np.empty(n), np.empty(n), np.zeros(n)
-    fan = np.zeros(n, np.bool_)
+    rho, u, p, c = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    fan = np.empty(n, np.int64)
+    k = 0
     for q in range(n):
         s = (x[q] - x0) / t
         if s <= u_star:
@@ -86,23 +88,32 @@ def _sample_pass(x, t, x0, gamma, p_star, u_star, left, right):
         else:
             r, v, pr, cq, region = _left_wave_point(-s, right, p_star, -u_star, gamma)
             v = -v
-        rho[q], u[q], p[q], c[q] = r, v, pr, cq
-        fan[q] = region == FAN
-    return rho, u, p, c, fan
+        rho[q], u[q], p[q] = r, v, pr
+        if region == FAN:
+            fan[k], c[k] = q, cq
+            k += 1
+    return rho, u, p, c[:k].copy(), fan[:k]
+
+
+@njit(cache=True)
+def _scale_fan(rho, p, fan, rho_power, p_power):
+    """``rho_q <- rho_q c^(2/(gamma-1))``, ``p_q <- p_q c^(2 gamma/(gamma-1))`` at the fan points ``fan``."""
+    for j in range(fan.size):
+        rho[fan[j]] = rho[fan[j]] * rho_power[j]
+        p[fan[j]] = p[fan[j]] * p_power[j]
 
 
 def sample(x: np.ndarray, t: float, x0: float, gamma: float, p_star: float, u_star: float,
            left: np.ndarray, right: np.ndarray):
     """``(rho, u, p)`` of the Riemann problem at ``x`` and ``t > 0`` (no vacuum), equal bit for bit
     to :func:`baselines.exact.riemann.sample`. ``left`` and ``right`` are :func:`wave_constants` of
-    the left wave and of the mirrored right wave."""
+    the left wave and of the mirrored right wave. numpy raises the fan points' ``c`` (one array, in
+    the order of the points, as the numpy reference's ``c[fan]``) to the two powers."""
     x = np.ascontiguousarray(x, dtype=float)
     rho, u, p, c, fan = _sample_pass(x.ravel(), float(t), float(x0), float(gamma), float(p_star), float(u_star),
                                      left, right)
-    if fan.any():
-        cf = c[fan]
-        rho[fan] = rho[fan] * cf ** (2.0 / (gamma - 1.0))
-        p[fan] = p[fan] * cf ** (2.0 * gamma / (gamma - 1.0))
+    if fan.size:
+        _scale_fan(rho, p, fan, c ** (2.0 / (gamma - 1.0)), c ** (2.0 * gamma / (gamma - 1.0)))
     return rho.reshape(x.shape), u.reshape(x.shape), p.reshape(x.shape)
 
 

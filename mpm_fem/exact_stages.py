@@ -47,14 +47,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
-from typing import Protocol
+from typing import Callable, Protocol
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 from skfem import Basis, ElementLineP1, ElementLineP2, MeshLine
 
-from . import exact_kernels
+from . import exact_kernels, grid_kernels
 from .grid import Grid
 from .shape import Shape, grid_functions, make_shape
 from .transfer import divide_by_lumped, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
@@ -87,14 +87,15 @@ class ExactFields(Protocol):
 class GridData:
     """What the projection hands the grid: the kernel and weights of the particles (or quadrature
     points), and ``m_i``, ``P_i``, ``F_i``. The mass matrix is ``matrix`` where given (the FE mass
-    of exact data, :func:`fe_mass`), else the particle matrix ``M_ij = sum_q w_q S_iq S_jq``."""
+    of exact data, :func:`fe_mass`, or a function of no arguments that assembles it: the lumped
+    solve needs only ``m_i``), else the particle matrix ``M_ij = sum_q w_q S_iq S_jq``."""
 
     shape: Shape
     mass: np.ndarray
     m_i: np.ndarray
     P_i: np.ndarray
     F_i: np.ndarray | None = field(default=None)
-    matrix: sp.csr_matrix | None = field(default=None)
+    matrix: sp.csr_matrix | Callable[[], sp.csr_matrix] | None = field(default=None)
 
 
 def nodal_values(data: GridData, rhs: np.ndarray, kind: str) -> np.ndarray:
@@ -105,7 +106,8 @@ def nodal_values(data: GridData, rhs: np.ndarray, kind: str) -> np.ndarray:
     if kind == "lumped":
         return divide_by_lumped(rhs, data.m_i)
     if kind == "consistent":
-        return spsolve(data.matrix.tocsc(), rhs)
+        matrix = data.matrix() if callable(data.matrix) else data.matrix
+        return spsolve(matrix.tocsc(), rhs)
     raise ValueError(f"unknown mass kind {kind!r}; choose one of lumped, consistent")
 
 
@@ -134,13 +136,27 @@ def _gauss(left: np.ndarray, width: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
 
 @dataclass(frozen=True, eq=False)
+class Cuts:
+    """The fixed pieces (nodes and half cells) that the breakpoints of one time cut, and the
+    sub-pieces that replace them, with their Gauss points, weights and rows: what
+    :class:`QuadratureRule` and :class:`FEMass` (the same fixed pieces) both splice in, made once a
+    step (:meth:`QuadratureRule.cuts`)."""
+
+    cut: np.ndarray  # (n_cut,) the cut pieces, increasing
+    first: np.ndarray  # (n_cut + 1,) each cut piece's first sub-piece, then the number of sub-pieces
+    x: np.ndarray  # (n_sub, GAUSS_POINTS) the sub-pieces' Gauss points
+    w: np.ndarray  # (n_sub, GAUSS_POINTS) and weights
+    rows: Shape  # rows of the points x, as (n_sub, GAUSS_POINTS, k) arrays
+
+
+@dataclass(frozen=True, eq=False)
 class QuadratureRule:
     """:func:`quadrature` with the grid functions at its points, for one grid: the points, weights
     and rows ``S_qi``, ``S_i'(x_q)`` of the fixed pieces (nodes and half cells) are evaluated once
     (:func:`quadrature_rule`); per step only the pieces that a breakpoint cuts are evaluated again,
-    on their sub-pieces, and spliced in at their place. The points, weights and rows are those of
-    ``quadrature(grid, breakpoints)`` and ``make_shape(grid, x, w, functions)`` bit for bit (each
-    row depends on its own point only)."""
+    on their sub-pieces (:meth:`cuts`), and spliced in at their place (:meth:`splice`). The points,
+    weights and rows are those of ``quadrature(grid, breakpoints)`` and ``make_shape(grid, x, w,
+    functions)`` bit for bit (each row depends on its own point only)."""
 
     grid: Grid
     functions: str
@@ -151,26 +167,59 @@ class QuadratureRule:
 
     def __call__(self, breakpoints) -> tuple[np.ndarray, np.ndarray, Shape]:
         """``(x, w, shape)`` of the rule split at ``breakpoints`` (those inside the domain)."""
+        return self.splice(self.cuts(breakpoints))
+
+    def cuts(self, breakpoints) -> Cuts:
+        """The pieces cut by ``breakpoints`` (those inside the domain) and their sub-pieces: the
+        compiled :func:`~mpm_fem.grid_kernels.cut_pieces`, equal bit for bit to :meth:`cuts_numpy`."""
+        bp = np.ascontiguousarray(breakpoints, dtype=float).ravel()
+        grid = self.grid
+        inv_spacing = 1.0 / grid.uniform_spacing if grid.uniform_spacing is not None else 0.0
+        cut, first, x, w, nodes, S, G, cell = grid_kernels.cut_pieces(
+            self.edges, bp, _XI, _W, grid.nodes, grid.h, inv_spacing, self.functions == "bspline")
+        return Cuts(cut, first, x, w, Shape(nodes, S, G, grid.n_nodes, cell))
+
+    def cuts_numpy(self, breakpoints) -> Cuts:
+        """The readable reference of :meth:`cuts`: :func:`_gauss` and :func:`~mpm_fem.shape.make_shape`
+        on the sub-pieces."""
         bp = np.asarray(breakpoints, dtype=float).ravel()
         n = self.x.shape[0]
         piece = np.searchsorted(self.edges, bp, side="right") - 1
         inside = (piece >= 0) & (piece < n) & (bp > self.edges[np.clip(piece, 0, n)])
         cut = np.unique(piece[inside])
-        fixed = (self.x, self.w, self.rows.nodes, self.rows.S, self.rows.G, self.rows.cell)
-        if cut.size == 0:
-            parts = fixed
-        else:
-            edges = np.unique(np.concatenate((self.edges[cut], self.edges[cut + 1], bp[inside])))
-            owner = np.searchsorted(self.edges, 0.5 * (edges[:-1] + edges[1:])) - 1
-            keep = np.isin(owner, cut)
-            x, w = _gauss(edges[:-1][keep], np.diff(edges)[keep])
+        edges = np.unique(np.concatenate((self.edges[cut], self.edges[cut + 1], bp[inside])))
+        owner = np.searchsorted(self.edges, 0.5 * (edges[:-1] + edges[1:])) - 1
+        keep = np.isin(owner, cut)
+        x, w = _gauss(edges[:-1][keep], np.diff(edges)[keep])
+        k = GAUSS_POINTS
+        if x.size:
             sub = make_shape(self.grid, x, w, self.functions)
-            k = GAUSS_POINTS
-            pieces = (x.reshape(-1, k), w.reshape(-1, k), *(a.reshape(-1, k, *a.shape[1:])
-                                                             for a in (sub.nodes, sub.S, sub.G, sub.cell)))
-            first = np.searchsorted(owner[keep], cut).tolist()  # each cut piece's first sub-piece
-            runs = _runs(cut.tolist(), first + [int(keep.sum())], n)
-            parts = [np.concatenate([(f, s)[j][lo:hi] for j, lo, hi in runs]) for f, s in zip(fixed, pieces)]
+            rows = Shape(*(a.reshape(-1, k, *a.shape[1:]) for a in (sub.nodes, sub.S, sub.G)), self.grid.n_nodes,
+                         sub.cell.reshape(-1, k))
+        else:
+            rows = Shape(*(a[:0] for a in (self.rows.nodes, self.rows.S, self.rows.G)), self.grid.n_nodes,
+                         self.rows.cell[:0])
+        first = np.append(np.searchsorted(owner[keep], cut), keep.sum())  # each cut piece's first sub-piece
+        return Cuts(cut, first, x.reshape(-1, k), w.reshape(-1, k), rows)
+
+    def splice(self, cuts: Cuts) -> tuple[np.ndarray, np.ndarray, Shape]:
+        """``(x, w, shape)``: the fixed pieces with the cut ones replaced by their sub-pieces, in
+        order along the domain (the compiled :func:`~mpm_fem.grid_kernels.splice`, equal to
+        :meth:`splice_numpy`)."""
+        fixed = (self.x, self.w, self.rows.nodes, self.rows.S, self.rows.G, self.rows.cell)
+        if cuts.cut.size == 0:
+            return self._flat(fixed)
+        sub = (cuts.x, cuts.w, cuts.rows.nodes, cuts.rows.S, cuts.rows.G, cuts.rows.cell)
+        return self._flat(grid_kernels.splice(*fixed, *sub, cuts.cut, cuts.first))
+
+    def splice_numpy(self, cuts: Cuts) -> tuple[np.ndarray, np.ndarray, Shape]:
+        """The readable reference of :meth:`splice`: runs of fixed pieces and of sub-pieces, concatenated."""
+        fixed = (self.x, self.w, self.rows.nodes, self.rows.S, self.rows.G, self.rows.cell)
+        sub = (cuts.x, cuts.w, cuts.rows.nodes, cuts.rows.S, cuts.rows.G, cuts.rows.cell)
+        runs = _runs(cuts.cut.tolist(), cuts.first.tolist(), self.x.shape[0])
+        return self._flat([np.concatenate([(f, s)[j][lo:hi] for j, lo, hi in runs]) for f, s in zip(fixed, sub)])
+
+    def _flat(self, parts) -> tuple[np.ndarray, np.ndarray, Shape]:
         x, w, nodes, S, G, cell = parts
         k = nodes.shape[-1]
         shape = Shape(nodes.reshape(-1, k), S.reshape(-1, k), G.reshape(-1, k), self.grid.n_nodes, cell.ravel())
@@ -227,31 +276,59 @@ class FEMass:
     dx: np.ndarray  # (n_pieces, GAUSS_POINTS) its weights dx_q
     assemble: sp.csr_matrix  # (nnz of M, n_points): S_qi S_qj in the row of the entry (i, j)
     pattern: sp.csr_matrix  # M's sparsity pattern, data: the keys i n_nodes + j of its entries
+    mirror: np.ndarray  # per entry (i, j): (j, i) where i > j and their rows of assemble are equal, else itself
 
-    def __call__(self, fields: ExactFields, t: float) -> tuple[sp.csr_matrix, np.ndarray]:
-        """``(M, m)`` of the exact density of ``fields`` at time ``t``."""
-        bp = np.asarray(fields.breakpoints(t), dtype=float)
-        piece = np.searchsorted(self.edges, bp, side="right") - 1
-        inside = (piece >= 0) & (piece < self.dx.shape[0]) & (bp > self.edges[np.clip(piece, 0, self.dx.shape[0])])
-        cut = np.unique(piece[inside])
-        edges = np.unique(np.concatenate((self.edges[cut], self.edges[cut + 1], bp[inside])))
-        keep = np.isin(np.searchsorted(self.edges, 0.5 * (edges[:-1] + edges[1:])) - 1, cut)
-        x, w = _gauss(edges[:-1][keep], np.diff(edges)[keep])  # the sub-pieces of the cut pieces
-        rho = fields.integrand(np.concatenate((self.points.ravel(), x)), t)[0]
+    def __call__(self, fields: ExactFields, t: float, cuts: Cuts | None = None,
+                 assembled: bool = True) -> tuple[sp.csr_matrix, np.ndarray]:
+        """``(M, m)`` of the exact density of ``fields`` at time ``t``. ``cuts``: the pieces the
+        breakpoints cut (:meth:`QuadratureRule.cuts`), when the caller has made them already;
+        ``assembled=False``: ``M`` is a function of no arguments that assembles it (the lumped
+        solves need ``m`` only)."""
+        data = self.entries(fields, t, cuts)
+        m = np.add.reduceat(data, self.pattern.indptr[:-1])
+        return (self._matrix(data) if assembled else lambda: self._matrix(data)), m
+
+    def _matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        return sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), self.pattern.shape)
+
+    def _density(self, fields: ExactFields, t: float, cuts: Cuts | None) -> tuple[Cuts, np.ndarray]:
+        """The cut pieces, and the density at the fixed Gauss points then at the sub-pieces' points."""
+        if cuts is None:
+            cuts = quadrature_rule(self.grid, self.functions).cuts(fields.breakpoints(t))
+        return cuts, fields.integrand(np.concatenate((self.points.ravel(), cuts.x.ravel())), t)[0]
+
+    def entries(self, fields: ExactFields, t: float, cuts: Cuts | None = None) -> np.ndarray:
+        """The stored entries of ``M`` (in the order of :attr:`pattern`): the compiled
+        :func:`~mpm_fem.grid_kernels.fe_entries`, equal bit for bit to :meth:`entries_numpy`."""
+        cuts, rho = self._density(fields, t, cuts)
+        k = cuts.rows.nodes.shape[-1]
+        n = self.points.size
+        data, outside = grid_kernels.fe_entries(
+            self.assemble.indptr, self.assemble.indices, self.assemble.data, self.mirror, self.dx,
+            rho[:n].reshape(self.dx.shape), cuts.cut, self.keys, self.grid.n_nodes,
+            cuts.rows.nodes.reshape(-1, k), cuts.rows.S.reshape(-1, k), cuts.w.ravel(), rho[n:])
+        if outside:
+            raise RuntimeError("a sub-piece couples nodes outside the FE mass pattern")
+        return data
+
+    def entries_numpy(self, fields: ExactFields, t: float, cuts: Cuts | None = None) -> np.ndarray:
+        """The readable reference of :meth:`entries`: ``A (dx rho)`` with the cut pieces' points
+        weighted 0, plus the sub-pieces' ``w_q rho_q S_qi S_qj`` summed into their entries."""
+        cuts, rho = self._density(fields, t, cuts)
         q = self.dx * np.reshape(rho[: self.points.size], self.dx.shape)
-        q[cut] = 0.0
+        q[cuts.cut] = 0.0
         data = self.assemble @ q.ravel()
-        if x.size:
-            shape = make_shape(self.grid, x, w, self.functions)
+        if cuts.x.size:
+            k = cuts.rows.nodes.shape[-1]
+            nodes, S, w = cuts.rows.nodes.reshape(-1, k), cuts.rows.S.reshape(-1, k), cuts.w.ravel()
             n = self.grid.n_nodes
-            wanted = shape.nodes[:, :, None] * n + shape.nodes[:, None, :]
+            wanted = nodes[:, :, None] * n + nodes[:, None, :]
             entry = np.minimum(np.searchsorted(self.keys, wanted), self.keys.size - 1)
-            product = (w * rho[self.points.size:])[:, None, None] * shape.S[:, :, None] * shape.S[:, None, :]
+            product = (w * rho[self.points.size:])[:, None, None] * S[:, :, None] * S[:, None, :]
             if np.any((self.keys[entry] != wanted) & (product != 0)):
                 raise RuntimeError("a sub-piece couples nodes outside the FE mass pattern")
             data = data + np.bincount(entry.ravel(), product.ravel(), self.keys.size)
-        M = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), self.pattern.shape)
-        return M, np.add.reduceat(data, self.pattern.indptr[:-1])
+        return data
 
     @property
     def keys(self) -> np.ndarray:
@@ -290,17 +367,42 @@ def fe_mass_operator(grid: Grid, functions: str) -> FEMass:
     assemble = sp.csr_matrix(((vals[:, :, None] * vals[:, None, :]).ravel(),
                               (entry.ravel(), np.repeat(np.arange(n), k * k))), shape=(key.size, n))
     pattern.data = key
-    return FEMass(grid, functions, edges, points, np.asarray(pieces.dx), assemble, pattern)
+    return FEMass(grid, functions, edges, points, np.ascontiguousarray(pieces.dx), assemble, pattern,
+                  _mirror(assemble, key, grid.n_nodes))
 
 
-def fe_mass(grid: Grid, basis: str, fields: ExactFields, t: float) -> tuple[sp.csr_matrix, np.ndarray]:
+def _mirror(assemble: sp.csr_matrix, key: np.ndarray, n: int) -> np.ndarray:
+    """Per entry ``(i, j)`` of ``M``: the entry ``(j, i)`` where ``i > j`` and its row of ``assemble``
+    holds the same points and values, bit for bit (``S_qi S_qj = S_qj S_qi``: ``M_ij`` is then
+    ``M_ji`` bit for bit, summed once), else the entry itself."""
+    entry = np.arange(key.size)
+    i, j = key // n, key % n
+    transposed = np.minimum(np.searchsorted(key, j * n + i), key.size - 1)
+    lengths = np.diff(assemble.indptr)
+    cand = np.flatnonzero((i > j) & (key[transposed] == j * n + i))
+    cand = cand[lengths[cand] == lengths[transposed[cand]]]
+    size = lengths[cand]
+    offset = np.arange(size.sum()) - np.repeat(np.cumsum(size) - size, size)
+    here = np.repeat(assemble.indptr[cand], size) + offset
+    there = np.repeat(assemble.indptr[transposed[cand]], size) + offset
+    bits = assemble.data.view(np.int64)
+    differ = (assemble.indices[here] != assemble.indices[there]) | (bits[here] != bits[there])
+    same = np.bincount(np.repeat(np.arange(cand.size), size), differ, cand.size) == 0
+    mirror = entry.copy()
+    mirror[cand[same]] = transposed[cand[same]]
+    return mirror
+
+
+def fe_mass(grid: Grid, basis: str, fields: ExactFields, t: float, cuts: Cuts | None = None,
+            assembled: bool = True) -> tuple[sp.csr_matrix, np.ndarray]:
     """The FE mass matrices of the exact density (:class:`FEMass`):
 
         M_ij = int rho S_i S_j dx,      m_i = sum_j M_ij,
 
     the lumped mass being the row sums (``= int rho S_i dx``: the grid functions sum to 1). ``S_i``
-    are the grid functions of ``basis`` (P1 hats, or quadratic B-splines for the B-spline bases)."""
-    return fe_mass_operator(grid, grid_functions(basis))(fields, t)
+    are the grid functions of ``basis`` (P1 hats, or quadratic B-splines for the B-spline bases).
+    ``cuts`` and ``assembled``: as :meth:`FEMass.__call__`."""
+    return fe_mass_operator(grid, grid_functions(basis))(fields, t, cuts, assembled)
 
 
 def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float, with_fe_mass: bool = False) -> GridData:
@@ -313,11 +415,30 @@ def exact_projection(grid: Grid, basis: str, fields: ExactFields, t: float, with
     (the exact form of the mass stage): the mass matrices are instead the FE mass of
     :func:`fe_mass` (on scikit-fem's basis), ``m_i`` its row sums (the same integrals).
     """
-    x, w, shape = quadrature_rule(grid, grid_functions(basis))(fields.breakpoints(t))
+    rule = quadrature_rule(grid, grid_functions(basis))
+    cuts = rule.cuts(fields.breakpoints(t))
+    x, w, shape = rule.splice(cuts)
     rho, v, sigma = fields.integrand(x, t)
+    M, m_fe = fe_mass(grid, basis, fields, t, cuts=cuts, assembled=False) if with_fe_mass else (None, None)
+    m_i, P_i, F_i = nodal_sums(shape, w, rho, v, sigma, with_mass=not with_fe_mass)
+    return GridData(shape, w * rho, m_i if m_fe is None else m_fe, P_i, F_i, M)
+
+
+def nodal_sums(shape: Shape, w: np.ndarray, rho: np.ndarray, v: np.ndarray, sigma: np.ndarray,
+               with_mass: bool = True) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
+    """``m_i`` (``None`` unless ``with_mass``), ``P_i``, ``F_i`` of quadrature points of weight ``w``:
+    the compiled :func:`~mpm_fem.grid_kernels.project`, equal bit for bit to :func:`nodal_sums_numpy`."""
+    m_i, P_i, F_i = grid_kernels.project(shape.nodes, shape.S, shape.G, w, rho, v, sigma, shape.n_nodes, with_mass)
+    return (m_i if with_mass else None), P_i, F_i
+
+
+def nodal_sums_numpy(shape: Shape, w: np.ndarray, rho: np.ndarray, v: np.ndarray, sigma: np.ndarray,
+                     with_mass: bool = True) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
+    """The readable reference of :func:`nodal_sums` (:mod:`mpm_fem.transfer`): the points as
+    particles of mass ``w rho`` and volume ``w``."""
     mass = w * rho
-    M, m_i = fe_mass(grid, basis, fields, t) if with_fe_mass else (None, nodal_mass(shape, mass))
-    return GridData(shape, mass, m_i, nodal_momentum(shape, mass, v), nodal_internal_force(shape, w, sigma), M)
+    return (nodal_mass(shape, mass) if with_mass else None), nodal_momentum(shape, mass, v), \
+        nodal_internal_force(shape, w, sigma)
 
 
 class ExactGridStage:
@@ -330,7 +451,7 @@ class ExactGridStage:
         projection exact   the quadrature data ``quad`` (:func:`exact_projection`) replace the particles'
         mass exact         v_i = v*_i + [solve(MPM data) - solve(exact data)] (``solve``: the lumped
                            division; exact data with the FE mass when the projection is MPM)
-        both exact         v_i = v*_i
+        both exact         v_i = v*_i (and a_i = a*_i: no quadrature data are made)
 
     and the exact nodal values with the grid's boundary rule, ``star_v = BC(v*_i)``,
     ``star_a = BC(a*_i)``, which the exact interpolation corrects against. :meth:`acceleration`
@@ -339,13 +460,15 @@ class ExactGridStage:
     def __init__(self, grid: Grid, boundary, stages, exact: ExactFields, mpm: GridData, t: float, dt: float):
         self.grid, self.boundary, self.stages, self.mpm, self.t, self.dt = grid, boundary, stages, mpm, t, dt
         fe_mass_stage = stages.mass == "exact" and stages.projection == "mpm"  # solves exact data with the FE mass
+        # the quadrature data where a solve reads them (both exact: v_i = v*_i reads none)
         self.quad = (exact_projection(grid, stages.basis, exact, t, with_fe_mass=fe_mass_stage)
-                     if stages.projection == "exact" or stages.mass == "exact" else None)
+                     if (stages.projection == "exact") != (stages.mass == "exact") else None)
         self.source = self.quad if stages.projection == "exact" else mpm
         self.kind = "lumped" if stages.mass == "exact" else stages.mass
         ref_v, _, self.ref_a = exact.reference(grid.nodes, t)
         P_exact = self.quad.P_i if self.quad is not None else None
-        self.v_i = boundary.velocity(grid, self.solve(self.source.P_i, P_exact, ref_v), t)
+        self.v_i = boundary.velocity(grid, self.solve(self.source.P_i if self.source is not None else None,
+                                                      P_exact, ref_v), t)
         self.star_v = boundary.velocity(grid, ref_v, t)
         self.star_a = boundary.acceleration(grid, self.ref_a, self.star_v, t, dt)
 
@@ -355,12 +478,20 @@ class ExactGridStage:
             return nodal_values(self.source, rhs, self.kind)
         if self.stages.projection == "exact":
             return reference.copy()
-        return reference + nodal_values(self.mpm, rhs, self.kind) - nodal_values(self.quad, exact_rhs, self.kind)
+        # the lumped solves (the mass stage's form) in one compiled pass
+        return grid_kernels.corrected(reference, rhs, self.mpm.m_i, exact_rhs, self.quad.m_i)
+
+    def solve_numpy(self, rhs: np.ndarray, exact_rhs: np.ndarray | None, reference: np.ndarray) -> np.ndarray:
+        """The readable reference of :meth:`solve` (equal bit for bit): the mass exact and the
+        projection MPM give ``v*_i + rhs_i / m_i - rhs*_i / m*_i`` with :func:`nodal_values`."""
+        if self.stages.mass == "exact" and self.stages.projection == "mpm":
+            return reference + nodal_values(self.mpm, rhs, self.kind) - nodal_values(self.quad, exact_rhs, self.kind)
+        return self.solve(rhs, exact_rhs, reference)
 
     def acceleration(self, F_mpm: np.ndarray | None) -> np.ndarray:
         """``a_i`` from the particles' force ``F_mpm`` (the quadrature's when the projection is exact,
         where ``F_mpm`` may be None), the boundary rule applied."""
-        F_i = F_mpm if self.stages.projection == "mpm" else self.quad.F_i
+        F_i = F_mpm if self.stages.projection == "mpm" else (self.quad.F_i if self.quad is not None else None)
         a_i = self.solve(F_i, self.quad.F_i if self.quad is not None else None, self.ref_a)
         return self.boundary.acceleration(self.grid, a_i, self.v_i, self.t, self.dt)
 

@@ -74,7 +74,7 @@ Taylor reconstruction. The exact stages of the error budget (an exact projection
 interpolation) run compiled for the gas with USL, the lumped mass and the calculated acceleration
 (:meth:`FusedStep._exact_step`): pass 1 gives the particles' sums; the grid stage is the numpy
 step's own (:class:`~mpm_fem.exact_stages.ExactGridStage`: the quadrature, the FE mass, the exact
-nodal values); pass 2 is the plain one with the MPM interpolation, else
+nodal values; its sums compiled in :mod:`mpm_fem.grid_kernels`); pass 2 is the plain one with the MPM interpolation, else
 
     pass 2   v_p += dt (a*_p + sum_i S_ip (a_i - a*_i)),  x_p += dt ((v*_p + dt a*_p) + sum_i S_ip (v_i^{n+1} - v*_i^{n+1}))
              (:func:`_move_exact`, the exact fields at x_p^n), then

@@ -26,9 +26,9 @@ Meshes: Sod h = 0.01 ... 0.00125 for every basis (GIMP and both B-splines gained
 step made their all-MPM runs and E2 cheaper, and 0.00125 once it ran their exact stages: four meshes
 give each basis's budget a trend, not only a change); Burgers 0.04 ... 0.01. A Sod case is 16 runs, all on the fused step
 (:mod:`mpm_fem.fused`): the fourteen with an exact stage run its compiled particle passes around the
-numpy step's grid stage (the quadrature projection, the FE mass and the exact nodal values, now about
-half of a P1 step; the exact fields compiled, :mod:`mpm_fem.exact_kernels`, the quadrature rows cached
-per grid). Four exact-stage runs (every stage exact, the exact interpolation, projection, mass alone),
+numpy step's grid stage (the quadrature projection, the FE mass and the exact nodal values; the exact
+fields compiled, :mod:`mpm_fem.exact_kernels`, the quadrature rows cached per grid, the cut pieces, the
+nodal sums and the FE mass entries compiled, :mod:`mpm_fem.grid_kernels`, bit for bit). Four exact-stage runs (every stage exact, the exact interpolation, projection, mass alone),
 CPU seconds on the shared 2-core machine, the numpy step -> the fused one: P1 at h = 0.0025 8.9 -> 5.8;
 GIMP at 0.005 8.3 -> 2.4; the particle-domain B-spline at 0.005 9.6 -> 3.4. A halving costs about 4x
 (twice the particles, twice the steps). What each run cost is in ``runs.csv`` (``wall_s``).

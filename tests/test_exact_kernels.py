@@ -68,3 +68,16 @@ def test_compiled_reference_fields_equal_numpy_bit_for_bit(name):
             assert np.array_equal(g, w)
         assert np.array_equal(fields.velocity_gradient(x, t), want[1])
     assert np.abs(want[1]).max() > 1.0  # a shock or a fan inside the sample
+
+
+def test_numpy_pow_of_an_array_does_not_depend_on_its_place_in_memory():
+    """:func:`mpm_fem.exact_kernels.sample` hands numpy the fan's ``c`` in an array the compiled pass
+    allocated (the numpy reference: ``c[fan]``, the same values in the same order): the powers must
+    not depend on the array's alignment (numpy's vectorised ``pow``, unlike the C library's, is used
+    by both)."""
+    c = np.random.default_rng(3).uniform(0.3, 1.0, 4099)
+    want = c ** (2.0 / 0.4)
+    for offset in range(9):
+        buffer = np.empty(c.size + 9)
+        buffer[offset:offset + c.size] = c
+        assert np.array_equal(buffer[offset:offset + c.size] ** (2.0 / 0.4), want)
