@@ -22,15 +22,18 @@ terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) -
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.00125 for every basis (GIMP and both B-splines gained 0.0025 once the fused
-step made their all-MPM runs and E2 cheaper, and 0.00125 once it ran their exact stages: four meshes
-give each basis's budget a trend, not only a change); Burgers 0.04 ... 0.01. A Sod case is 16 runs, all on the fused step
+Meshes: Sod h = 0.01 ... 0.000625 for every basis (GIMP and both B-splines gained 0.0025 once the fused
+step made their all-MPM runs and E2 cheaper, 0.00125 once it ran their exact stages, and every basis
+0.000625 once the grid stage was compiled: five meshes give each basis's budget a trend, not only a
+change); Burgers 0.04 ... 0.01. A Sod case is 16 runs, all on the fused step
 (:mod:`mpm_fem.fused`): the fourteen with an exact stage run its compiled particle passes around the
 numpy step's grid stage (the quadrature projection, the FE mass and the exact nodal values; the exact
 fields compiled, :mod:`mpm_fem.exact_kernels`, the quadrature rows cached per grid, the cut pieces, the
 nodal sums and the FE mass entries compiled, :mod:`mpm_fem.grid_kernels`, bit for bit). Four exact-stage runs (every stage exact, the exact interpolation, projection, mass alone),
 CPU seconds on the shared 2-core machine, the numpy step -> the fused one: P1 at h = 0.0025 8.9 -> 5.8;
-GIMP at 0.005 8.3 -> 2.4; the particle-domain B-spline at 0.005 9.6 -> 3.4. A halving costs about 4x
+GIMP at 0.005 8.3 -> 2.4; the particle-domain B-spline at 0.005 9.6 -> 3.4; then the compiled grid
+stage, the four runs with the exact mass: P1 at 0.0025 7.95 -> 3.90, the B-spline at 0.005 4.55 -> 2.22,
+the particle-domain B-spline 4.44 -> 2.07 (means of three alternating rounds). A halving costs about 4x
 (twice the particles, twice the steps). What each run cost is in ``runs.csv`` (``wall_s``).
 Round-off: the subsets with the exact mass stage and the MPM projection (``v_i = v*_i + solve(MPM) -
 solve(exact)``) amplify it. At h = 0.005 a 1-ulp shift of every particle position grows to 5e-9 of the
@@ -41,7 +44,7 @@ and ``roundoff.csv`` measures it in every run: P1's Sod budget runs a second tim
 (the reference arithmetic; its sixteen runs cost about 1.5x the fused ones), and each Shapley share
 is given from both with the change in percentage points.
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125, the Sod study's meshes but
-its single finest: each halving costs 4x; at 0.00125 the three bases took 2.8 / 8.9 / 7.0 s (P1 /
+its two finest: each halving costs 4x; at 0.00125 the three bases took 2.8 / 8.9 / 7.0 s (P1 /
 GIMP / B-spline), so the two finest meshes add ~6 CPU-minutes.
 """
 
@@ -73,7 +76,7 @@ K = 2  # time exact: dt -> 0 from dt and dt / K
 SOD = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", scheme="usl", layout="regular", seed=0)
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
                scheme="usl", layout="regular", seed=0)
-H = {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}
+H = {"sod": (0.01, 0.005, 0.0025, 0.00125, 0.000625), "burgers": (0.04, 0.02, 0.01)}
 FINEST = {}  # (problem, basis): the finest mesh of a basis whose budget stops above H's finest (none now)
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
@@ -98,6 +101,7 @@ def plan(quick: bool) -> dict:
 
 #: CPU time of a case relative to P1's (the four exact-stage runs of the docstring, fused, Sod, h = 0.005)
 STEP_COST = {"mpm": 1.0, "gimp": 1.1, "bspline": 1.6, "bspline_gimp": 1.6}
+NUMPY_STEP_COST = 1.5  # a roundoff.csv case (the numpy step) against the same case fused
 
 
 def cost(case: dict) -> float:
@@ -106,7 +110,7 @@ def cost(case: dict) -> float:
     if case["kind"] == "bases":
         return SOD["ppc"] / case["h"] ** 2
     steps = SOD["ppc"] / case["h"] ** 2 if case["problem"] == "sod" else 0.08 * BURGERS["ppc"] / case["h"] ** 3
-    return 24 * STEP_COST[case["basis"]] * steps
+    return 24 * STEP_COST[case["basis"]] * steps * (NUMPY_STEP_COST if case.get("kernel") == "numpy" else 1.0)
 
 
 # ---------------------------------------------------------------- one case
