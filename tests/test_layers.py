@@ -2,7 +2,7 @@
 
 1. exact solutions: ``baselines.exact`` (no project imports);
 2. the MPM core and the fixed-mesh baselines: ``grid shape particles transfer step fused exact_kernels
-   exact_stages models solve problems cases frame_chunks``, ``baselines`` (all but ``baselines.exact``);
+   grid_kernels exact_stages models solve problems cases frame_chunks``, ``baselines`` (all but ``baselines.exact``);
 3. measurements: ``errors quadrature projection regions timing claims source tables``;
 4. the application: ``sweep study report output fields plots cli``;
 5. the studies: ``studies``.
@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 LAYERS = {
     1: ("baselines.exact",),
     2: ("mpm_fem.grid", "mpm_fem.shape", "mpm_fem.particles", "mpm_fem.transfer", "mpm_fem.step",
-        "mpm_fem.fused", "mpm_fem.exact_stages", "mpm_fem.exact_kernels", "mpm_fem.models", "mpm_fem.solve", "mpm_fem.problems", "mpm_fem.cases",
+        "mpm_fem.fused", "mpm_fem.exact_stages", "mpm_fem.exact_kernels", "mpm_fem.grid_kernels", "mpm_fem.models", "mpm_fem.solve", "mpm_fem.problems", "mpm_fem.cases",
         "mpm_fem.reconstruction", "mpm_fem.volume", "mpm_fem.xpic", "mpm_fem.norms", "mpm_fem.frame_chunks", "baselines", "mpm_fem"),
     3: ("mpm_fem.errors", "mpm_fem.quadrature", "mpm_fem.projection", "mpm_fem.regions", "mpm_fem.timing",
         "mpm_fem.claims", "mpm_fem.source", "mpm_fem.tables", "mpm_fem.shock_tube", "mpm_fem.decomposition"),
