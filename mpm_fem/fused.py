@@ -101,6 +101,7 @@ from .particles import Particles, PositivityError
 from .reconstruction import OFFSETS, force_quadrature
 from .shape import Shape, basis_integrals, make_shape
 from .exact_stages import ExactFields, ExactGridStage, GridData
+from .grid_kernels import locate as _locate
 from .step import SCHEMES, Dirichlet, GridState, Stages, Walls
 from .transfer import solve_consistent
 from .xpic import boundary_change_rule
@@ -134,21 +135,6 @@ def check_kernel(kernel: str, threads: int) -> None:
 
 # --------------------------------------------------------------------------- per-particle helpers
 # Each repeats the numpy arithmetic of mpm_fem.shape / mpm_fem.models operation for operation.
-
-@njit(cache=True, inline="always")
-def _locate(nodes, inv_spacing, x):
-    """:func:`mpm_fem.shape.locate` for one point (inside the grid): cell ``c`` and ``xi``."""
-    last = nodes.size - 2
-    if inv_spacing > 0.0:
-        c = int((x - nodes[0]) * inv_spacing)
-        c = min(max(c, 0), last)
-        if x < nodes[c] or (x >= nodes[c + 1] and c < last):
-            c = min(np.searchsorted(nodes, x, side="right") - 1, last)
-    else:
-        c = min(np.searchsorted(nodes, x, side="right") - 1, last)
-    x0 = nodes[c]
-    return c, (x - x0) / (nodes[c + 1] - x0)
-
 
 @njit(cache=True, inline="always")
 def _point(nodes, h, inv_spacing, x):
