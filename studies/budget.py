@@ -22,12 +22,9 @@ terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) -
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.00125 for every basis (GIMP and both B-splines gained 0.0025 once the fused
-step made their all-MPM runs and E2 cheaper, and 0.00125 once it ran their exact stages: four meshes
-give each basis's budget a trend, not only a change); Burgers 0.04 ... 0.01. h = 0.000625 was planned
-once the grid stage was compiled and taken out again: in a full run on 2 cores no case of it had
-finished after 33 min (the two B-splines' cases, 16 runs each, ran first), so that the budget alone
-would outlast a session and the record could no longer be regenerated from one code version. A Sod case is 16 runs, all on the fused step
+Meshes: Sod h = 0.01 ... 0.00125 for every basis (four meshes give each basis's budget a trend, not only
+a change; h = 0.000625 was tried and taken out: no case of it finished in 33 min of a full run on 2
+cores); Burgers 0.04 ... 0.01. A Sod case is 16 runs, all on the fused step
 (:mod:`mpm_fem.fused`): the fourteen with an exact stage run its compiled particle passes around the
 numpy step's grid stage (the quadrature projection, the FE mass and the exact nodal values; the exact
 fields compiled, :mod:`mpm_fem.exact_kernels`, the quadrature rows cached per grid, the cut pieces, the

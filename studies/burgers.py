@@ -39,9 +39,7 @@ METHODS = {  # name: (label, solver, settings, the source's row it stands beside
     "fem_consistent": ("FEM consistent", "fem", {"mass": "consistent"}, None),
     "fem_lumped": ("FEM lumped", "fem", {"mass": "lumped"}, None),
 }
-# The meshes each method runs on: every mesh of the source's table for every row. A run costs ~ eps/h^3
-# (the viscous limit): at h = 0.000625 and eps = 0.045 about 40 s (P1 MPM, 4 per cell), 150 s (16 per
-# cell), 20 s (FEM lumped) and 45 s (FEM consistent) of CPU, the compiled loops of both.
+# Every mesh of the source's table for every row; a run costs ~ eps/h^3 (at h = 0.000625 MPM took 48-270 s)
 MESHES = {
     "default": {m: H for m in METHODS},
     "other": {m: H for m in METHODS if m != "mpm_calculated_16"},
