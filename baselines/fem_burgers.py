@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.sparse.linalg import splu
 
-from mpm_fem.grid import Grid
+from mpm_fem.core.grid import Grid
 
 from baselines import fem_burgers_kernel
 from baselines.galerkin import P1Cells, check_settings, mesh, p1_cells

@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from mpm_fem import frame_chunks
+from mpm_fem.core import frame_chunks
 
 frame_chunks.install()  # numba's compiler crosses CPython 3.11's frame-chunk starts: reuse the chunks
 

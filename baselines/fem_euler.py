@@ -52,7 +52,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from mpm_fem.grid import Grid
+from mpm_fem.core.grid import Grid
 
 from baselines.galerkin import MASS_KINDS  # noqa: F401 (the choices of ``mass``, for callers)
 from baselines.galerkin import P1Cells, check_mass, check_settings, mesh, p1_cells

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mpm_fem.grid import uniform_grid
+from mpm_fem.core.grid import uniform_grid
 
 
 LIMITERS = ("minmod", "mc")

@@ -3,7 +3,7 @@
 
 A P1 mesh is read cell by cell: cell ``e = [x_a, x_b]`` joins the nodes ``a`` and ``b`` and has
 the size ``h_e = x_b - x_a``; the lumped mass is ``m_i = int S_i dx``, the row sums of the
-consistent mass ``M_ij = int S_i S_j dx`` (both assembled by scikit-fem in :mod:`mpm_fem.grid`).
+consistent mass ``M_ij = int S_i S_j dx`` (both assembled by scikit-fem in :mod:`mpm_fem.core.grid`).
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mpm_fem.grid import Grid, GridError, uniform_grid
+from mpm_fem.core.grid import Grid, GridError, uniform_grid
 
 MASS_KINDS = ("consistent", "lumped")
 

@@ -2,8 +2,8 @@
 
 One run reports, for each basis (point mass, GIMP, B-spline, the particle-domain B-spline; USL,
 lumped mass, 4 particles per cell) at n_p = 1e3 ... 1e7:
-  * particle-steps per second of the numpy step (``mpm_fem.step.explicit_step``), of the fused
-    step called once per step (``mpm_fem.fused.FusedStep.step``, one thread) and of the fused
+  * particle-steps per second of the numpy step (``mpm_fem.core.step.explicit_step``), of the fused
+    step called once per step (``mpm_fem.fused.step.FusedStep.step``, one thread) and of the fused
     step's compiled loop (``FusedStep.advance``, which ``solve.run`` takes between walls with the
     lumped mass), and their ratios to the numpy step;
   * the log-log slope of step time against n_p (n_p >= 1e4; 1.0 = linear);
@@ -25,12 +25,12 @@ import time
 
 import numpy as np
 
-from mpm_fem.fused import FusedStep
-from mpm_fem.grid import uniform_grid
-from mpm_fem.models.euler import IdealGas
+from mpm_fem.fused.step import FusedStep
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.problems.sod import SodSettings, initial_particles
-from mpm_fem.solve import Problem
-from mpm_fem.step import Stages, Walls, explicit_step
+from mpm_fem.core.solve import Problem
+from mpm_fem.core.step import Stages, Walls, explicit_step
 
 BASES = ("mpm", "gimp", "bspline", "bspline_gimp")
 # particle-steps/s of the fused loop at 1e6 particles, one thread (uniform-grid arithmetic in every basis)

@@ -7,7 +7,7 @@ USL, lumped mass) and viscous Burgers (the rarefaction, eps = 0.045, 4 particles
 quadratic B-spline "bspline", and E5's closest remedy, the B-spline averaged over the particle
 domain "bspline_gimp", whose exact stages use the same quadratic B-splines) with every subset ``S`` of the four stages {projection, mass
 (FE + mass lumping), interpolation, time} in MPM form and the others in their exact form
-(:mod:`mpm_fem.exact_stages`). The error field ``e_S(x)`` is the piecewise-linear field through
+(:mod:`mpm_fem.exact_stages.stage`). The error field ``e_S(x)`` is the piecewise-linear field through
 the particle values (Sod density, Burgers velocity) minus the exact solution, on fixed points
 (Burgers: 5% margins off each end, where the inflow reservoir acts); for Sod also the nodal
 density error ``e_i``. *Time exact* is the dt -> 0 Richardson extrapolation of the runs at the
@@ -18,17 +18,17 @@ being first order in dt (C1):
 
 so eight runs at dt and eight at dt/K make all sixteen subsets. ``v(S)`` is the L1 norm of
 ``e_S`` (particles: trapezoid rule over the points; nodes: weights ``int S_i dx``). Its Moebius
-terms and Shapley values (:mod:`mpm_fem.decomposition`) decompose ``v(all MPM) - v(all exact)``
+terms and Shapley values (:mod:`mpm_fem.measure.decomposition`) decompose ``v(all MPM) - v(all exact)``
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
 Meshes: Sod h = 0.01 ... 0.00125 for every basis (four meshes give each basis's budget a trend, not only
 a change; h = 0.000625 was tried and taken out: no case of it finished in 33 min of a full run on 2
 cores); Burgers 0.04 ... 0.01. A Sod case is 16 runs, all on the fused step
-(:mod:`mpm_fem.fused`): the fourteen with an exact stage run its compiled particle passes around the
+(:mod:`mpm_fem.fused.step`): the fourteen with an exact stage run its compiled particle passes around the
 numpy step's grid stage (the quadrature projection, the FE mass and the exact nodal values; the exact
-fields compiled, :mod:`mpm_fem.exact_kernels`, the quadrature rows cached per grid, the cut pieces, the
-nodal sums and the FE mass entries compiled, :mod:`mpm_fem.grid_kernels`, bit for bit). Four exact-stage runs (every stage exact, the exact interpolation, projection, mass alone),
+fields compiled, :mod:`mpm_fem.exact_stages.kernels`, the quadrature rows cached per grid, the cut pieces, the
+nodal sums and the FE mass entries compiled, :mod:`mpm_fem.exact_stages.grid_kernels`, bit for bit). Four exact-stage runs (every stage exact, the exact interpolation, projection, mass alone),
 CPU seconds on the shared 2-core machine, the numpy step -> the fused one: P1 at h = 0.0025 8.9 -> 5.8;
 GIMP at 0.005 8.3 -> 2.4; the particle-domain B-spline at 0.005 9.6 -> 3.4; then the compiled grid
 stage, the four runs with the exact mass: P1 at 0.0025 7.95 -> 3.90, the B-spline at 0.005 4.55 -> 2.22,
@@ -55,14 +55,14 @@ from pathlib import Path
 import numpy as np
 
 from baselines.exact import riemann
-from mpm_fem.decomposition import decompose, label, share_changes, subsets
-from mpm_fem.grid import uniform_grid
-from mpm_fem.particles import PositivityError
-from mpm_fem.plots import Curve, Plot, plt, save
+from mpm_fem.measure.decomposition import decompose, label, share_changes, subsets
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.particles import PositivityError
+from mpm_fem.app.plots import Curve, Plot, plt, save
 from mpm_fem.problems import burgers, sod
-from mpm_fem.regions import REGION_NAMES, l1_by_region, plateau_velocity, sod_regions
-from mpm_fem.study import StudyOptions, publish, script_main
-from mpm_fem.timing import field_on
+from mpm_fem.measure.regions import REGION_NAMES, l1_by_region, plateau_velocity, sod_regions
+from mpm_fem.app.study import StudyOptions, publish, script_main
+from mpm_fem.measure.timing import field_on
 
 NAME = "budget"
 BASES = ("mpm", "gimp", "bspline")  # E2's bases

@@ -14,12 +14,13 @@ import numpy as np
 
 from baselines import fem_burgers
 from baselines.exact.burgers import make_solution
-from mpm_fem import plots, source
-from mpm_fem.claims import BURGERS_SHOWN
-from mpm_fem.errors import fitted_order, observed_orders, orders_row
-from mpm_fem.plots import Curve, Plot
+from mpm_fem.app import plots
+from mpm_fem.measure import source
+from mpm_fem.measure.claims import BURGERS_SHOWN
+from mpm_fem.measure.errors import fitted_order, observed_orders, orders_row
+from mpm_fem.app.plots import Curve, Plot
 from mpm_fem.problems import burgers
-from mpm_fem.study import StudyOptions, publish, script_main
+from mpm_fem.app.study import StudyOptions, publish, script_main
 
 NAME = "burgers"
 H = source.BURGERS_H

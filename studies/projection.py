@@ -6,9 +6,9 @@ four layouts: regular midpoints, jittered (one uniform point per sub-cell), rand
 uniform points per cell) - both over several seeds, mean and spread reported - and advected
 (regular particles moved by a kinematic MPM run in ``u = 0.1 sin(2 pi x)`` for T = 0.8). Each
 nodal projection of the slides is compared with the exact integral it stands in for
-(:mod:`mpm_fem.projection`), with the slides' weights ``h/N_p^i`` and, for the advected layout,
+(:mod:`mpm_fem.measure.projection`), with the slides' weights ``h/N_p^i`` and, for the advected layout,
 also with the volumes ``V_p`` the run carries. Hickernell's ``D2`` and bound
-(:mod:`mpm_fem.quadrature`) are measured on every cell.
+(:mod:`mpm_fem.measure.quadrature`) are measured on every cell.
 
 Tables (``figures/projection/``): ``errors.csv`` (quantity, layout, weights, N_p, h, norm, value,
 spread), ``orders.csv`` (least-squares order over all h, the orders between the two coarsest and
@@ -25,15 +25,15 @@ from pathlib import Path
 
 import numpy as np
 
-from mpm_fem.errors import fitted_order, observed_orders
-from mpm_fem.grid import uniform_grid
-from mpm_fem.projection import QUANTITIES, Advection, cell_weights, layout, projection_errors, quadrature_checks, smooth_fields
-from mpm_fem.quadrature import cell_points, discrepancy_d2, estimate_c, expected_offset, offset_term
-from mpm_fem import plots
-from mpm_fem.claims import BAND_TOLERANCE
-from mpm_fem.plots import Curve, Plot
-from mpm_fem.source import D2_C, PROJECTION_BANDS, band_text
-from mpm_fem.study import StudyOptions, script_main, write_table
+from mpm_fem.measure.errors import fitted_order, observed_orders
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.measure.projection import QUANTITIES, Advection, cell_weights, layout, projection_errors, quadrature_checks, smooth_fields
+from mpm_fem.measure.quadrature import cell_points, discrepancy_d2, estimate_c, expected_offset, offset_term
+from mpm_fem.app import plots
+from mpm_fem.measure.claims import BAND_TOLERANCE
+from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.measure.source import D2_C, PROJECTION_BANDS, band_text
+from mpm_fem.app.study import StudyOptions, script_main, write_table
 
 NAME = "projection"
 CELLS = [10 * 2**k for k in range(9)]  # h = 1/10 ... 1/2560

@@ -2,13 +2,13 @@
 
 Sod (the Sod study's MPM settings: 16 particles per cell, CFL 0.05, von Neumann-Richtmyer 0.5 /
 2.0, USL, lumped mass; density) and viscous Burgers (rarefaction, eps = 0.045, 4 particles per
-cell, calculated acceleration; velocity) with each remedy of :mod:`mpm_fem.step` alone and in the
+cell, calculated acceleration; velocity) with each remedy of :mod:`mpm_fem.core.step` alone and in the
 combinations that promise most, errors over grid nodes and over particles:
 
 - ``errors.csv``: every problem, remedy and mesh; observed orders against the previous mesh; on
   Sod the finite-volume reference (MUSCL-Hancock + HLLC) on the same mesh and the ratio to it.
 - ``orders.csv``: per problem and remedy, the lowest successive and the fitted orders, the errors
-  at the finest mesh, and whether the plateau is removed (E5 criterion, in :mod:`mpm_fem.claims`).
+  at the finest mesh, and whether the plateau is removed (E5 criterion, in :mod:`mpm_fem.measure.claims`).
 - ``cost.csv`` / ``cost.png``: Sod density L1 against particle- (or cell-) steps and against wall
   time, for MPM with each remedy, fixed-mesh P1 FEM (lumped mass) and FV. Wall time is the last
   column: it varies from run to run and no verdict uses it.
@@ -18,7 +18,7 @@ Meshes: Sod h = 0.01 ... 0.00015625, the convergence study's first seven. Every 
 plateau on the six coarser meshes in the last full run (``FINEST``: the B-spline domain, alone, with
 Taylor + volume and with XPIC(5)); E5 counts a remedy as removing the plateau only if it ran on every
 Sod mesh of the table, so the others count as not removing it, which they do not on the coarser
-meshes already. Every remedy runs the fused compiled step (:mod:`mpm_fem.fused`, equal to the numpy
+meshes already. Every remedy runs the fused compiled step (:mod:`mpm_fem.fused.step`, equal to the numpy
 step), all of them in its compiled loop (the Taylor reconstruction, XPIC(m) and the grid volume
 included). What each run cost is in ``cost.csv`` (``wall_s``, measured in the run that wrote it). A
 halving of h costs about 4x (twice the particles, twice the steps), so the finest mesh costs about
@@ -26,7 +26,7 @@ three times the six coarser ones together, and each of the seven other remedies 
 four times its cost at h = 0.0003125.
 Burgers h = 0.04 ... 0.005 (the viscous step limit makes a halving of h cost 8x).
 
-XPIC(m) (:mod:`mpm_fem.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline, on every
+XPIC(m) (:mod:`mpm_fem.core.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline, on every
 mesh of both problems.
 """
 
@@ -39,14 +39,14 @@ from pathlib import Path
 import numpy as np
 
 from baselines import fem_euler, fv_euler
-from mpm_fem.claims import PLATEAU_ORDER, remedy_assessment, successive_orders
-from mpm_fem.errors import norms
-from mpm_fem.grid import uniform_grid
-from mpm_fem.particles import PositivityError
+from mpm_fem.measure.claims import PLATEAU_ORDER, remedy_assessment, successive_orders
+from mpm_fem.measure.errors import norms
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.particles import PositivityError
 from mpm_fem.problems import burgers, sod
-from mpm_fem.plots import Curve, Plot
-from mpm_fem.shock_tube import exact_density
-from mpm_fem.study import StudyOptions, publish, script_main
+from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.measure.shock_tube import exact_density
+from mpm_fem.app.study import StudyOptions, publish, script_main
 from studies.sod import FEM, FV, H, MPM as SOD_MPM
 
 NAME = "remedies"
@@ -221,7 +221,7 @@ PLOTS = (
 
 def _cost_figure(folder: Path, cost) -> None:
     """Sod density L1 against work and against wall time, one line per method (``cost.png``)."""
-    from mpm_fem import plots
+    from mpm_fem.app import plots
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(13, 4.4))

@@ -14,14 +14,15 @@ import numpy as np
 
 from baselines import fem_euler, fv_euler
 from baselines.exact import riemann
-from mpm_fem import plots, shock_tube, source
-from mpm_fem.errors import orders_column
-from mpm_fem.grid import uniform_grid
-from mpm_fem.particles import PositivityError
+from mpm_fem.app import plots
+from mpm_fem.measure import shock_tube, source
+from mpm_fem.measure.errors import orders_column
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.particles import PositivityError
 from mpm_fem.problems import sod
-from mpm_fem.regions import REGION_NAMES, ExtremaCounter, describe
-from mpm_fem.plots import Curve, Plot
-from mpm_fem.study import StudyOptions, publish, script_main
+from mpm_fem.measure.regions import REGION_NAMES, ExtremaCounter, describe
+from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.app.study import StudyOptions, publish, script_main
 
 NAME = "sod"
 H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625, 0.000078125)  # the source's meshes and two finer
@@ -46,7 +47,7 @@ QUICK = dict(H=H[:3], PPC_H=(0.01,), CONSISTENT_H=H[:2], PLATEAU_H=())
 
 
 def run_case(case: dict) -> dict:
-    """One run, measured (:mod:`mpm_fem.shock_tube`): ``case["solver"]`` is ``"mpm"`` (keys of
+    """One run, measured (:mod:`mpm_fem.measure.shock_tube`): ``case["solver"]`` is ``"mpm"`` (keys of
     :data:`MPM` and ``h``), ``"fem"`` (``h``, ``mass`` and the keys of :data:`FEM`) or ``"fv"``."""
     h, width, profiles = case["h"], case.get("region_half_width"), case.get("profiles", False)
     if case["solver"] == "fv":

@@ -2,11 +2,11 @@
 
 C1, ``time_order.csv``: at fixed h and particles, a fixed dt refined 1, 2, 4, 8, 16 times against
 dt / 256 (pulse) or dt / 64 (Burgers), for a smooth acoustic pulse in a gas without viscosity
-(:class:`mpm_fem.timing.PulseSettings`) and for viscous Burgers (the rarefaction, eps = 0.045,
+(:class:`mpm_fem.measure.timing.PulseSettings`) and for viscous Burgers (the rarefaction, eps = 0.045,
 4 particles per cell, CFL 0.5: the viscous limit fixes dt); ``local_error.csv``: one step from a
 common state (T/2) against 256 substeps, for dt/2 ... dt/16. C2, ``crossing.csv``: the jump of
 ``d^3 x_p / dt^3`` at each node crossing of one particle (Burgers rarefaction, h = 0.02, exact and
-calculated acceleration), measured and by the slides' formula (:mod:`mpm_fem.timing`). Every
+calculated acceleration), measured and by the slides' formula (:mod:`mpm_fem.measure.timing`). Every
 basis: point-mass P1 ("mpm"), GIMP and the C1 quadratic B-spline ("bspline").
 """
 
@@ -18,14 +18,14 @@ from pathlib import Path
 
 import numpy as np
 
-from mpm_fem.grid import uniform_grid
-from mpm_fem.models.burgers import ViscousBurgers
-from mpm_fem.plots import Curve, Plot, draw, plt, save
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.burgers import ViscousBurgers
+from mpm_fem.app.plots import Curve, Plot, draw, plt, save
 from mpm_fem.problems import burgers
-from mpm_fem.solve import Problem
-from mpm_fem.step import Dirichlet
-from mpm_fem.study import StudyOptions, script_main, write_table
-from mpm_fem.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, observed_order,
+from mpm_fem.core.solve import Problem
+from mpm_fem.core.step import Dirichlet
+from mpm_fem.app.study import StudyOptions, script_main, write_table
+from mpm_fem.measure.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, observed_order,
                             pulse_setup, simulate_pulse, state_at)
 
 NAME = "time"

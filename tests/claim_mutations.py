@@ -19,8 +19,8 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 
-from mpm_fem.claims import CLAIMS, select
-from mpm_fem.tables import load_tables
+from mpm_fem.measure.claims import CLAIMS, select
+from mpm_fem.measure.tables import load_tables
 
 #: The committed tables of the full reproduction.
 TABLES = load_tables(Path(__file__).resolve().parent.parent / "figures")

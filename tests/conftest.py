@@ -2,7 +2,7 @@
 
 import pytest
 
-import mpm_fem.fused as fused_module
+import mpm_fem.fused.step as fused_module
 
 
 @pytest.fixture

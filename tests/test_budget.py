@@ -7,15 +7,15 @@ import numpy as np
 import pytest
 
 from baselines.exact import riemann
-from mpm_fem.decomposition import decompose, label
-from mpm_fem.exact_stages import RiemannFields, exact_projection, quadrature
-from mpm_fem.grid import uniform_grid
-from mpm_fem.models.euler import IdealGas
+from mpm_fem.measure.decomposition import decompose, label
+from mpm_fem.exact_stages.stage import RiemannFields, exact_projection, quadrature
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.problems import burgers, sod
-from mpm_fem.shape import make_shape
-from mpm_fem.step import Stages, Walls, explicit_step
-from mpm_fem.timing import field_difference, field_on
-from mpm_fem.transfer import nodal_internal_force
+from mpm_fem.core.shape import make_shape
+from mpm_fem.core.step import Stages, Walls, explicit_step
+from mpm_fem.measure.timing import field_difference, field_on
+from mpm_fem.core.transfer import nodal_internal_force
 from studies import budget as study
 
 SOD = ((1.0, 0.0, 1.0), (0.125, 0.0, 0.1))
@@ -251,8 +251,8 @@ def test_the_particle_domain_bspline_runs_every_subset_and_its_shapley_values_ad
 def test_the_roundoff_table_compares_the_two_arithmetics():
     """``roundoff.csv``: P1's Sod budget runs again on the numpy step; each share from both, the
     change in percentage points; E1's evidence names the largest change per mesh."""
-    from mpm_fem.claims import _roundoff_text
-    from mpm_fem.decomposition import share_changes
+    from mpm_fem.measure.claims import _roundoff_text
+    from mpm_fem.measure.decomposition import share_changes
     from studies.budget import ROUNDOFF, plan
 
     cases = plan(quick=False)["roundoff"]

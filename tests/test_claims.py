@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from claim_mutations import TABLES, assert_flips, claim_named, judge, mutate
 
-from mpm_fem.claims import CLAIMS, STATEMENTS, VERDICTS
+from mpm_fem.measure.claims import CLAIMS, STATEMENTS, VERDICTS
 
 ORDERS = "projection/orders"
 

@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from mpm_fem.cli import main
+from mpm_fem.app.cli import main
 
 
 def test_sod_run_writes_summary_particles_and_figure(tmp_path, capsys):
@@ -82,7 +82,7 @@ def test_unwritable_output_directory_exits_2(tmp_path, capsys):
 
 def test_help_of_every_command_exits_0():
     for argv in (["--help"], ["sod", "--help"], ["burgers", "--help"]):
-        proc = subprocess.run([sys.executable, "-m", "mpm_fem.cli", *argv], capture_output=True, text=True,
+        proc = subprocess.run([sys.executable, "-m", "mpm_fem.app.cli", *argv], capture_output=True, text=True,
                               env={**os.environ, "PYTHONPATH": os.getcwd()})
         assert proc.returncode == 0 and "usage: mpm-fem" in proc.stdout
 

@@ -5,7 +5,7 @@ from itertools import permutations
 import numpy as np
 import pytest
 
-from mpm_fem.decomposition import decompose, label, shapley_by_orders, subsets
+from mpm_fem.measure.decomposition import decompose, label, shapley_by_orders, subsets
 
 STAGES = ("projection", "mass", "interpolation", "time")
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from baselines.exact import riemann
-from mpm_fem.exact_stages import RiemannFields, quadrature, quadrature_rule
-from mpm_fem.grid import uniform_grid
-from mpm_fem.shape import make_shape
+from mpm_fem.exact_stages.stage import RiemannFields, quadrature, quadrature_rule
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.shape import make_shape
 
 # Sod; a left shock and right rarefaction (mirror image); two shocks; two rarefactions
 CASES = {
@@ -71,7 +71,7 @@ def test_compiled_reference_fields_equal_numpy_bit_for_bit(name):
 
 
 def test_numpy_pow_of_an_array_does_not_depend_on_its_place_in_memory():
-    """:func:`mpm_fem.exact_kernels.sample` hands numpy the fan's ``c`` in an array the compiled pass
+    """:func:`mpm_fem.exact_stages.kernels.sample` hands numpy the fan's ``c`` in an array the compiled pass
     allocated (the numpy reference: ``c[fan]``, the same values in the same order): the powers must
     not depend on the array's alignment (numpy's vectorised ``pow``, unlike the C library's, is used
     by both)."""

@@ -1,18 +1,18 @@
-"""The FE + mass lumping stage's mass matrices, assembled by scikit-fem (mpm_fem.exact_stages.fe_mass),
+"""The FE + mass lumping stage's mass matrices, assembled by scikit-fem (mpm_fem.exact_stages.stage.fe_mass),
 against the particle mass matrix on Gauss points, an exact matrix, and where the step uses them."""
 
 import numpy as np
 import pytest
 from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
 
-from mpm_fem import exact_stages
-from mpm_fem.exact_stages import RiemannFields, exact_projection, fe_mass, nodal_values, quadrature
-from mpm_fem.grid import uniform_grid
-from mpm_fem.models.euler import IdealGas
+from mpm_fem.exact_stages.stage import stage
+from mpm_fem.exact_stages.stage import RiemannFields, exact_projection, fe_mass, nodal_values, quadrature
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.problems import sod
-from mpm_fem.shape import make_shape
-from mpm_fem.step import Stages, Walls, explicit_step
-from mpm_fem.transfer import particle_mass_matrix
+from mpm_fem.core.shape import make_shape
+from mpm_fem.core.step import Stages, Walls, explicit_step
+from mpm_fem.core.transfer import particle_mass_matrix
 
 SOD = ((1.0, 0.0, 1.0), (0.125, 0.0, 0.1))
 

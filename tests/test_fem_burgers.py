@@ -13,7 +13,7 @@ import scipy.sparse as sp
 
 from baselines.fem_burgers import _operators, errors, residual, solve
 from baselines.fem_burgers_kernel import tridiagonal_factors
-from mpm_fem.grid import grid_from_nodes
+from mpm_fem.core.grid import grid_from_nodes
 
 EPS = 0.045
 HS = (0.02, 0.01, 0.005)

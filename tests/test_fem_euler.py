@@ -20,7 +20,7 @@ from baselines.fem_euler import (
     sod_initial_state,
     solve,
 )
-from mpm_fem.grid import grid_from_nodes, uniform_grid
+from mpm_fem.core.grid import grid_from_nodes, uniform_grid
 
 GAMMA = 1.4
 RHO_POST_SHOCK = 0.26557  # Toro, Table 4.2: rho*_R of Sod's problem

@@ -1,11 +1,11 @@
-"""The frame-chunk cache (mpm_fem.frame_chunks): a call loop that crosses a chunk's start maps and
+"""The frame-chunk cache (mpm_fem.core.frame_chunks): a call loop that crosses a chunk's start maps and
 unmaps a 16 KiB chunk on every call without it (CPython 3.11, 3.12), and reuses one with it."""
 
 import resource
 
 import pytest
 
-from mpm_fem import frame_chunks
+from mpm_fem.core import frame_chunks
 
 pytestmark = pytest.mark.skipif(not frame_chunks.NEEDED, reason="this interpreter keeps a freed chunk itself")
 

@@ -1,4 +1,4 @@
-"""The fused compiled step (mpm_fem.fused) against the numpy step it compiles (mpm_fem.step).
+"""The fused compiled step (mpm_fem.fused.step) against the numpy step it compiles (mpm_fem.core.step).
 
 Every combination of basis, scheme, mass, model and boundary (the fast set a pairwise cover of
 basis, scheme and model, the slow set the rest) runs 1,000 steps through ``solve.run`` twice,
@@ -15,16 +15,16 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from mpm_fem.fused import FusedStep, supported
-from mpm_fem.grid import grid_from_nodes, uniform_grid
-from mpm_fem.models.burgers import ViscousBurgers
-from mpm_fem.models.euler import IdealGas
-from mpm_fem.particles import PositivityError, make_particles, seed_positions
+from mpm_fem.fused.step import FusedStep, supported
+from mpm_fem.core.grid import grid_from_nodes, uniform_grid
+from mpm_fem.core.models.burgers import ViscousBurgers
+from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.particles import PositivityError, make_particles, seed_positions
 from mpm_fem.problems.burgers import Reservoir
 from mpm_fem.problems.sod import SodSettings, simulate
-from mpm_fem.shape import OutsideGridError
-from mpm_fem.solve import Problem, run
-from mpm_fem.step import SCHEMES, Dirichlet, Stages, Walls
+from mpm_fem.core.shape import OutsideGridError
+from mpm_fem.core.solve import Problem, run
+from mpm_fem.core.step import SCHEMES, Dirichlet, Stages, Walls
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 STEPS = 1000
@@ -116,7 +116,7 @@ def _compare(basis, scheme, mass, model, boundary, steps):
     return reference, fused
 
 
-BASES, MODELS = ("mpm", "gimp", "bspline"), ("gas", "burgers")  # the schemes: mpm_fem.step.SCHEMES
+BASES, MODELS = ("mpm", "gimp", "bspline"), ("gas", "burgers")  # the schemes: mpm_fem.core.step.SCHEMES
 
 
 def _pairwise(basis, scheme, model):
@@ -310,7 +310,7 @@ def test_what_the_fused_step_refuses():
 
 
 def _domain_rows(fused_row, x, V, nodes, K=8):
-    """Each particle's row from ``fused_row`` (a compiled row of mpm_fem.fused) on a uniform grid,
+    """Each particle's row from ``fused_row`` (a compiled row of mpm_fem.fused.step) on a uniform grid,
     ``K`` columns (each row needs at most K)."""
     h = np.vstack([np.diff(nodes), 1.0 / np.diff(nodes)])
     inv_spacing = 1.0 / (nodes[1] - nodes[0])
@@ -324,10 +324,10 @@ def _domain_rows(fused_row, x, V, nodes, K=8):
 def test_particle_domain_bspline_row_is_the_formula_float_for_float():
     """The uniform-grid row of the particle-domain B-spline evaluates ``M`` and ``N`` only in the
     pieces that do not vanish (``_bspline_pieces``): the same floats as the formula of
-    ``mpm_fem.shape`` (``_bspline_integral``, ``_quadratic_bspline``) at every node of the row, on
+    ``mpm_fem.core.shape`` (``_bspline_integral``, ``_quadratic_bspline``) at every node of the row, on
     domain ends placed at random, on nodes, half-way between nodes and at the grid's ends."""
-    from mpm_fem.fused import _bspline_domain_row
-    from mpm_fem.shape import _bspline_integral, _quadratic_bspline
+    from mpm_fem.fused.step import _bspline_domain_row
+    from mpm_fem.core.shape import _bspline_integral, _quadratic_bspline
 
     nodes = np.linspace(0.0, 1.0, 41)
     n_cells = nodes.size - 1
@@ -358,7 +358,7 @@ def test_the_five_column_bspline_row_is_the_column_rows_float_for_float():
     three pieces placed by selects, ``_five``) gives ``_domain_column``'s floats at every column, for
     domains within two cells placed at random, on nodes and at the grid's ends; ``_five`` is
     ``_piece`` at every start it is used for."""
-    from mpm_fem.fused import _bspline_domain_five, _domain, _domain_column, _five, _piece
+    from mpm_fem.fused.step import _bspline_domain_five, _domain, _domain_column, _five, _piece
 
     for d in range(3):
         assert _five(d, 7.0, 1.0, 2.0, 3.0) == tuple(_piece(k - d, 7.0, 1.0, 2.0, 3.0) for k in range(5))

@@ -1,5 +1,5 @@
 """The exact stages compiled (``FusedStep`` with exact projection, mass or interpolation) against
-the numpy step with the same stages (mpm_fem.step).
+the numpy step with the same stages (mpm_fem.core.step).
 
 The error budget (E1) runs every subset of the stages in MPM or exact form; the fused step runs
 the particle passes of each (pass 1, and pass 2 or, with the exact interpolation, ``_move_exact``
@@ -11,15 +11,15 @@ uniform grid the uniform-grid arithmetic agrees to ``TOLERANCE`` (tests/test_fus
 import numpy as np
 import pytest
 
-from mpm_fem import solve
-from mpm_fem.exact_stages import RiemannFields
-from mpm_fem.fused import FusedStep, supported
-from mpm_fem.grid import grid_from_nodes, uniform_grid
-from mpm_fem.models.burgers import ViscousBurgers
-from mpm_fem.models.euler import IdealGas
-from mpm_fem.particles import make_particles, seed_positions
-from mpm_fem.solve import Problem, run
-from mpm_fem.step import Stages, Walls
+from mpm_fem.core import solve
+from mpm_fem.exact_stages.stage import RiemannFields
+from mpm_fem.fused.step import FusedStep, supported
+from mpm_fem.core.grid import grid_from_nodes, uniform_grid
+from mpm_fem.core.models.burgers import ViscousBurgers
+from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.particles import make_particles, seed_positions
+from mpm_fem.core.solve import Problem, run
+from mpm_fem.core.step import Stages, Walls
 from test_fused import TOLERANCE, _assert_same, _drifting_grid, _worst
 
 #: the seven subsets with an exact stage: which of projection, mass, interpolation are exact

@@ -8,15 +8,15 @@ grid every basis takes uniform-grid arithmetic: it equals the numpy step to ``TO
 import numpy as np
 import pytest
 
-import mpm_fem.fused as fused_module
-from mpm_fem.grid import uniform_grid
-from mpm_fem.models.burgers import ViscousBurgers
-from mpm_fem.particles import make_particles, seed_positions
-from mpm_fem.models.euler import IdealGas
+import mpm_fem.fused.step as fused_module
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.burgers import ViscousBurgers
+from mpm_fem.core.particles import make_particles, seed_positions
+from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.problems import burgers
 from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
-from mpm_fem.solve import Problem, run
-from mpm_fem.step import Stages, Walls
+from mpm_fem.core.solve import Problem, run
+from mpm_fem.core.step import Stages, Walls
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 TOLERANCE = 1e-12  # as tests/test_fused.py: max_p |u_fused - u_numpy| <= TOLERANCE max_p |u_numpy|, each field

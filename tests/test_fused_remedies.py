@@ -1,4 +1,4 @@
-"""The plateau remedies in the fused step (mpm_fem.fused) against the numpy step (mpm_fem.step):
+"""The plateau remedies in the fused step (mpm_fem.fused.step) against the numpy step (mpm_fem.core.step):
 the PIC/FLIP blend, XPIC(m), the particle-domain B-spline ``"bspline_gimp"`` and the grid volume
 reset, to 1e-12 relative (every basis on a uniform grid takes uniform-grid arithmetic), through
 the per-step path (the consistent mass; an observer) and the compiled loop (walls or Dirichlet ends
@@ -8,15 +8,15 @@ every basis."""
 import numpy as np
 import pytest
 
-from mpm_fem.fused import FusedStep, supported
-from mpm_fem.grid import uniform_grid
-from mpm_fem.models.burgers import ViscousBurgers
-from mpm_fem.models.euler import IdealGas
-from mpm_fem.particles import make_particles, seed_positions
+from mpm_fem.fused.step import FusedStep, supported
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.burgers import ViscousBurgers
+from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.particles import make_particles, seed_positions
 from mpm_fem.problems.burgers import Reservoir
 from mpm_fem.problems.sod import SodSettings, simulate
-from mpm_fem.solve import Problem, run
-from mpm_fem.step import Dirichlet, Stages, Walls, explicit_step
+from mpm_fem.core.solve import Problem, run
+from mpm_fem.core.step import Dirichlet, Stages, Walls, explicit_step
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 GRID = uniform_grid(0.0, 1.0, 0.1)

@@ -1,11 +1,11 @@
-"""The compiled sums of the exact grid stage (mpm_fem.grid_kernels) equal the numpy ones bit for bit."""
+"""The compiled sums of the exact grid stage (mpm_fem.exact_stages.grid_kernels) equal the numpy ones bit for bit."""
 
 import numpy as np
 import pytest
 
-from mpm_fem.exact_stages import (RiemannFields, exact_projection, fe_mass, fe_mass_operator, nodal_sums,
+from mpm_fem.exact_stages.stage import (RiemannFields, exact_projection, fe_mass, fe_mass_operator, nodal_sums,
                                   nodal_sums_numpy, quadrature_rule)
-from mpm_fem.grid import uniform_grid
+from mpm_fem.core.grid import uniform_grid
 
 SOD = RiemannFields((1.0, 0.0, 1.0), (0.125, 0.0, 0.1), 0.5, 1.4, 0.01)
 TIMES = (0.0, 0.013, 0.1, 0.2)  # no cut (t = 0: every breakpoint on the node x0), then four cuts
@@ -64,7 +64,7 @@ def test_the_lumped_fe_mass_assembles_its_matrix_only_on_demand():
 def test_cut_pieces_equal_numpy_bit_for_bit():
     """Random breakpoints (outside the domain, on nodes, on half cells, repeated) on uniform grids and,
     for the hats, a random one: the cut pieces, the sub-pieces' points, weights and rows."""
-    from mpm_fem.grid import grid_from_nodes
+    from mpm_fem.core.grid import grid_from_nodes
 
     rng = np.random.default_rng(1)
     grids = [(uniform_grid(0.0, 1.0, h), ("mpm", "bspline")) for h in (0.05, 0.01)]
@@ -106,8 +106,8 @@ def test_the_fe_mass_sums_a_symmetric_entry_once(functions):
 @pytest.mark.parametrize("basis", ["mpm", "bspline"])
 def test_the_exact_mass_stage_solve_equals_numpy_bit_for_bit(basis):
     """``v*_i + P_i / m_i - P*_i / m*_i`` compiled, against :func:`nodal_values` (a node without mass included)."""
-    from mpm_fem.exact_stages import ExactGridStage, GridData
-    from mpm_fem.step import Stages, Walls
+    from mpm_fem.exact_stages.stage import ExactGridStage, GridData
+    from mpm_fem.core.step import Stages, Walls
 
     grid = uniform_grid(0.0, 1.0, 0.01)
     rng = np.random.default_rng(2)

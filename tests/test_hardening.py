@@ -16,8 +16,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mpm_fem import guard
-from mpm_fem.cli import main
+from mpm_fem.app import guard
+from mpm_fem.app.cli import main
 from mpm_fem.problems import Cost, burgers, sod
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -185,7 +185,7 @@ def test_a_failed_run_leaves_the_output_folder_untouched(tmp_path, capsys):
 
 def test_concurrent_runs_into_one_folder_leave_one_whole_run(tmp_path):
     out = tmp_path / "shared"
-    procs = [subprocess.Popen([sys.executable, "-m", "mpm_fem.cli", "sod", "--h", "0.02", "--T", "0.1", "--ppc", str(ppc),
+    procs = [subprocess.Popen([sys.executable, "-m", "mpm_fem.app.cli", "sod", "--h", "0.02", "--T", "0.1", "--ppc", str(ppc),
                                "--save-fields", "3", "--out", str(out), "--overwrite", "--quiet"],
                               env=ENV, stderr=subprocess.PIPE, text=True) for ppc in (2, 3)]
     codes = [p.wait(timeout=120) for p in procs]
@@ -228,7 +228,7 @@ def _alive(pid: int) -> bool:
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_ctrl_c_prints_one_line_and_exits_130(tmp_path):
     out = tmp_path / "run"
-    proc = subprocess.Popen([sys.executable, "-m", "mpm_fem.cli", "sod", "--h", "0.0005", "--ppc", "16", "--kernel", "numpy",
+    proc = subprocess.Popen([sys.executable, "-m", "mpm_fem.app.cli", "sod", "--h", "0.0005", "--ppc", "16", "--kernel", "numpy",
                              "--out", str(out)],  # the numpy step: a run of ~1 min, still going at the signal
                             env=ENV, stderr=subprocess.PIPE, text=True,
                             # a shell's background job starts with SIGINT ignored; a user's terminal does not
@@ -295,7 +295,7 @@ def test_random_options_finish_or_exit_2_on_one_line(tmp_path_factory, problem, 
 
 def test_the_random_options_with_a_subprocess_give_no_traceback(tmp_path):
     for argv in (["sod", "--gamma", "nan"], ["burgers", "--eps", "inf"], ["sod", "--T", "nan"], ["sod", "--cfl", "-0"]):
-        proc = subprocess.run([sys.executable, "-m", "mpm_fem.cli", *argv, "--out", str(tmp_path / "x")],
+        proc = subprocess.run([sys.executable, "-m", "mpm_fem.app.cli", *argv, "--out", str(tmp_path / "x")],
                               env=ENV, capture_output=True, text=True, timeout=60)
         assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, (argv, proc.stderr)
 
@@ -312,15 +312,15 @@ def test_no_module_imports_the_command_line_and_study_scripts_run_without_it():
                 names = [f"{node.module}"] + [f"{node.module}.{a.name}" for a in node.names]
                 names += [a.name for a in node.names if node.module is None or node.level]
                 assert not any(n.endswith("cli") for n in names), f"{path} imports cli"
-    code = ("import sys; from mpm_fem.study import script_main; code = script_main('sod', ['--jobs', '0']); "
-            "assert 'mpm_fem.cli' not in sys.modules; sys.exit(code)")
+    code = ("import sys; from mpm_fem.app.study import script_main; code = script_main('sod', ['--jobs', '0']); "
+            "assert 'mpm_fem.app.cli' not in sys.modules; sys.exit(code)")
     proc = subprocess.run([sys.executable, "-c", code], env=ENV, capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2 and proc.stderr.strip() == "studies/sod.py: error: --jobs must be >= 1, got 0", proc.stderr
 
 
 def test_help_texts_are_complete_and_true():
     def help_of(*argv):
-        return subprocess.run([sys.executable, "-m", "mpm_fem.cli", *argv, "--help"], env=ENV, capture_output=True,
+        return subprocess.run([sys.executable, "-m", "mpm_fem.app.cli", *argv, "--help"], env=ENV, capture_output=True,
                               text=True, timeout=60).stdout
 
     text = " ".join(help_of("burgers").split())

@@ -1,15 +1,20 @@
 """Layers import downwards only, and no import cycle exists (parsed with ``ast``, no code run).
 
-1. exact solutions: ``baselines.exact`` (no project imports);
-2. the MPM core and the fixed-mesh baselines: ``grid shape particles transfer step fused exact_kernels
-   grid_kernels exact_stages models solve problems cases frame_chunks``, ``baselines`` (all but ``baselines.exact``);
-3. measurements: ``errors quadrature projection regions timing claims source tables``;
-4. the application: ``sweep study report output fields plots cli``;
-5. the studies: ``studies``.
+The layers are the folders:
 
-A module may import its own layer or a lower one. Imports inside functions count too: a lazy
-import is still a dependency. Studies are found by name at run time (``importlib``), which is how
-the application runs them without depending on them.
+1. exact solutions: ``baselines/exact/`` (no project imports);
+2. the MPM core and the fixed-mesh baselines: ``mpm_fem/core/`` (grid, shape, particles, transfer,
+   step, solve, models), ``mpm_fem/exact_stages/`` (the exact stages and their kernels),
+   ``mpm_fem/fused/`` (the compiled step), ``mpm_fem/problems/`` (the problem set-ups), and
+   ``baselines/`` (all but ``baselines/exact/``);
+3. measurements: ``mpm_fem/measure/``;
+4. the application: ``mpm_fem/app/``;
+5. the studies: ``studies/``.
+
+A module's layer is its folder's: a new module needs no entry here, a new folder does. A module may
+import its own layer or a lower one. Imports inside functions count too: a lazy import is still a
+dependency. Studies are found by name at run time (``importlib``), which is how the application
+runs them without depending on them.
 """
 
 from __future__ import annotations
@@ -20,17 +25,21 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-LAYERS = {
-    1: ("baselines.exact",),
-    2: ("mpm_fem.grid", "mpm_fem.shape", "mpm_fem.particles", "mpm_fem.transfer", "mpm_fem.step",
-        "mpm_fem.fused", "mpm_fem.exact_stages", "mpm_fem.exact_kernels", "mpm_fem.grid_kernels", "mpm_fem.models", "mpm_fem.solve", "mpm_fem.problems", "mpm_fem.cases",
-        "mpm_fem.reconstruction", "mpm_fem.volume", "mpm_fem.xpic", "mpm_fem.norms", "mpm_fem.frame_chunks", "baselines", "mpm_fem"),
-    3: ("mpm_fem.errors", "mpm_fem.quadrature", "mpm_fem.projection", "mpm_fem.regions", "mpm_fem.timing",
-        "mpm_fem.claims", "mpm_fem.source", "mpm_fem.tables", "mpm_fem.shock_tube", "mpm_fem.decomposition"),
-    4: ("mpm_fem.sweep", "mpm_fem.study", "mpm_fem.guard", "mpm_fem.report", "mpm_fem.pages", "mpm_fem.output", "mpm_fem.fields", "mpm_fem.plots",
-        "mpm_fem.cli"),
-    5: ("studies",),
+#: folder (as a dotted package) -> layer; the longest matching folder decides.
+FOLDERS = {
+    "baselines.exact": 1,
+    "baselines": 2,
+    "mpm_fem.core": 2,
+    "mpm_fem.exact_stages": 2,
+    "mpm_fem.fused": 2,
+    "mpm_fem.problems": 2,
+    "mpm_fem.measure": 3,
+    "mpm_fem.app": 4,
+    "studies": 5,
 }
+#: modules that are not in a layer folder: the package's own ``__init__`` (its version only).
+TOP = {"mpm_fem": 2}
+LAYERS = sorted(set(FOLDERS.values()))
 
 
 def modules() -> dict[str, Path]:
@@ -42,19 +51,14 @@ def modules() -> dict[str, Path]:
     return found
 
 
-#: Packages whose own ``__init__`` is listed, but whose modules must each be listed by name
-#: (``baselines`` is a package entry: every fixed-mesh baseline is layer 2, ``baselines.exact`` layer 1).
-ROOTS = ("mpm_fem",)
-
-
 def layer(module: str) -> int:
-    """The layer of ``module``: its own entry, or the entry of the package it lies in (not a root)."""
-    found = [prefix for prefixes in LAYERS.values() for prefix in prefixes
-             if module == prefix or (module.startswith(prefix + ".") and prefix not in ROOTS)]
+    """The layer of ``module``: that of the deepest folder it lies in (or its own ``TOP`` entry)."""
+    if module in TOP:
+        return TOP[module]
+    found = [folder for folder in FOLDERS if module == folder or module.startswith(folder + ".")]
     if not found:
-        raise KeyError(f"{module} has no layer: add it to LAYERS")
-    best = max(found, key=len)
-    return next(n for n, prefixes in LAYERS.items() if best in prefixes)
+        raise KeyError(f"{module} has no layer: put it in a layer folder (or add its folder to FOLDERS)")
+    return FOLDERS[max(found, key=len)]
 
 
 def imports(module: str, path: Path, known) -> set[str]:
@@ -89,6 +93,7 @@ def test_every_module_has_a_layer():
         assert layer(m) in LAYERS, m
     with pytest.raises(KeyError, match="no layer"):
         layer("mpm_fem.new_module")
+    assert layer("mpm_fem.app.new_module") == 4 and layer("baselines.exact.new") == 1
 
 
 def test_no_module_imports_a_higher_layer():

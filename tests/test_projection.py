@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from skfem import Basis, ElementLineP1, LinearForm, asm
 
-from mpm_fem.errors import fitted_order
-from mpm_fem.grid import grid_from_nodes, uniform_grid
-from mpm_fem.particles import seed_positions
-from mpm_fem.projection import (
+from mpm_fem.measure.errors import fitted_order
+from mpm_fem.core.grid import grid_from_nodes, uniform_grid
+from mpm_fem.core.particles import seed_positions
+from mpm_fem.measure.projection import (
     Advection,
     Fields,
     cell_weights,

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from mpm_fem.grid import grid_from_nodes, uniform_grid
-from mpm_fem.particles import seed_positions
-from mpm_fem.projection import quadrature_checks, smooth_fields
-from mpm_fem.quadrature import (
+from mpm_fem.core.grid import grid_from_nodes, uniform_grid
+from mpm_fem.core.particles import seed_positions
+from mpm_fem.measure.projection import quadrature_checks, smooth_fields
+from mpm_fem.measure.quadrature import (
     cell_mean_error,
     cell_points,
     derivative_l2,

@@ -1,10 +1,10 @@
-"""E5's criterion (mpm_fem.claims, block "remedies: E5") on made-up tables: each part of the goal
+"""E5's criterion (mpm_fem.measure.claims, block "remedies: E5") on made-up tables: each part of the goal
 can fail it (mutation tests: one number moved across a threshold flips the verdict)."""
 
 import pytest
 from claim_mutations import judge
 
-from mpm_fem.claims import remedy_assessment as assess
+from mpm_fem.measure.claims import remedy_assessment as assess
 
 
 def verdict(tables):

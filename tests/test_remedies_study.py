@@ -4,11 +4,11 @@ import pytest
 
 from claim_mutations import judge
 
-from mpm_fem.fused import supported
-from mpm_fem.models.euler import IdealGas
-from mpm_fem.step import Stages
-from mpm_fem.study import StudyOptions, read_table
-from mpm_fem.tables import load_tables
+from mpm_fem.fused.step import supported
+from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.step import Stages
+from mpm_fem.app.study import StudyOptions, read_table
+from mpm_fem.measure.tables import load_tables
 from studies import remedies, sod
 
 

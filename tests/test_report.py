@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from mpm_fem.claims import STATEMENTS
-from mpm_fem.report import Page, View, captions_of, cell, markdown_table, render, study_pages, write_report
-from mpm_fem.tables import load_tables
+from mpm_fem.measure.claims import STATEMENTS
+from mpm_fem.app.report import Page, View, captions_of, cell, markdown_table, render, study_pages, write_report
+from mpm_fem.measure.tables import load_tables
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"
 
@@ -24,7 +24,7 @@ def committed():
 def test_the_committed_report_is_the_rendering_of_the_committed_tables(committed):
     pages = study_pages(FIGURES)
     rendered = render(load_tables(FIGURES), pages, {p.name: captions_of(FIGURES / p.name) for p in pages}) + "\n"
-    assert rendered == committed, "figures/REPORT.md differs from `python -m mpm_fem.report --out figures`"
+    assert rendered == committed, "figures/REPORT.md differs from `python -m mpm_fem.app.report --out figures`"
 
 
 def test_the_header_names_the_code_version_of_the_tables(committed):
@@ -78,15 +78,15 @@ def test_cells_keep_four_significant_digits_and_escape_pipes():
 
 
 def test_readme_results_in_brief_are_generated_from_the_committed_tables():
-    from mpm_fem.report import README_BEGIN, README_END, results_in_brief
+    from mpm_fem.app.report import README_BEGIN, README_END, results_in_brief
 
     readme = (FIGURES.parent / "README.md").read_text()
     block = README_BEGIN + readme.split(README_BEGIN, 1)[1].split(README_END, 1)[0] + README_END
-    assert block == results_in_brief(load_tables(FIGURES)), "run `python -m mpm_fem.report --readme README.md`"
+    assert block == results_in_brief(load_tables(FIGURES)), "run `python -m mpm_fem.app.report --readme README.md`"
 
 
 def test_the_command_refuses_a_missing_folder(tmp_path, capsys):
-    from mpm_fem.report import main
+    from mpm_fem.app.report import main
 
     assert main(["--out", str(tmp_path / "absent")]) == 2
     assert "no folder" in capsys.readouterr().err

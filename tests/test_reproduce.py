@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mpm_fem.claims import STATEMENTS
-from mpm_fem.report import reproduce
-from mpm_fem.study import StudyOptions, read_table
+from mpm_fem.measure.claims import STATEMENTS
+from mpm_fem.app.report import reproduce
+from mpm_fem.app.study import StudyOptions, read_table
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"
 TABLES = {

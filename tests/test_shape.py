@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mpm_fem.grid import GridError, grid_from_nodes, uniform_grid
-from mpm_fem.shape import OutsideGridError, gimp_shape, locate, make_shape, point_shape
+from mpm_fem.core.grid import GridError, grid_from_nodes, uniform_grid
+from mpm_fem.core.shape import OutsideGridError, gimp_shape, locate, make_shape, point_shape
 
 MESHES = {
     "uniform": np.linspace(0.0, 1.0, 11),
@@ -150,7 +150,7 @@ def test_fast_uniform_cell_search_agrees_with_bisection_on_nodes_and_neighbours(
 
 @pytest.mark.parametrize("basis", ["mpm", "bspline"])
 def test_basis_integrals_sum_to_the_domain_length_and_match_the_ends(basis):
-    from mpm_fem.shape import basis_integrals
+    from mpm_fem.core.shape import basis_integrals
 
     grid = uniform_grid(0.0, 1.0, 0.1)
     w = basis_integrals(grid, basis)

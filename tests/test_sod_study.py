@@ -9,10 +9,10 @@ import pytest
 
 from baselines import fem_euler
 from baselines.exact import riemann
-from mpm_fem.grid import uniform_grid
-from mpm_fem.particles import make_particles
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.particles import make_particles
 from mpm_fem.problems.sod import SodSettings
-from mpm_fem.regions import REGION_NAMES, ExtremaCounter, l1_by_region, mean_by_region, sod_regions, strict_extrema
+from mpm_fem.measure.regions import REGION_NAMES, ExtremaCounter, l1_by_region, mean_by_region, sod_regions, strict_extrema
 from studies import sod as study
 
 RHO_POST_SHOCK = 0.26557  # Toro, Table 4.2
@@ -128,8 +128,8 @@ def read_csv_rows(path):
 
 def _check_quick_outputs(folder, hs, ppc_h):
     """Every table and figure of a quick run exists, and the claims judge them from the tables."""
-    from mpm_fem.claims import claims_of
-    from mpm_fem.tables import load_tables
+    from mpm_fem.measure.claims import claims_of
+    from mpm_fem.measure.tables import load_tables
 
     for name in ("convergence", "regions", "extrema", "ppc", "mass"):
         assert (folder / "sod" / f"{name}.csv").exists() and (folder / "sod" / f"{name}.json").exists(), name
@@ -145,7 +145,7 @@ def _check_quick_outputs(folder, hs, ppc_h):
 
 @pytest.mark.slow
 def test_quick_study_writes_every_table_and_its_claims_are_judged(tmp_path):
-    from mpm_fem.study import StudyOptions
+    from mpm_fem.app.study import StudyOptions
 
     study.run(StudyOptions(quick=True, jobs=1, out=tmp_path, progress=False))
     verdicts = _check_quick_outputs(tmp_path, study.QUICK["H"], study.QUICK["PPC_H"])
@@ -154,7 +154,7 @@ def test_quick_study_writes_every_table_and_its_claims_are_judged(tmp_path):
 
 def test_smoke_a_tiny_plan_writes_every_table_and_figure(tmp_path, monkeypatch):
     """The fast version of the slow check: the same run on the two coarsest meshes, few particles."""
-    from mpm_fem.study import StudyOptions
+    from mpm_fem.app.study import StudyOptions
 
     tiny = dict(H=(0.04, 0.02), PPC_H=(0.04,), CONSISTENT_H=(0.04,), PLATEAU_H=())
     monkeypatch.setattr(study, "QUICK", tiny)

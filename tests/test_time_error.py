@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from mpm_fem.problems import burgers
-from mpm_fem.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, pulse_setup,
+from mpm_fem.measure.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, pulse_setup,
                             state_at)
 
 CROSSING = dict(h=0.02, ppc=4, solution="rarefaction", eps=0.045, cfl=0.05, T=0.2)

@@ -5,12 +5,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mpm_fem.grid import grid_from_nodes, uniform_grid
-from mpm_fem.models.euler import IdealGas
-from mpm_fem.particles import make_particles, seed_positions
-from mpm_fem.shape import make_shape
-from mpm_fem.step import Stages, Walls, explicit_step
-from mpm_fem.transfer import (
+from mpm_fem.core.grid import grid_from_nodes, uniform_grid
+from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.particles import make_particles, seed_positions
+from mpm_fem.core.shape import make_shape
+from mpm_fem.core.step import Stages, Walls, explicit_step
+from mpm_fem.core.transfer import (
     grid_values,
     nodal_internal_force,
     nodal_mass,

@@ -1,4 +1,4 @@
-"""XPIC(m), the extended PIC update (mpm_fem/xpic.py): its equation against dense matrices, what it
+"""XPIC(m), the extended PIC update (mpm_fem/core/xpic.py): its equation against dense matrices, what it
 filters, what it conserves, XPIC(1) = PIC, and its order on the smooth problems of the remedies.
 
 The order bands follow from the filter: on a smooth mode ``k`` one XPIC(m) update keeps all of
@@ -14,15 +14,15 @@ import math
 import numpy as np
 import pytest
 
-from mpm_fem.errors import fitted_order
-from mpm_fem.grid import uniform_grid
-from mpm_fem.particles import seed_positions
+from mpm_fem.measure.errors import fitted_order
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.particles import seed_positions
 from mpm_fem.problems import burgers, sod
-from mpm_fem.shape import make_shape
-from mpm_fem.solve import run
-from mpm_fem.step import Dirichlet, Stages, Walls, explicit_step
-from mpm_fem.timing import PulseSettings, field_difference, pulse_setup
-from mpm_fem.xpic import boundary_change_rule, xpic_grid_velocity, xpic_velocity
+from mpm_fem.core.shape import make_shape
+from mpm_fem.core.solve import run
+from mpm_fem.core.step import Dirichlet, Stages, Walls, explicit_step
+from mpm_fem.measure.timing import PulseSettings, field_difference, pulse_setup
+from mpm_fem.core.xpic import boundary_change_rule, xpic_grid_velocity, xpic_velocity
 
 
 @pytest.fixture

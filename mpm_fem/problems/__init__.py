@@ -10,9 +10,9 @@ from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 
-from ..grid import n_cells_for
-from ..particles import LAYOUTS
-from ..step import Stages, StageSwitches
+from mpm_fem.core.grid import n_cells_for
+from mpm_fem.core.particles import LAYOUTS
+from mpm_fem.core.step import Stages, StageSwitches
 
 # Bytes and seconds of one run, measured and then given a margin (stated, not tuned per run):
 # the particle state plus the peak of one step is 212-250 B per particle (benchmarks/step_cost.py,
@@ -61,9 +61,9 @@ class Cost:
 class RunSettings(StageSwitches):
     """The settings every MPM run shares, with the command line's defaults: the mesh size ``h``,
     particles per cell ``ppc`` and their ``layout`` (``seed`` for the random ones), the final time
-    ``T`` and CFL number ``cfl``, the stage switches (:class:`~mpm_fem.step.StageSwitches`; a
+    ``T`` and CFL number ``cfl``, the stage switches (:class:`~mpm_fem.core.step.StageSwitches`; a
     problem adds ``acceleration`` where it has an exact one), and the step's implementation (``kernel``,
-    ``threads``; :func:`mpm_fem.solve.run`). A problem's settings subclass this one, adding its own
+    ``threads``; :func:`mpm_fem.core.solve.run`). A problem's settings subclass this one, adding its own
     parameters and changing the defaults it needs."""
 
     # the mesh and the particles

@@ -17,7 +17,7 @@ h/N_p^i``: every particle of cell ``I_i`` weighs ``h / N_p^i``, reset after ever
 count-normalised second difference ``eps (v_{i+1} - 2 v_i + v_{i-1})/h^2``, point mass only);
 ``dt_rule`` ``"stable"`` (``dt = CFL min(h/max|v|, h^2/(2 eps))``) or ``"advective"`` (``CFL
 h/max|v|``: no viscous limit, for the exact acceleration, which computes no viscous force).
-``kernel`` and ``threads`` choose the step's implementation (:func:`mpm_fem.solve.run`).
+``kernel`` and ``threads`` choose the step's implementation (:func:`mpm_fem.core.solve.run`).
 """
 
 from __future__ import annotations
@@ -28,16 +28,16 @@ import numpy as np
 
 from baselines.exact import burgers as exact_burgers
 
-from ..norms import norms
-from ..exact_stages import SmoothBurgersFields
-from ..grid import Grid, uniform_grid
-from ..fused import check_kernel
-from ..models.burgers import FORCES, ViscousBurgers
-from ..particles import Particles, make_particles, seed_positions
-from ..shape import locate
-from ..solve import Problem, Result, run
-from ..step import ACCELERATIONS, Dirichlet
-from . import Cost, RunSettings, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
+from mpm_fem.core.norms import norms
+from mpm_fem.exact_stages.stage import SmoothBurgersFields
+from mpm_fem.core.grid import Grid, uniform_grid
+from mpm_fem.fused.step import check_kernel
+from mpm_fem.core.models.burgers import FORCES, ViscousBurgers
+from mpm_fem.core.particles import Particles, make_particles, seed_positions
+from mpm_fem.core.shape import locate
+from mpm_fem.core.solve import Problem, Result, run
+from mpm_fem.core.step import ACCELERATIONS, Dirichlet
+from mpm_fem.problems import Cost, RunSettings, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
 
 
 WEIGHTS = ("volume", "cell")
@@ -147,12 +147,12 @@ def initial_particles(settings: BurgersSettings, grid: Grid) -> Particles:
 
 
 def exact_fields(settings: BurgersSettings) -> SmoothBurgersFields:
-    """The exact fields of the exact stages (:mod:`mpm_fem.exact_stages`): point values."""
+    """The exact fields of the exact stages (:mod:`mpm_fem.exact_stages.stage`): point values."""
     return SmoothBurgersFields(settings.exact, settings.eps)
 
 
 def simulate(settings: BurgersSettings = BurgersSettings(), progress: bool | None = None, observer=None) -> Result:
-    """Run MPM on viscous Burgers with ``settings`` through :func:`mpm_fem.solve.run`."""
+    """Run MPM on viscous Burgers with ``settings`` through :func:`mpm_fem.core.solve.run`."""
     solution = settings.exact
     grid = uniform_grid(*solution.domain, settings.h)
     problem = Problem(

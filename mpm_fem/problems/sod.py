@@ -15,15 +15,15 @@ import numpy as np
 
 from baselines.exact import riemann
 
-from ..norms import norms
-from ..exact_stages import RiemannFields
-from ..fused import check_kernel
-from ..grid import uniform_grid
-from ..models.euler import IdealGas
-from ..particles import make_particles, seed_positions
-from . import Cost, RunSettings, check_non_negative, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
-from ..solve import Problem, Result, run
-from ..step import Walls
+from mpm_fem.core.norms import norms
+from mpm_fem.exact_stages.stage import RiemannFields
+from mpm_fem.fused.step import check_kernel
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.particles import make_particles, seed_positions
+from mpm_fem.problems import Cost, RunSettings, check_non_negative, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
+from mpm_fem.core.solve import Problem, Result, run
+from mpm_fem.core.step import Walls
 
 DOMAIN = (0.0, 1.0)
 
@@ -73,7 +73,7 @@ def exact(settings: SodSettings, x: np.ndarray, t: float):
 
 
 def exact_fields(settings: SodSettings) -> RiemannFields:
-    """The exact fields of the exact stages (:mod:`mpm_fem.exact_stages`): the Riemann solution,
+    """The exact fields of the exact stages (:mod:`mpm_fem.exact_stages.stage`): the Riemann solution,
     averaged over one cell (half-width ``h / 2``) where a stage needs ``v_x`` or ``Dv/Dt``, which
     are Dirac masses at the shock. One cell, not one particle: the artificial viscosity's length
     is the cell size, and a gradient spread over ``h / N_p`` makes it overheat the shock."""

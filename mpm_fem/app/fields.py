@@ -1,0 +1,79 @@
+"""Field output over time for ParaView: VTU snapshots written with meshio and a ``.pvd`` series.
+
+``FieldWriter`` is an observer of :func:`mpm_fem.core.solve.run`: at every ``every``-th step it writes the
+particles (points with their state as point data) and the grid (P1 line cells with nodal mass,
+velocity and acceleration) to ``folder/particles_NNNNN.vtu`` and ``folder/grid_NNNNN.vtu``, and
+``close()`` adds the final frame at ``T`` and writes ``particles.pvd`` and ``grid.pvd``, the time
+series ParaView opens. The grid's final frame is the projection of the final particles: its mass
+and velocity; its acceleration is NaN, since no step is taken at ``T``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import meshio
+import numpy as np
+
+from mpm_fem.core.grid import Grid
+from mpm_fem.core.particles import Particles
+from mpm_fem.core.step import GridState
+
+PARTICLE_FIELDS = ("velocity", "density", "energy", "pressure", "volume", "mass")
+
+
+def _points(x: np.ndarray) -> np.ndarray:
+    return np.column_stack((x, np.zeros_like(x), np.zeros_like(x)))
+
+
+def particle_mesh(particles: Particles) -> meshio.Mesh:
+    """The particles as meshio vertices carrying their state."""
+    n = particles.n
+    return meshio.Mesh(_points(particles.x), [("vertex", np.arange(n).reshape(-1, 1))],
+                       point_data={name: getattr(particles, name) for name in PARTICLE_FIELDS})
+
+
+def grid_mesh(grid: Grid, state: GridState) -> meshio.Mesh:
+    """The grid as meshio line cells carrying ``m_i``, ``v_i^{n+1}`` and ``a_i``."""
+    cells = np.column_stack((np.arange(grid.n_cells), np.arange(1, grid.n_nodes)))
+    return meshio.Mesh(_points(grid.nodes), [("line", cells)],
+                       point_data={"mass": state.mass, "velocity": state.new_velocity, "acceleration": state.acceleration})
+
+
+class FieldWriter:
+    """Observer writing snapshots every ``every`` steps (and at the first step) into ``folder``."""
+
+    keeps_particles = False  # it writes what it is handed at once (mpm_fem.core.solve.run may reuse the arrays)
+
+    def __init__(self, folder, grid: Grid, every: int = 20):
+        if every < 1:
+            raise ValueError(f"fields are written every EVERY >= 1 steps, got {every}")
+        self.folder = Path(folder)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.grid, self.every = grid, every
+        self.series: dict[str, list[tuple[float, str]]] = {"particles": [], "grid": []}
+
+    def _write(self, kind: str, mesh: meshio.Mesh, t: float) -> None:
+        name = f"{kind}_{len(self.series[kind]):05d}.vtu"
+        meshio.write(self.folder / name, mesh)
+        self.series[kind].append((t, name))
+
+    def __call__(self, step: int, t: float, old: Particles, new: Particles, state: GridState) -> None:
+        """At steps 0, EVERY, 2 EVERY, ...: the particles at the start of the step (time ``t``) and
+        the grid they projected to."""
+        if step % self.every == 0:
+            self._write("particles", particle_mesh(old), t)
+            self._write("grid", grid_mesh(self.grid, state), t)
+
+    def close(self, t_final: float, particles: Particles, nodal_mass: np.ndarray, nodal_velocity: np.ndarray) -> None:
+        """Write the final particles and grid (if not yet written) and the two ``.pvd`` series."""
+        if not self.series["particles"] or self.series["particles"][-1][0] < t_final:
+            self._write("particles", particle_mesh(particles), t_final)
+            state = GridState(nodal_mass, nodal_velocity, np.full_like(nodal_mass, np.nan), nodal_velocity)
+            self._write("grid", grid_mesh(self.grid, state), t_final)
+        for kind, entries in self.series.items():
+            lines = ['<?xml version="1.0"?>', '<VTKFile type="Collection" version="0.1">', "  <Collection>"]
+            lines += [f'    <DataSet timestep="{t:.10g}" part="0" file={quoteattr(name)}/>' for t, name in entries]
+            lines += ["  </Collection>", "</VTKFile>", ""]
+            (self.folder / f"{kind}.pvd").write_text("\n".join(lines))

@@ -1,0 +1,199 @@
+"""Sweeps: a study is a list of independent cases, run in parallel, each result cached.
+
+``run_cases(fn, cases)`` calls the module-level function ``fn(case) -> dict`` on every case (a
+JSON-able dict of settings). Results are cached under ``cache_dir`` by a key made of ``fn``'s
+qualified name, the case, and a hash of the source code of ``mpm_fem``, ``baselines`` and ``studies``: a
+finished case is never recomputed while the code is unchanged, and a change to the code
+recomputes everything. Each result is written atomically (temporary file + rename), so a sweep that
+is interrupted resumes where it stopped and never reads a half-written result.
+
+Parallelism: ``jobs`` worker processes (``concurrent.futures``), or an existing Dask cluster when
+``scheduler="tcp://HOST:PORT"`` is given (``dask.distributed``, the optional extra ``[dask]``).
+Progress: a ``tqdm`` bar on a terminal, plain lines otherwise (CI logs).
+
+Workers die with their parent: each worker ignores Ctrl-C (the parent handles it and ends them),
+asks Linux to kill it when its parent dies (``prctl(PR_SET_PDEATHSIG)``), and runs a watchdog
+thread that ends it within half a second once the parent process is gone (any platform).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import json
+import os
+import signal
+import sys
+import threading
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from functools import lru_cache
+from pathlib import Path
+from typing import Callable
+
+from tqdm.auto import tqdm
+
+from mpm_fem.app.output import write_json
+
+CaseFn = Callable[[dict], dict]
+
+
+@lru_cache(maxsize=1)
+def code_version() -> str:
+    """A hash of every ``.py`` file of the packages ``mpm_fem``, ``baselines`` and ``studies``."""
+    root = Path(__file__).resolve().parents[2]
+    digest = hashlib.sha256()
+    for package in ("mpm_fem", "baselines", "studies"):
+        for path in sorted((root / package).rglob("*.py")):
+            digest.update(str(path.relative_to(root)).encode())
+            digest.update(path.read_bytes())
+    return digest.hexdigest()[:12]
+
+
+def case_key(fn: CaseFn, case: dict) -> str:
+    """Cache key of ``fn(case)`` under the current code."""
+    text = json.dumps({"fn": f"{fn.__module__}.{fn.__qualname__}", "case": case, "code": code_version()},
+                      sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def _load(path: Path) -> dict | None:
+    try:
+        return json.loads(path.read_text())["result"]
+    except (OSError, ValueError, KeyError):
+        return None
+
+
+def _watch_parent(parent: int, interval: float = 0.5) -> None:
+    while os.getppid() == parent:
+        time.sleep(interval)
+    os._exit(1)  # the parent is gone: nobody waits for this worker's result
+
+
+def _worker_init(parent: int) -> None:
+    """Runs in each worker process before its first case: see the module docstring."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != parent:  # the parent died before prctl took effect
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True, name="watch-parent").start()
+
+
+def _run_pool(fn, cases, todo, jobs: int, finish) -> None:
+    """``fn`` over ``todo`` in ``jobs`` worker processes. If the parent is interrupted (Ctrl-C) or
+    fails, the workers are ended at once instead of finishing their cases."""
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),))
+    try:
+        futures = {pool.submit(fn, cases[k]): (k, path) for k, path in todo}
+        for future in as_completed(futures):
+            k, path = futures[future]
+            finish(k, path, future.result())
+    except BaseException:
+        workers = list(getattr(pool, "_processes", {}).values())  # no public handle on the workers
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in workers:
+            process.kill()
+        raise
+    pool.shutdown()
+
+
+def _default_jobs() -> int:
+    return max(1, min(os.cpu_count() or 1, 8))
+
+
+def run_cases(
+    fn: CaseFn,
+    cases: list[dict],
+    jobs: int | None = None,
+    cache_dir: str | os.PathLike | None = None,
+    desc: str = "cases",
+    scheduler: str | None = None,
+    progress: bool | None = None,
+) -> list[dict]:
+    """``[fn(case) for case in cases]``, in parallel, cached; results in the order of ``cases``."""
+    if jobs is not None and jobs < 1:
+        raise ValueError(f"jobs must be >= 1, got {jobs}")
+    jobs = jobs or _default_jobs()
+    cache = Path(cache_dir) if cache_dir is not None else None
+    if cache is not None:
+        cache.mkdir(parents=True, exist_ok=True)
+    results: list[dict | None] = [None] * len(cases)
+    todo = []
+    for k, case in enumerate(cases):
+        path = cache / f"{case_key(fn, case)}.json" if cache is not None else None
+        cached = _load(path) if path is not None and path.exists() else None
+        if cached is not None:
+            results[k] = cached
+        else:
+            todo.append((k, path))
+    reporter = _Progress(len(cases), len(cases) - len(todo), desc, progress)
+
+    def finish(k: int, path: Path | None, result: dict) -> None:
+        results[k] = result
+        if path is not None:
+            write_json(path, {"case": cases[k], "code": code_version(), "result": result})
+        reporter.update(cases[k])
+
+    try:
+        if not todo:
+            pass
+        elif scheduler is not None:
+            _run_dask(fn, cases, todo, scheduler, finish)
+        elif jobs == 1 or len(todo) == 1:
+            for k, path in todo:
+                finish(k, path, fn(cases[k]))
+        else:
+            _run_pool(fn, cases, todo, min(jobs, len(todo)), finish)
+    finally:
+        reporter.close()
+    return results  # type: ignore[return-value]
+
+
+def _run_dask(fn, cases, todo, scheduler, finish) -> None:
+    try:
+        from dask.distributed import Client, as_completed as dask_completed
+    except ImportError:
+        raise RuntimeError("--scheduler needs dask.distributed: pip install 'mpm-fem[dask]'") from None
+    try:
+        client = Client(scheduler, timeout="10s")
+    except Exception as err:  # noqa: BLE001 -- one line, whatever the failure of the connection
+        raise RuntimeError(f"cannot connect to the Dask scheduler at {scheduler}: {err.__class__.__name__}: "
+                           f"{str(err).splitlines()[0] if str(err) else ''}") from None
+    with client:
+        futures = {}
+        for k, path in todo:
+            futures[client.submit(fn, cases[k], pure=False, key=f"case-{k}-{time.time_ns()}")] = (k, path)
+        for future in dask_completed(list(futures)):
+            k, path = futures[future]
+            finish(k, path, future.result())
+
+
+class _Progress:
+    """A tqdm bar on a terminal; on other streams a plain line per case (every ~10 %)."""
+
+    def __init__(self, total: int, done: int, desc: str, progress: bool | None):
+        self.total, self.done, self.desc = total, done, desc
+        self.start = time.perf_counter()
+        tty = sys.stderr.isatty()
+        self.enabled = progress if progress is not None else True
+        self.bar = tqdm(total=total, initial=done, desc=desc, leave=False) if (self.enabled and tty) else None
+        self.plain = self.enabled and not tty and total > done
+        self.step = max(1, (total - done) // 10)
+        if self.plain:
+            print(f"[{desc}] {total - done} of {total} cases to run ({done} cached)", file=sys.stderr, flush=True)
+
+    def update(self, case: dict) -> None:
+        self.done += 1
+        if self.bar is not None:
+            self.bar.update(1)
+        elif self.plain and (self.done % self.step == 0 or self.done == self.total):
+            elapsed = time.perf_counter() - self.start
+            print(f"[{self.desc}] {self.done}/{self.total} done, {elapsed:.0f} s", file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()

@@ -1,0 +1,318 @@
+"""One explicit MPM step (slides, "Forward Euler time integration").
+
+    v_i^{n+1} = v_i^n + dt a_i
+    v_p^{n+1} = v_p^n + dt sum_i S_ip a_i
+    x_p^{n+1} = x_p^n + dt sum_i S_ip v_i^{n+1}            (semi-implicit: the new grid velocity)
+
+with ``v_i^n = P_i / m_i`` and ``a_i = F_i / m_i`` from the projections of :mod:`mpm_fem.core.transfer`.
+The particle state (density, energy, pressure) is updated from the velocity gradient
+
+    USL (update stress last, the slides' order):  (dv/dx)_p = sum_i G_ip v_i^{n+1}, after the move
+    USF (update stress first):                    (dv/dx)_p = sum_i G_ip v_i^n, before the force
+    MUSL (modified USL): as USL, with v_i^{n+1} re-projected from the updated particle velocities.
+
+Each stage of the step has a switch (:class:`Stages`); the exact forms used by the error budget
+are supplied by the problem (``exact_acceleration``, and :class:`~mpm_fem.exact_stages.stage.
+ExactFields` for the projection, mass and interpolation switches; their equations are in
+:mod:`mpm_fem.exact_stages.stage`). The default stages run the plain MPM step below, untouched.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Protocol
+
+import numpy as np
+
+from mpm_fem.exact_stages.stage import ExactFields, ExactGridStage, GridData
+from mpm_fem.core.grid import Grid
+from mpm_fem.core.particles import Particles
+from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force
+from mpm_fem.core.shape import BASES, make_shape
+from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
+from mpm_fem.core.volume import VOLUMES, grid_volume_factor
+from mpm_fem.core.xpic import boundary_change_rule, check_order, xpic_velocity
+
+SCHEMES = ("usl", "usf", "musl")
+ACCELERATIONS = ("calculated", "exact")
+PROJECTIONS = ("mpm", "exact")
+INTERPOLATIONS = ("mpm", "exact")
+STAGE_MASS = MASS_KINDS + ("exact",)
+
+
+@dataclass(frozen=True)
+class StageSwitches:
+    """The stage switches of :class:`Stages` that every run's settings carry (all but the
+    acceleration, which only a problem with an exact one offers)."""
+
+    basis: str = "mpm"
+    mass: str = "lumped"
+    scheme: str = "usl"
+    projection: str = "mpm"
+    interpolation: str = "mpm"
+    refine: int = 1
+    flip: float = 1.0
+    reconstruct: str = "none"
+    volume: str = "carried"
+    xpic: int = 0
+
+
+@dataclass(frozen=True)
+class Stages(StageSwitches):
+    """Which form each stage of the step takes.
+
+    ``basis``: ``"mpm"`` (point mass), ``"gimp"`` or ``"bspline"``; ``mass``: ``"lumped"``,
+    ``"consistent"`` (particle mass matrix) or ``"exact"`` (FE + lumping error removed);
+    ``acceleration``: ``"calculated"`` (``F_i/m_i``) or ``"exact"`` (the problem's exact nodal
+    acceleration); ``scheme``: ``"usl"``, ``"usf"`` or ``"musl"``; ``projection`` and
+    ``interpolation``: ``"mpm"`` or ``"exact"``; ``refine``: the time step is ``dt / refine``.
+    The exact forms are those of :mod:`mpm_fem.exact_stages.stage`. The remedies (module docstring):
+    ``flip`` in [0, 1] (1: FLIP, 0: PIC), ``xpic`` the order ``m >= 1`` of the XPIC update
+    (:mod:`mpm_fem.core.xpic`; 0: off, else in place of the blend), ``reconstruct`` ``"none"`` or
+    ``"taylor"``, ``volume`` ``"carried"`` or ``"grid"``, and the basis ``"bspline_gimp"``.
+    """
+
+    acceleration: str = "calculated"
+
+    def __post_init__(self):
+        for name, allowed in (("basis", BASES), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
+                              ("scheme", SCHEMES), ("projection", PROJECTIONS), ("interpolation", INTERPOLATIONS),
+                              ("reconstruct", RECONSTRUCTIONS), ("volume", VOLUMES)):
+            value = getattr(self, name)
+            if value not in allowed:
+                raise ValueError(f"unknown {name} {value!r}; choose one of {', '.join(allowed)}")
+        if isinstance(self.refine, bool) or not isinstance(self.refine, (int, np.integer)) or self.refine < 1:
+            raise ValueError(f"the time refinement must be an integer >= 1, got {self.refine!r}")
+        if self.uses_exact_fields and self.scheme == "musl":
+            raise ValueError("the exact projection, mass and interpolation stages are defined for USL and USF only")
+        if isinstance(self.flip, bool) or not isinstance(self.flip, (int, float, np.number)) or not 0 <= self.flip <= 1:
+            raise ValueError(f"the PIC/FLIP blend must lie in [0, 1] (1: FLIP, 0: PIC), got {self.flip!r}")
+        check_order(self.xpic)
+        if self.xpic and self.flip != 1:
+            raise ValueError(f"XPIC replaces the PIC/FLIP blend: use xpic {self.xpic} with flip 1, got flip {self.flip!r}")
+        if self.uses_exact_fields and (self.flip != 1 or self.xpic != 0 or self.reconstruct != "none"
+                                       or self.volume != "carried"):
+            raise ValueError("the remedies flip, xpic, reconstruct and volume run with the MPM stages only "
+                             "(the basis bspline_gimp also with the exact stages)")
+
+    @property
+    def uses_remedy(self) -> bool:
+        """Whether a plateau remedy is on (the fused step runs every one: the blend, XPIC,
+        ``bspline_gimp``, the grid volume and ``reconstruct``)."""
+        return (self.basis == "bspline_gimp" or self.flip != 1 or self.xpic != 0 or self.reconstruct != "none"
+                or self.volume != "carried")
+
+    @property
+    def uses_exact_fields(self) -> bool:
+        """Whether a stage needs the problem's :class:`~mpm_fem.exact_stages.stage.ExactFields`."""
+        return self.projection == "exact" or self.interpolation == "exact" or self.mass == "exact"
+
+
+class Model(Protocol):
+    """A material: its stress, its state update and its stable time step. A model whose stress
+    ignores ``(dv/dx)_p`` sets ``stress_uses_gradient = False`` (the step then gathers none); a
+    model with ``force == "slides"`` gives the nodal acceleration itself (``grid_acceleration``)."""
+
+    def stress(self, particles: Particles, grad_v: np.ndarray | None) -> np.ndarray: ...
+
+    def update(self, particles: Particles, grad_v: np.ndarray, dt: float, cell_size: np.ndarray) -> Particles: ...
+
+    def stable_dt(self, particles: Particles, grid: Grid, cfl: float) -> float: ...
+
+    # the volume remedy also calls ``with_volume(particles, volume) -> Particles``: the state at
+    # the same mass (and specific energy) with the volumes ``volume``
+
+
+
+class Boundary(Protocol):
+    """Grid boundary conditions: impose them on the nodal velocity and acceleration."""
+
+    def velocity(self, grid: Grid, v: np.ndarray, t: float) -> np.ndarray: ...
+
+    def acceleration(self, grid: Grid, a: np.ndarray, v: np.ndarray, t: float, dt: float) -> np.ndarray: ...
+
+
+@dataclass(frozen=True)
+class Walls:
+    """Rigid walls at both ends: ``v_i = a_i = 0`` on the boundary nodes."""
+
+    def velocity(self, grid, v, t):
+        v = v.copy()
+        v[grid.boundary_nodes] = 0.0
+        return v
+
+    def acceleration(self, grid, a, v, t, dt):
+        a = a.copy()
+        a[grid.boundary_nodes] = 0.0
+        return a
+
+
+@dataclass(frozen=True)
+class Dirichlet:
+    """Prescribed velocity ``g(x, t)`` at both ends; ``a_i`` makes ``v_i^{n+1} = g(x_i, t + dt)``.
+
+    The data at ``t + dt`` of one step are the data at ``t`` of the next: the last evaluation is
+    kept, so ``g`` is called once per step."""
+
+    g: Callable[[np.ndarray, float], np.ndarray]
+    _last: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def _values(self, grid, t):
+        b = grid.boundary_nodes
+        key = (float(grid.nodes[b[0]]), float(grid.nodes[b[-1]]), t)
+        if self._last.get("key") != key:
+            self._last.update(key=key, value=self.g(grid.nodes[b], t))
+        return b, self._last["value"]
+
+    def end_values(self, grid, t):
+        """``g`` at the boundary nodes at ``t``, the evaluation the step uses (kept per ``t``)."""
+        return self._values(grid, t)[1]
+
+    def velocity(self, grid, v, t):
+        v = v.copy()
+        b, g = self._values(grid, t)
+        v[b] = g
+        return v
+
+    def acceleration(self, grid, a, v, t, dt):
+        a = a.copy()
+        b, g = self._values(grid, t + dt)
+        a[b] = (g - v[b]) / dt
+        return a
+
+
+@dataclass(frozen=True, eq=False)
+class GridState:
+    """What the grid held during one step, all (n_nodes,): ``m_i``, ``v_i^n``, ``a_i``, ``v_i^{n+1}``."""
+
+    mass: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    new_velocity: np.ndarray
+
+
+def explicit_step(
+    grid: Grid,
+    particles: Particles,
+    model: Model,
+    boundary: Boundary,
+    t: float,
+    dt: float,
+    stages: Stages = Stages(),
+    exact_acceleration: Callable[[np.ndarray, float], np.ndarray] | None = None,
+    exact: ExactFields | None = None,
+) -> tuple[Particles, GridState]:
+    """Advance the particles from ``t`` to ``t + dt``; returns the new particles and the grid state."""
+    if stages.uses_exact_fields:
+        return _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exact_acceleration, exact)
+    shape = make_shape(grid, particles.x, particles.volume, stages.basis)
+    h_p = grid.h[shape.cell]
+    m, V = particles.mass, particles.volume
+    m_i = nodal_mass(shape, m)
+    v_i = boundary.velocity(grid, grid_values(shape, m, m_i, nodal_momentum(shape, m, particles.velocity), stages.mass), t)
+    if stages.volume == "grid":
+        particles = _reset_volume(model, particles, grid_volume_factor(grid, particles.x, V, stages.basis, shape))
+        V = particles.volume
+
+    if stages.scheme == "usf":
+        particles = model.update(particles, shape.gather_gradient(v_i), dt, h_p)
+        V = particles.volume
+
+    if stages.acceleration == "exact":
+        if exact_acceleration is None:
+            raise ValueError("this problem has no exact acceleration to use")
+        a_i = exact_acceleration(grid.nodes, t)
+    elif getattr(model, "force", "weak") == "slides":
+        a_i = model.grid_acceleration(grid, shape.cell, v_i)
+    else:
+        if getattr(model, "stress_uses_gradient", True):
+            stress = model.stress(particles, shape.gather_gradient(v_i))
+        else:
+            stress = model.stress(particles, None)
+        if stages.reconstruct == "taylor":
+            F_i = reconstructed_force(grid, particles.x, stress, stages.basis)
+        else:
+            F_i = nodal_internal_force(shape, V, stress)
+        a_i = grid_values(shape, m, m_i, F_i, stages.mass)
+    a_i = boundary.acceleration(grid, a_i, v_i, t, dt)
+    v_new = v_i + dt * a_i
+
+    moving = shape.gather(v_new)
+    if stages.xpic:
+        velocity = xpic_velocity(shape, m, m_i, v_i, a_i, dt, stages.xpic, stages.mass,
+                                 boundary_change_rule(boundary, grid, t))
+    else:
+        velocity = particles.velocity + dt * shape.gather(a_i)
+        if stages.flip != 1:
+            velocity = stages.flip * velocity + (1.0 - stages.flip) * moving
+    x = particles.x + dt * moving
+    particles = particles.replace(x=x, velocity=velocity)
+
+    if stages.scheme == "musl":
+        v_new = boundary.velocity(
+            grid, grid_values(shape, m, m_i, nodal_momentum(shape, m, velocity), stages.mass), t + dt
+        )
+    if stages.scheme in ("usl", "musl"):
+        particles = model.update(particles, shape.gather_gradient(v_new), dt, h_p)
+    return particles, GridState(m_i, v_i, a_i, v_new)
+
+
+def _reset_volume(model: Model, particles: Particles, factor: np.ndarray) -> Particles:
+    """``V_p <- f_p V_p`` through the model (:mod:`mpm_fem.core.volume`)."""
+    if not hasattr(model, "with_volume"):
+        raise ValueError(f"the volume reset needs a model with with_volume(); {type(model).__name__} has none")
+    return model.with_volume(particles, particles.volume * factor)
+
+
+def _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exact_acceleration, exact):
+    """:func:`explicit_step` with some stages in their exact form (:mod:`mpm_fem.exact_stages.stage`).
+
+    The same pipeline as the plain step; at each stage the MPM value is replaced as follows.
+    projection: ``m_i, P_i, F_i`` are the exact integrals. mass ``"exact"``: a nodal value is the
+    exact nodal value plus the projection error carried through the lumped solve (MPM data: the
+    particle mass; exact data: the FE mass assembled by scikit-fem). interpolation:
+    ``f_p = f*(x_p) + sum_i S_ip (f_i - f*_i)`` for the particle acceleration, the velocity that
+    moves the particle and the velocity gradient.
+    """
+    if exact is None:
+        raise ValueError("the exact projection, mass and interpolation stages need the problem's exact fields")
+    shape = make_shape(grid, particles.x, particles.volume, stages.basis)
+    h_p = grid.h[shape.cell]
+    m = particles.mass
+    mpm = GridData(shape, m, nodal_mass(shape, m), nodal_momentum(shape, m, particles.velocity))
+    stage = ExactGridStage(grid, boundary, stages, exact, mpm, t, dt)
+    v_i, star_v, star_a = stage.v_i, stage.star_v, stage.star_a
+    exact_at_particles = stages.interpolation == "exact"
+    if exact_at_particles:
+        p_v, p_vx, p_a = exact.reference(particles.x, t)
+
+    def gradient(nodal, star, time):
+        if not exact_at_particles:
+            return shape.gather_gradient(nodal)
+        field = p_vx if time == t else exact.velocity_gradient(particles.x, time)
+        return field + shape.gather_gradient(nodal - star)
+
+    if stages.scheme == "usf":
+        particles = model.update(particles, gradient(v_i, star_v, t), dt, h_p)
+
+    if stages.acceleration == "exact":
+        if exact_acceleration is None:
+            raise ValueError("this problem has no exact acceleration to use")
+        a_i = boundary.acceleration(grid, exact_acceleration(grid.nodes, t), v_i, t, dt)
+    else:
+        stress = model.stress(particles, gradient(v_i, star_v, t))
+        a_i = stage.acceleration(nodal_internal_force(shape, particles.volume, stress)
+                                 if stages.projection == "mpm" else None)
+    v_new = v_i + dt * a_i
+
+    if exact_at_particles:
+        star_new = stage.star_new
+        acceleration = p_a + shape.gather(a_i - star_a)
+        moving = p_v + dt * p_a + shape.gather(v_new - star_new)
+    else:
+        star_new = None
+        acceleration, moving = shape.gather(a_i), shape.gather(v_new)
+    particles = particles.replace(x=particles.x + dt * moving, velocity=particles.velocity + dt * acceleration)
+    if stages.scheme == "usl":
+        particles = model.update(particles, gradient(v_new, star_new, t + dt), dt, h_p)
+    return particles, GridState(mpm.m_i, v_i, a_i, v_new)

@@ -1,0 +1,114 @@
+"""Particle-to-grid projection and grid-to-particle interpolation.
+
+Slides, "MPM Basis Overview" and "Mass/Momentum/Force Projection Error":
+
+    nodal mass        m_i = sum_p m_p S_ip
+    nodal momentum    P_i = sum_p m_p v_p S_ip          v_i = P_i / m_i   (lumped)
+    internal force    F_i = - sum_p V_p sigma_p G_ip    a_i = F_i / m_i   (lumped)
+
+with the Cauchy stress ``sigma_p`` (gas: ``sigma = -p``, so ``F_i = sum_p V_p p_p G_ip``). With a
+consistent mass the nodal values solve ``M v = P`` and ``M a = F`` instead, where ``M`` is the
+particle mass matrix ``M_ij = sum_p m_p S_ip S_jp``. Interpolation back to the particles:
+
+    v_p = sum_i S_ip v_i,     (dv/dx)_p = sum_i G_ip v_i.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.linalg import solve_banded
+from scipy.sparse.linalg import spsolve
+
+from mpm_fem.core.shape import Shape
+
+MASS_KINDS = ("lumped", "consistent")
+
+
+def nodal_mass(shape: Shape, mass: np.ndarray) -> np.ndarray:
+    """``m_i = sum_p m_p S_ip``."""
+    return shape.scatter(mass)
+
+
+def nodal_momentum(shape: Shape, mass: np.ndarray, velocity: np.ndarray) -> np.ndarray:
+    """``P_i = sum_p m_p v_p S_ip``."""
+    return shape.scatter(mass * velocity)
+
+
+def nodal_internal_force(shape: Shape, volume: np.ndarray, stress: np.ndarray) -> np.ndarray:
+    """``F_i = - sum_p V_p sigma_p G_ip``."""
+    return -shape.scatter_gradient(volume * stress)
+
+
+def particle_mass_matrix(shape: Shape, mass: np.ndarray) -> sp.csr_matrix:
+    """Consistent particle mass matrix ``M_ij = sum_p m_p S_ip S_jp`` (n_nodes x n_nodes)."""
+    S = shape.matrix()
+    return (S.T @ sp.diags(mass) @ S).tocsr()
+
+
+def divide_by_lumped(rhs: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """``rhs_i / m_i`` where the node carries mass, 0 where it carries none."""
+    out = np.zeros_like(rhs)
+    np.divide(rhs, m, out=out, where=m > 0)
+    return out
+
+
+def _tridiagonal_mass(shape: Shape, mass: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Diagonal ``M_ii`` (n_nodes,) and super-diagonal ``M_{i,i+1}`` (n_nodes - 1,) of the particle
+    mass matrix when every particle touches two neighbouring nodes ``(c, c + 1)`` (P1 point mass):
+    the same sums as :func:`particle_mass_matrix`, by bincount instead of sparse products."""
+    c, n = shape.nodes[:, 0], shape.n_nodes
+    S0, S1 = shape.S[:, 0], shape.S[:, 1]
+    diag = np.bincount(c, mass * S0 * S0, n) + np.bincount(c + 1, mass * S1 * S1, n)
+    return diag, np.bincount(c, mass * S0 * S1, n)[: n - 1]
+
+
+def solve_consistent(shape: Shape, mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Solve ``M u = rhs`` with the particle mass matrix; nodes with no mass get 0.
+
+    For P1 the matrix is tridiagonal and is solved banded; otherwise by sparse LU.
+    """
+    out = np.zeros_like(rhs)
+    tridiagonal = shape.nodes.shape[1] == 2 and np.array_equal(shape.nodes[:, 1], shape.nodes[:, 0] + 1)
+    try:
+        if tridiagonal:
+            diag, upper = _tridiagonal_mass(shape, mass)
+            active = np.flatnonzero(diag > 0)
+            ab = np.zeros((3, active.size))
+            ab[1] = diag[active]
+            # neighbours across a node without mass are not coupled
+            ab[0, 1:] = np.where(np.diff(active) == 1, upper[active[:-1]], 0.0)
+            ab[2, :-1] = ab[0, 1:]
+            out[active] = solve_banded((1, 1), ab, rhs[active])
+        else:
+            M = particle_mass_matrix(shape, mass)
+            active = np.asarray(M.diagonal()) > 0
+            out[active] = spsolve(M[active][:, active].tocsc(), rhs[active])
+        singular = not np.all(np.isfinite(out))
+    except np.linalg.LinAlgError:
+        singular = True
+    if singular:
+        raise FloatingPointError(
+            "the consistent particle mass matrix is singular (too few particles in some cells); "
+            "use the lumped mass or more particles per cell"
+        )
+    return out
+
+
+def grid_values(shape: Shape, mass: np.ndarray, m_i: np.ndarray, rhs: np.ndarray, kind: str) -> np.ndarray:
+    """Nodal values from a projected right-hand side: ``rhs/m_i`` (lumped) or ``M^{-1} rhs``."""
+    if kind == "lumped":
+        return divide_by_lumped(rhs, m_i)
+    if kind == "consistent":
+        return solve_consistent(shape, mass, rhs)
+    raise ValueError(f"unknown mass kind {kind!r}; choose one of {', '.join(MASS_KINDS)}")
+
+
+def interpolate(shape: Shape, f: np.ndarray) -> np.ndarray:
+    """``f_p = sum_i S_ip f_i``."""
+    return shape.gather(f)
+
+
+def gradient(shape: Shape, f: np.ndarray) -> np.ndarray:
+    """``(df/dx)_p = sum_i G_ip f_i``."""
+    return shape.gather_gradient(f)

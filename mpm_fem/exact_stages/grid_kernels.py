@@ -1,0 +1,233 @@
+"""Compiled sums of the exact grid stage (numba): the quadrature's nodal sums and the FE mass.
+
+The exact grid stage (:class:`~mpm_fem.exact_stages.stage.ExactGridStage`) runs every step on a few
+thousand Gauss points and a few hundred nodes; in numpy its cost is mostly the overhead of many
+small array calls. The kernels below make the same sums with the same floating-point operations in
+the same order, so they equal the numpy ones bit for bit (tested: ``tests/test_grid_kernels.py``);
+the numpy forms (:mod:`mpm_fem.core.transfer`, :meth:`~mpm_fem.exact_stages.stage.FEMass.entries_numpy`) stay
+the readable reference.
+
+    project     m_i = sum_q (w_q rho_q) S_qi,   P_i = sum_q ((w_q rho_q) v_q) S_qi,
+                F_i = - sum_q (w_q sigma_q) G_qi,
+                each sum in the order of the points and of a row's columns, as ``np.bincount``
+                adds its weights (one after the other, from 0).
+    cut_pieces  the pieces (nodes and half cells) that breakpoints cut, their sub-pieces' Gauss
+                points ``x = (a + w/2) + (w/2) xi_g`` and weights ``(w/2) w_g`` and the rows of the
+                grid functions there (:meth:`~mpm_fem.exact_stages.stage.QuadratureRule.cuts`): P1 hats
+                ``S = (1 - xi, xi)``, ``G = (-1, 1)/h_c`` or quadratic B-splines (:func:`mpm_fem.core.shape.
+                point_shape`, :func:`~mpm_fem.core.shape.bspline_shape`, their point location
+                :func:`~mpm_fem.core.shape.locate` included).
+    splice      the rows of the fixed pieces with each cut piece replaced by its sub-pieces
+                (:meth:`~mpm_fem.exact_stages.stage.QuadratureRule.splice`): copies only.
+    fe_entries  the entries of the FE mass, ``M_e = sum_q A_eq (dx_q rho_q)`` (scipy's CSR
+                matrix-vector product: each row summed from 0 in its stored order; ``M_ji`` copied
+                from ``M_ij`` where their rows of ``A`` are equal), the cut pieces' points weighted 0, then the sub-pieces' products ``(dx_q rho_q) S_qi S_qj`` summed
+                from 0 into their entries in the order of ``np.bincount`` and added.
+    corrected   the exact mass stage's nodal value ``u*_i + rhs_i / m_i - rhs*_i / m*_i``, each
+                lumped division 0 where its mass is not positive
+                (:func:`~mpm_fem.core.transfer.divide_by_lumped`), added in that order.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from mpm_fem.core import frame_chunks
+
+frame_chunks.install()  # numba's compiler crosses CPython 3.11's frame-chunk starts: reuse the chunks
+
+
+@njit(cache=True)
+def project(nodes, S, G, w, rho, v, sigma, n_nodes, with_mass):
+    """``(m_i, P_i, F_i)`` of the quadrature points (module docstring); ``with_mass=False`` leaves
+    ``m_i`` empty. ``nodes``, ``S``, ``G`` are (n_q, k) rows, the rest (n_q,)."""
+    m_i, P_i, F_i = np.zeros(n_nodes if with_mass else 0), np.zeros(n_nodes), np.zeros(n_nodes)
+    for q in range(nodes.shape[0]):
+        mass = w[q] * rho[q]
+        momentum = mass * v[q]
+        force = w[q] * sigma[q]
+        for k in range(nodes.shape[1]):
+            i = nodes[q, k]
+            if with_mass:
+                m_i[i] += S[q, k] * mass
+            P_i[i] += S[q, k] * momentum
+            F_i[i] += G[q, k] * force
+    return m_i, P_i, -F_i
+
+
+@njit(cache=True, inline="always")
+def locate(nodes, inv_spacing, x):
+    """:func:`mpm_fem.core.shape.locate` of one point inside the grid (``inv_spacing``: ``1 / h`` on a
+    uniform grid, else 0): its cell ``c`` and ``xi = (x - x_c)/(x_{c+1} - x_c)``, bit for bit. The
+    one compiled point location: the fused step (:mod:`mpm_fem.fused.step`) uses it too."""
+    last = nodes.size - 2
+    if inv_spacing > 0.0:
+        c = min(max(int((x - nodes[0]) * inv_spacing), 0), last)
+        if x < nodes[c] or (x >= nodes[c + 1] and c < last):
+            c = min(np.searchsorted(nodes, x, side="right") - 1, last)
+    else:
+        c = min(np.searchsorted(nodes, x, side="right") - 1, last)
+    x0 = nodes[c]
+    return c, (x - x0) / (nodes[c + 1] - x0)
+
+
+@njit(cache=True, inline="always")
+def _bspline(r):
+    """``N(r)``, ``N'(r)`` of :func:`mpm_fem.core.shape._quadratic_bspline` at one ``r``."""
+    a = abs(r)
+    if a <= 0.5:
+        return 0.75 - r * r, -2.0 * r
+    if a < 1.5:
+        u = 1.5 - a
+        return 0.5 * (u * u), -u * np.sign(r)
+    return 0.0, 0.0
+
+
+@njit(cache=True)
+def cut_pieces(edges, bp, xi, wq, nodes, h, inv_spacing, bspline):
+    """The pieces ``edges`` (n_pieces + 1,) that the breakpoints ``bp`` inside them cut, and their
+    sub-pieces (module docstring; :meth:`~mpm_fem.exact_stages.stage.QuadratureRule.cuts_numpy`):
+    ``(cut, first, x, w, rows, S, G, cell)`` with ``first`` each cut piece's first sub-piece and
+    then their number, ``x``, ``w``, ``cell`` (n_sub, n_gauss) and ``rows``, ``S``, ``G`` (n_sub,
+    n_gauss, k), ``k = 4`` for the B-splines (``bspline``) and 2 for the hats."""
+    n = edges.size - 1
+    piece = np.searchsorted(edges, bp, side="right") - 1
+    inside = np.zeros(bp.size, np.bool_)
+    for j in range(bp.size):
+        inside[j] = piece[j] >= 0 and piece[j] < n and bp[j] > edges[min(max(piece[j], 0), n)]
+    cut = np.unique(piece[inside])
+    ends = np.unique(np.concatenate((edges[cut], edges[cut + 1], bp[inside])))
+    owner = np.searchsorted(edges, 0.5 * (ends[:-1] + ends[1:])) - 1
+    keep = np.zeros(owner.size, np.bool_)
+    for j in range(owner.size):
+        c = np.searchsorted(cut, owner[j])
+        keep[j] = c < cut.size and cut[c] == owner[j]
+    left, width = ends[:-1][keep], (ends[1:] - ends[:-1])[keep]
+    first = np.append(np.searchsorted(owner[keep], cut), left.size)
+    g, k = xi.size, 4 if bspline else 2
+    x, w, cell = np.empty((left.size, g)), np.empty((left.size, g)), np.empty((left.size, g), np.intp)
+    rows, S, G = np.empty((left.size, g, k), np.intp), np.empty((left.size, g, k)), np.empty((left.size, g, k))
+    top = nodes.size - 1
+    for p in range(left.size):
+        for q in range(g):
+            x[p, q] = (left[p] + 0.5 * width[p]) + 0.5 * width[p] * xi[q]
+            w[p, q] = 0.5 * width[p] * wq[q]
+            c, t = locate(nodes, inv_spacing, x[p, q])
+            cell[p, q] = c
+            if bspline:
+                for j in range(4):
+                    rows[p, q, j] = min(max(c + j - 1, 0), top)
+                    value, slope = _bspline(t - (j - 1))
+                    S[p, q, j] = value
+                    G[p, q, j] = slope / h[0]
+            else:
+                inv_h = 1.0 / h[c]
+                rows[p, q, 0], rows[p, q, 1] = c, c + 1
+                S[p, q, 0], S[p, q, 1] = 1.0 - t, t
+                G[p, q, 0], G[p, q, 1] = -inv_h, inv_h
+    return cut, first, x, w, rows, S, G, cell
+
+
+@njit(cache=True)
+def _order(n, cut, first):
+    """Where each piece of the spliced rule comes from: ``p >= 0`` the fixed piece ``p``, ``-1 - s``
+    the sub-piece ``s`` (each cut piece ``cut[j]`` replaced by the sub-pieces ``first[j] ...
+    first[j + 1] - 1``)."""
+    order = np.empty(n - cut.size + first[-1], np.int64)
+    o, start = 0, 0
+    for j in range(cut.size + 1):
+        stop = cut[j] if j < cut.size else n
+        for p in range(start, stop):
+            order[o] = p
+            o += 1
+        if j < cut.size:
+            for p in range(first[j], first[j + 1]):
+                order[o] = -1 - p
+                o += 1
+            start = cut[j] + 1
+    return order
+
+
+@njit(cache=True)
+def _spliced(fixed, sub, order):
+    """The pieces of ``fixed`` and ``sub`` (C-contiguous, the trailing axes alike) in ``order``."""
+    out = np.empty((order.size,) + fixed.shape[1:], fixed.dtype)
+    m = fixed[0].size
+    o2, f2, s2 = out.reshape((order.size, m)), fixed.reshape((fixed.shape[0], m)), sub.reshape((sub.shape[0], m))
+    for o in range(order.size):
+        src = order[o]
+        if src >= 0:
+            for c in range(m):
+                o2[o, c] = f2[src, c]
+        else:
+            for c in range(m):
+                o2[o, c] = s2[-1 - src, c]
+    return out
+
+
+@njit(cache=True)
+def splice(x, w, nodes, S, G, cell, sub_x, sub_w, sub_nodes, sub_S, sub_G, sub_cell, cut, first):
+    """The fixed pieces' points ``x``, weights ``w`` (n_pieces, n_gauss), rows ``nodes``, ``S``,
+    ``G`` (n_pieces, n_gauss, k) and ``cell`` with each cut piece replaced by its sub-pieces (the
+    ``sub_`` arrays; :func:`_order`), in order along the domain."""
+    order = _order(x.shape[0], cut, first)
+    return (_spliced(x, sub_x, order), _spliced(w, sub_w, order), _spliced(nodes, sub_nodes, order),
+            _spliced(S, sub_S, order), _spliced(G, sub_G, order), _spliced(cell, sub_cell, order))
+
+
+@njit(cache=True)
+def fe_entries(indptr, indices, data, mirror, dx, rho, cut, keys, n_nodes, sub_nodes, sub_S, sub_w, sub_rho):
+    """The entries of the FE mass (module docstring) and whether a sub-piece product that is not 0
+    falls outside the pattern ``keys`` (``i n_nodes + j`` of each stored entry, increasing).
+
+    ``indptr``, ``indices``, ``data``: the CSR operator ``A`` (entries x points); ``mirror``: an
+    earlier entry whose row of ``A`` is the same, stored and valued (the transposed entry of a
+    symmetric ``M``), whose sum is then copied, else the entry itself; ``dx``, ``rho``:
+    the fixed pieces' (n_pieces, n_gauss) weights and densities; ``cut``: the cut pieces; the sub-
+    pieces' rows ``sub_nodes``, ``sub_S`` (n_sub, k), weights ``sub_w`` and densities ``sub_rho``."""
+    g = dx.shape[1]
+    q = np.empty(dx.size)
+    for p in range(dx.shape[0]):
+        for j in range(g):
+            q[p * g + j] = dx[p, j] * rho[p, j]
+    for c in cut:
+        q[c * g: (c + 1) * g] = 0.0
+    n = indptr.size - 1
+    out = np.zeros(n)
+    for e in range(n):
+        if mirror[e] < e:  # the same products summed in the same order
+            out[e] = out[mirror[e]]
+            continue
+        total = 0.0
+        for jj in range(indptr[e], indptr[e + 1]):
+            total += data[jj] * q[indices[jj]]
+        out[e] = total
+    outside = False
+    if sub_w.size:
+        extra = np.zeros(n)
+        k = sub_nodes.shape[1]
+        for p in range(sub_w.size):
+            mass = sub_w[p] * sub_rho[p]
+            for a in range(k):
+                left = mass * sub_S[p, a]
+                for b in range(k):
+                    wanted = sub_nodes[p, a] * n_nodes + sub_nodes[p, b]
+                    entry = min(np.searchsorted(keys, wanted), keys.size - 1)
+                    product = left * sub_S[p, b]
+                    if keys[entry] != wanted and product != 0.0:
+                        outside = True
+                    extra[entry] += product
+        out = out + extra
+    return out, outside
+
+
+@njit(cache=True)
+def corrected(reference, rhs, m, exact_rhs, exact_m):
+    """``(reference_i + rhs_i / m_i) - exact_rhs_i / exact_m_i`` (module docstring)."""
+    out = np.empty(reference.size)
+    for i in range(reference.size):
+        a = rhs[i] / m[i] if m[i] > 0 else 0.0
+        b = exact_rhs[i] / exact_m[i] if exact_m[i] > 0 else 0.0
+        out[i] = (reference[i] + a) - b
+    return out
