@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
 
-from mpm_fem.exact_stages.stage import stage
+from mpm_fem.exact_stages import stage as exact_stages
 from mpm_fem.exact_stages.stage import RiemannFields, exact_projection, fe_mass, nodal_values, quadrature
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas

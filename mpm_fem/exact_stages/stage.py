@@ -588,7 +588,7 @@ class RiemannFields:
         """``U(xi)``, ``F(xi)`` and ``G(xi) = F - xi U`` for finite ``xi``: the compiled
         :func:`~mpm_fem.exact_stages.kernels.profile`, equal bit for bit to :meth:`_profile_numpy`."""
         xi = np.asarray(xi, dtype=float)
-        U, F, G = exact_kernels.profile(np.ascontiguousarray(xi).ravel(), self._speeds, *self._pieces)
+        U, F, G = kernels.profile(np.ascontiguousarray(xi).ravel(), self._speeds, *self._pieces)
         return U.reshape(xi.shape), F.reshape(xi.shape), G.reshape(xi.shape)
 
     def _profile_numpy(self, xi):
@@ -609,8 +609,8 @@ class RiemannFields:
 
         p_star, u_star, left, right = riemann.waves(self.left, self.right, self.gamma)
         mirrored = (float(self.right[0]), -float(self.right[1]), float(self.right[2]))
-        return (p_star, u_star, exact_kernels.wave_constants(self.left, left, self.gamma),
-                exact_kernels.wave_constants(mirrored, right, self.gamma))
+        return (p_star, u_star, kernels.wave_constants(self.left, left, self.gamma),
+                kernels.wave_constants(mirrored, right, self.gamma))
 
     def _sample(self, x, t):
         """The Riemann solution ``(rho, u, p)`` at ``x`` and ``t``: for ``t > 0`` the compiled
@@ -618,7 +618,7 @@ class RiemannFields:
         from baselines.exact import riemann
 
         if t > 0:
-            return exact_kernels.sample(x, t, self.x0, self.gamma, *self._waves)
+            return kernels.sample(x, t, self.x0, self.gamma, *self._waves)
         return riemann.sample(x, t, self.left, self.right, x0=self.x0, gamma=self.gamma)
 
     def breakpoints(self, t):
@@ -655,7 +655,7 @@ class RiemannFields:
     def _averaged(self, x, t, full):
         """``(v*, v*_x, a*)`` at ``t > 0`` in one compiled pass (:func:`~mpm_fem.exact_stages.kernels.averaged`;
         ``full=False``: ``v*_x`` only), equal bit for bit to :meth:`_averaged_numpy`."""
-        out = exact_kernels.averaged(np.ascontiguousarray(x).ravel(), float(t), float(self.half_width), float(self.x0),
+        out = kernels.averaged(np.ascontiguousarray(x).ravel(), float(t), float(self.half_width), float(self.x0),
                                      full, self._speeds, *self._pieces)
         return tuple(a.reshape(x.shape) if a.size == x.size else a for a in out)
 
