@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 from tqdm.auto import tqdm
 
-from mpm_fem.exact_stages.stage import ExactFields
+from mpm_fem.exact_stages import ExactFields
 from mpm_fem.fused.step import FusedStep, all_finite, check_kernel, supported
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles, PositivityError

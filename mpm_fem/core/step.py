@@ -24,7 +24,7 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from mpm_fem.exact_stages.stage import ExactFields, ExactGridStage, GridData
+from mpm_fem.exact_stages import ExactFields, ExactGridStage, GridData
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force

@@ -100,7 +100,7 @@ from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import Particles, PositivityError
 from mpm_fem.core.reconstruction import OFFSETS, force_quadrature
 from mpm_fem.core.shape import Shape, basis_integrals, make_shape
-from mpm_fem.exact_stages.stage import ExactFields, ExactGridStage, GridData
+from mpm_fem.exact_stages import ExactFields, ExactGridStage, GridData
 from mpm_fem.exact_stages.grid_kernels import locate as _locate
 from mpm_fem.core.step import SCHEMES, Dirichlet, GridState, Stages, Walls
 from mpm_fem.core.transfer import solve_consistent
