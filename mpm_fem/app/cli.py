@@ -219,7 +219,7 @@ def cmd_sod(args) -> dict:
     from mpm_fem.problems import sod
 
     settings, cost, out = _prepare(args, "sod", sod, sod.SodSettings)
-    from mpm_fem import plots  # after the checks: matplotlib takes a while to import
+    from mpm_fem.app import plots  # after the checks: matplotlib takes a while to import
     with _publishing(out, args) as folder:
         result = _simulate(args, sod, settings, folder, sod.uniform_grid(*sod.DOMAIN, settings.h))
         errors = sod.errors(settings, result)
@@ -247,7 +247,7 @@ def cmd_burgers(args) -> dict:
     from mpm_fem.problems import burgers
 
     settings, cost, out = _prepare(args, "burgers", burgers, burgers.BurgersSettings)
-    from mpm_fem import plots  # after the checks: matplotlib takes a while to import
+    from mpm_fem.app import plots  # after the checks: matplotlib takes a while to import
     solution = settings.exact
     with _publishing(out, args) as folder:
         result = _simulate(args, burgers, settings, folder, burgers.uniform_grid(*solution.domain, settings.h))
