@@ -39,10 +39,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.sparse.linalg import splu
 
-from mpm_fem.core.grid import Grid
-
 from baselines import fem_burgers_kernel
 from baselines.galerkin import P1Cells, check_settings, mesh, p1_cells
+from mpm_fem.core.grid import Grid
 
 KERNELS = ("fused", "numpy")  # the compiled loop, the numpy reference (:func:`solve`)
 PROGRESS_EVERY = 1000  # steps per compiled call, and between progress lines
@@ -209,7 +208,8 @@ def _numpy_steps(ops: _Operators, eps: float, dt: float, g: np.ndarray, g_t: np.
 
 
 def _compiled_steps(ops: _Operators, eps: float, dt: float, g: np.ndarray, g_t: np.ndarray):
-    """``take(v, first, count)`` of :func:`_numpy_steps` with the compiled loop (:mod:`baselines.fem_burgers_kernel`)."""
+    """``take(v, first, count)`` of :func:`_numpy_steps` with the compiled loop
+    (:mod:`baselines.fem_burgers_kernel`)."""
     consistent = ops.mass == "consistent"
     if consistent:
         l, w, u = fem_burgers_kernel.tridiagonal_factors(ops.M_II)

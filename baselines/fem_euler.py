@@ -52,10 +52,15 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from baselines.galerkin import (
+    MASS_KINDS,  # noqa: F401 (the choices of ``mass``, for callers)
+    P1Cells,
+    check_mass,
+    check_settings,
+    mesh,
+    p1_cells,
+)
 from mpm_fem.core.grid import Grid
-
-from baselines.galerkin import MASS_KINDS  # noqa: F401 (the choices of ``mass``, for callers)
-from baselines.galerkin import P1Cells, check_mass, check_settings, mesh, p1_cells
 
 SOD_LEFT = (1.0, 0.0, 1.0)
 SOD_RIGHT = (0.125, 0.0, 0.1)

@@ -30,7 +30,6 @@ import numpy as np
 
 from mpm_fem.core.grid import uniform_grid
 
-
 LIMITERS = ("minmod", "mc")
 BOUNDARIES = ("walls", "periodic")
 
@@ -164,5 +163,5 @@ def solve(h: float, T: float = 0.2, cfl: float = 0.8, gamma: float = 1.4, left=(
     uniform grid of size ``h`` on [0, 1], walls at both ends, with the ``limiter`` of
     :data:`LIMITERS` (module docstring)."""
     xc = cell_centres(h)
-    state = [np.where(xc < x0, a, b) for a, b in zip(left, right)]
+    state = [np.where(xc < x0, a, b) for a, b in zip(left, right, strict=False)]
     return evolve(*state, h, T, cfl=cfl, gamma=gamma, limiter=limiter)

@@ -240,7 +240,7 @@ def sample(x, t: float, left, right, x0: float = 0.5, gamma: float = 1.4):
     x = np.asarray(x, dtype=float)
     if t == 0.0:
         is_left = x < x0
-        return tuple(np.where(is_left, ql, qr) for ql, qr in zip(left, right))
+        return tuple(np.where(is_left, ql, qr) for ql, qr in zip(left, right, strict=False))
     s = (x - x0) / t
     vacuum = _vacuum_speeds(left, right, gamma)
     if vacuum is not None:

@@ -22,13 +22,13 @@ from pathlib import Path
 import numpy as np
 
 from mpm_fem.app import guard, output
-from mpm_fem.core.grid import GridError
 from mpm_fem.app.guard import UsageError
+from mpm_fem.app.study import add_study_options, run_study, study_options
+from mpm_fem.core.grid import GridError
 from mpm_fem.core.particles import LAYOUTS
+from mpm_fem.core.reconstruction import RECONSTRUCTIONS
 from mpm_fem.core.shape import BASES
 from mpm_fem.core.step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, SCHEMES, STAGE_MASS
-from mpm_fem.app.study import add_study_options, run_study, study_options
-from mpm_fem.core.reconstruction import RECONSTRUCTIONS
 from mpm_fem.core.volume import VOLUMES
 
 CHOICES = {"mass": STAGE_MASS, "basis": BASES, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
@@ -69,11 +69,12 @@ HELP = {
                "cell needs point mass with USL",
     "force": "internal force: weak (F_i = -sum_p V_p eps (dv/dx)_p G_ip) or slides (their count-normalised second "
              "difference); slides needs point mass with USL",
-    "dt_rule": "time step: stable (CFL min(h/max|v|, h^2/(2 eps))) or advective (CFL h/max|v|, exact acceleration only)",
+    "dt_rule": "time step: stable (CFL min(h/max|v|, h^2/(2 eps))) or advective (CFL h/max|v|, exact "
+               "acceleration only)",
 }
 BURGERS_HELP = {
-    "cfl": "CFL number: dt = CFL min(h/max|v|, h^2/(2 eps)); stable range (0, 1], (0, 1/3] with consistent mass and the "
-           "calculated acceleration",
+    "cfl": "CFL number: dt = CFL min(h/max|v|, h^2/(2 eps)); stable range (0, 1], (0, 1/3] with consistent mass "
+           "and the calculated acceleration",
 }
 HELP.update(REMEDY_HELP)
 
@@ -99,17 +100,16 @@ def _add_settings_options(parser: argparse.ArgumentParser, settings_cls, extra_c
                              "the run writes into a temporary folder beside it and renames it into place when done")
     parser.add_argument("--overwrite", action="store_true", help="replace a non-empty --out whole (refused without it)")
     parser.add_argument("--yes-long", action="store_true",
-                        help=f"run even if estimated over {guard.LONG_RUN_S / 3600:g} h (the estimate is printed at the "
-                             "start of every run and recorded in summary.json)")
+                        help=f"run even if estimated over {guard.LONG_RUN_S / 3600:g} h (the estimate is printed "
+                             "at the start of every run and recorded in summary.json)")
     parser.add_argument("--save-fields", type=int, nargs="?", const=20, default=None, metavar="EVERY",
-                        help="write particle and grid fields every EVERY steps (default 20) and at T as VTU files with a "
-                             ".pvd time series for ParaView, into DIR/fields/")
+                        help="write particle and grid fields every EVERY steps (default 20) and at T as VTU files "
+                             "with a .pvd time series for ParaView, into DIR/fields/")
     parser.add_argument("--quiet", action="store_true", help="no estimate, progress bar or summary line")
 
 
 def build_parser() -> argparse.ArgumentParser:
     from baselines.exact.burgers import SOLUTIONS
-
     from mpm_fem.problems.burgers import DT_RULES, FORCES, WEIGHTS, BurgersSettings
     from mpm_fem.problems.sod import SodSettings
 
@@ -129,7 +129,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     from mpm_fem.app.study import STUDIES
 
-    study = sub.add_parser("study", help="run one study: tables and figures into figures/<name>/ (figures/quick/<name>/ with --quick)",
+    study = sub.add_parser("study", help="run one study: tables and figures into figures/<name>/ "
+                           "(figures/quick/<name>/ with --quick)",
                            description="Run one study of the error analysis; results are cached per case.")
     study.add_argument("name", choices=STUDIES, help="which study")
     add_study_options(study)
@@ -225,11 +226,11 @@ def cmd_sod(args) -> dict:
         errors = sod.errors(settings, result)
         P = result.particles
         rho, u, p = sod.exact(settings, P.x, result.t)
-        columns = {name: getattr(P, name) for name in ("x", "volume", "mass", "velocity", "density", "energy", "pressure")}
+        columns = {name: getattr(P, name) for name in output.PARTICLE_COLUMNS}
         summary = _record(folder, "sod", settings, cost, result, errors, sod.conservation(settings, result),
                           {**columns, "density_exact": rho})
         xe = np.linspace(*sod.DOMAIN, 2001)
-        ex = dict(zip(("density", "velocity", "pressure"), sod.exact(settings, xe, result.t)))
+        ex = dict(zip(("density", "velocity", "pressure"), sod.exact(settings, xe, result.t), strict=False))
         ex["internal energy"] = ex["pressure"] / ((settings.gamma - 1) * ex["density"])
         part = {"density": P.density, "velocity": P.velocity, "pressure": (settings.gamma - 1) * P.density * P.energy,
                 "internal energy": P.energy}
@@ -255,7 +256,8 @@ def cmd_burgers(args) -> dict:
         P = result.particles
         # Unit density, no energy or pressure: the meaningful columns only.
         columns = {"x": P.x, "volume": P.volume, "velocity": P.velocity, "velocity_exact": solution.v(P.x, result.t)}
-        summary = _record(folder, "burgers", settings, cost, result, errors, burgers.conservation(settings, result), columns)
+        conservation = burgers.conservation(settings, result)
+        summary = _record(folder, "burgers", settings, cost, result, errors, conservation, columns)
         xe = np.linspace(*solution.domain, 2001)
         plots.profiles(folder / "profiles.png", xe, {"velocity": solution.v(xe, result.t)}, P.x,
                        {"velocity": P.velocity}, result.grid.nodes, {"velocity": result.nodal_velocity},
@@ -263,7 +265,8 @@ def cmd_burgers(args) -> dict:
                              f"{settings.acceleration} acceleration, t={result.t:.3g}")
     e = errors["velocity"]["particles"]
     line = (f"burgers {settings.solution} eps={settings.eps} h={settings.h} ({settings.acceleration}): velocity "
-            f"L1 {e['L1']:.4g}, L2 {e['L2']:.4g}, max {e['max']:.4g}; {result.steps} steps in {result.wall_s:.2f} s -> {out}")
+            f"L1 {e['L1']:.4g}, L2 {e['L2']:.4g}, max {e['max']:.4g}; {result.steps} steps in "
+            f"{result.wall_s:.2f} s -> {out}")
     return {"summary": summary, "line": line}
 
 

@@ -38,7 +38,8 @@ def grid_mesh(grid: Grid, state: GridState) -> meshio.Mesh:
     """The grid as meshio line cells carrying ``m_i``, ``v_i^{n+1}`` and ``a_i``."""
     cells = np.column_stack((np.arange(grid.n_cells), np.arange(1, grid.n_nodes)))
     return meshio.Mesh(_points(grid.nodes), [("line", cells)],
-                       point_data={"mass": state.mass, "velocity": state.new_velocity, "acceleration": state.acceleration})
+                       point_data={"mass": state.mass, "velocity": state.new_velocity,
+                                   "acceleration": state.acceleration})
 
 
 class FieldWriter:

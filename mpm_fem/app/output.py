@@ -24,6 +24,9 @@ import numpy as np
 
 from mpm_fem.core.particles import Particles
 
+#: the particle fields a run writes, in this column order
+PARTICLE_COLUMNS = ("x", "volume", "mass", "velocity", "density", "energy", "pressure")
+
 _UMASK = os.umask(0)
 os.umask(_UMASK)
 
@@ -152,7 +155,7 @@ def particles_csv(particles: Particles, columns: dict[str, np.ndarray] | None = 
     """Particle columns as CSV text, one row per particle, sorted by position. ``columns`` maps a
     header to an (n_p,) array and must hold ``"x"``; by default the whole particle state."""
     if columns is None:
-        columns = {name: getattr(particles, name) for name in ("x", "volume", "mass", "velocity", "density", "energy", "pressure")}
+        columns = {name: getattr(particles, name) for name in PARTICLE_COLUMNS}
     order = np.argsort(columns["x"], kind="stable")
     buffer = io.StringIO()
     np.savetxt(buffer, np.column_stack([np.asarray(v)[order] for v in columns.values()]), fmt="%.17g", delimiter=",",

@@ -19,13 +19,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-def profiles(path, x_exact, exact: dict, x_particles, particles: dict, x_nodes=None, nodes: dict | None = None, title: str = ""):
+def profiles(path, x_exact, exact: dict, x_particles, particles: dict, x_nodes=None, nodes: dict | None = None,
+             title: str = ""):
     """One panel per field: exact (line), particles (dots), grid nodes (crosses). Saves a PNG; the
     layout is constrained, so the title (lines split by ``\\n``) fits above the panels."""
     names = list(exact)
     fig, axes = plt.subplots(1, len(names), figsize=(max(4.2 * len(names), 6.0), 3.8), squeeze=False,
                              layout="constrained")
-    for ax, name in zip(axes[0], names):
+    for ax, name in zip(axes[0], names, strict=False):
         ax.plot(x_exact, exact[name], "k-", lw=1.2, label="exact")
         if name in particles:
             ax.plot(x_particles, particles[name], ".", ms=2.5, color="tab:blue", label="MPM particles")
@@ -61,11 +62,12 @@ def panels(path, content: dict, xlabel: str, ylabel: str, title: str = "", ncols
     ncols = ncols or len(names)
     nrows = -(-len(names) // ncols)
     fig, axes = plt.subplots(nrows, ncols, figsize=(size[0] * ncols, size[1] * nrows), squeeze=False)
-    for ax, name in zip(axes.ravel(), names):
+    for ax, name in zip(axes.ravel(), names, strict=False):
         xs, top = [], 0.0
         for label, (x, y, fmt, *options) in content[name].items():
             y = np.asarray(y, float)
-            (ax.loglog if log else ax.plot)(x, y, fmt, label=label, **{"ms": 3.5, "lw": 1.1, **(options[0] if options else {})})
+            style = {"ms": 3.5, "lw": 1.1, **(options[0] if options else {})}
+            (ax.loglog if log else ax.plot)(x, y, fmt, label=label, **style)
             xs += list(x)
             top = max(top, np.nanmax(y, initial=0.0))
         if slopes and top > 0:
@@ -88,7 +90,7 @@ def stacked_shares(path, rows: list[dict], names, title: str = "", ylabel: str =
     groups = list(dict.fromkeys(r[group] for r in rows))
     fig, axes = plt.subplots(1, len(groups), figsize=(3.6 * len(groups), 4.0), sharey=True, squeeze=False)
     colors = plt.cm.tab10(np.arange(len(names)))
-    for ax, g in zip(axes[0], groups):
+    for ax, g in zip(axes[0], groups, strict=False):
         bars = [r for r in rows if r[group] == g]
         labels, bottom = [f"{_value(r[bar]):g}" for r in bars], np.zeros(len(bars))
         for k, name in enumerate(names):
@@ -143,10 +145,10 @@ def profile_grid(path, exact: dict, rows: dict, title: str = "") -> None:
     fields = next(iter(exact.values())) if per_row else exact
     fig, axes = plt.subplots(len(rows), len(fields), figsize=(4 * len(fields), 3.2 * len(rows)), sharex=True,
                              squeeze=False)
-    for axes_row, (row_label, series) in zip(axes, rows.items()):
-        for ax, (field, (xe, ye)) in zip(axes_row, (exact[row_label] if per_row else exact).items()):
+    for axes_row, (row_label, series) in zip(axes, rows.items(), strict=False):
+        for ax, (name, (xe, ye)) in zip(axes_row, (exact[row_label] if per_row else exact).items(), strict=False):
             ax.plot(xe, ye, "k-", lw=1.0, label="exact")
-            ax.set_title(field, fontsize=9)
+            ax.set_title(name, fontsize=9)
             for label, x, values, fmt, options in series:
                 if field in values:
                     ax.plot(x, values[field], fmt, label=label, **options)
@@ -214,13 +216,15 @@ def draw(folder, plot: Plot, rows: list[dict]) -> None:
     for c in plot.curves:
         sel = [r for r in rows if _matches(r, c.where)]
         for key in dict.fromkeys(tuple(r.get(k) for k in plot.split + c.group) for r in sel):
-            values = dict(zip(plot.split + c.group, key))
+            values = dict(zip(plot.split + c.group, key, strict=False))
             pts = sorted((_value(r[plot.x]), _value(r.get(c.y))) for r in sel if _matches(r, values))
             pts = [(x, y) for x, y in pts if math.isfinite(x) and math.isfinite(y) and y > 0]
             if pts:
-                panel = ", ".join([c.panel] * bool(c.panel) + [f"{k} = {values[k]}" for k in plot.split]) or plot.caption
+                labels = [c.panel] * bool(c.panel) + [f"{k} = {values[k]}" for k in plot.split]
+                panel = ", ".join(labels) or plot.caption
                 content.setdefault(panel, {})[c.label.format(**values)] = (
-                    [x for x, _ in pts], [y for _, y in pts], c.fmt, {"mfc": "none", **c.options} if c.fmt[0] == "k" else c.options)
+                    [x for x, _ in pts], [y for _, y in pts], c.fmt,
+                    {"mfc": "none", **c.options} if c.fmt[0] == "k" else c.options)
     panels(Path(folder) / plot.file, content, plot.xlabel, plot.ylabel, plot.caption if len(content) > 1 else "",
            slopes=plot.slopes, size=plot.size, legends=len(content) > 1 and not plot.split, ncols=plot.ncols)
     record_caption(Path(folder) / plot.file, plot.caption)

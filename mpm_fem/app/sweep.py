@@ -155,7 +155,8 @@ def run_cases(
 
 def _run_dask(fn, cases, todo, scheduler, finish) -> None:
     try:
-        from dask.distributed import Client, as_completed as dask_completed
+        from dask.distributed import Client
+        from dask.distributed import as_completed as dask_completed
     except ImportError:
         raise RuntimeError("--scheduler needs dask.distributed: pip install 'mpm-fem[dask]'") from None
     try:

@@ -20,7 +20,8 @@ LAYOUTS = ("regular", "jittered", "random")
 class PositivityError(ArithmeticError):
     """A particle lost positivity of density or internal energy."""
 
-    def __init__(self, quantity: str, particle: int, x: float, value: float, step: int | None = None, t: float | None = None):
+    def __init__(self, quantity: str, particle: int, x: float, value: float, step: int | None = None,
+                 t: float | None = None):
         self.quantity, self.particle, self.x, self.value = quantity, particle, x, value
         self.step, self.t = step, t
         super().__init__(self._message())

@@ -24,7 +24,6 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from mpm_fem.exact_stages import ExactFields, ExactGridStage, GridData
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force
@@ -32,6 +31,7 @@ from mpm_fem.core.shape import BASES, make_shape
 from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
 from mpm_fem.core.volume import VOLUMES, grid_volume_factor
 from mpm_fem.core.xpic import boundary_change_rule, check_order, xpic_velocity
+from mpm_fem.exact_stages import ExactFields, ExactGridStage, GridData
 
 SCHEMES = ("usl", "usf", "musl")
 ACCELERATIONS = ("calculated", "exact")
@@ -89,7 +89,8 @@ class Stages(StageSwitches):
             raise ValueError(f"the PIC/FLIP blend must lie in [0, 1] (1: FLIP, 0: PIC), got {self.flip!r}")
         check_order(self.xpic)
         if self.xpic and self.flip != 1:
-            raise ValueError(f"XPIC replaces the PIC/FLIP blend: use xpic {self.xpic} with flip 1, got flip {self.flip!r}")
+            raise ValueError(f"XPIC replaces the PIC/FLIP blend: use xpic {self.xpic} with flip 1, "
+                             f"got flip {self.flip!r}")
         if self.uses_exact_fields and (self.flip != 1 or self.xpic != 0 or self.reconstruct != "none"
                                        or self.volume != "carried"):
             raise ValueError("the remedies flip, xpic, reconstruct and volume run with the MPM stages only "
@@ -209,7 +210,8 @@ def explicit_step(
     h_p = grid.h[shape.cell]
     m, V = particles.mass, particles.volume
     m_i = nodal_mass(shape, m)
-    v_i = boundary.velocity(grid, grid_values(shape, m, m_i, nodal_momentum(shape, m, particles.velocity), stages.mass), t)
+    P_i = nodal_momentum(shape, m, particles.velocity)
+    v_i = boundary.velocity(grid, grid_values(shape, m, m_i, P_i, stages.mass), t)
     if stages.volume == "grid":
         particles = _reset_volume(model, particles, grid_volume_factor(grid, particles.x, V, stages.basis, shape))
         V = particles.volume

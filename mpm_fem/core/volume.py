@@ -13,9 +13,9 @@ so that ``sum_p V_p = sum_i int S_i dx = |domain|`` exactly (every node touched 
 domains that tile the grid, wherever the particles sit, are left unchanged (``V_i = int S_i``,
 ``f_p = 1``): only overlaps and gaps are corrected. ``f_p`` is a smooth, positive factor: it moves
 no discontinuity. (With point weights ``S_i(x_p)`` instead of the domain averages, ``V_i`` would
-carry the projection's own quadrature noise and the reset would feed it into the density.) The masses are untouched (mass is conserved
-exactly) and so are the velocities (momentum too); the model sets the state at the new volume
-(gas: ``rho_p = m_p / V_p`` at the same specific energy, so the total energy is conserved too).
+carry the projection's own quadrature noise and the reset would feed it into the density.) The masses
+are untouched (mass is conserved exactly) and so are the velocities (momentum too); the model sets the
+state at the new volume (gas: ``rho_p = m_p / V_p`` at the same specific energy, so the total energy is conserved too).
 """
 
 from __future__ import annotations

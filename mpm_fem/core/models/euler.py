@@ -89,7 +89,8 @@ class IdealGas:
         check_positive("density", density, particles.x)
         q = particles.pressure - self.thermal_pressure(particles.density, particles.energy)
         return particles.replace(volume=volume, density=density,
-                                 pressure=self.thermal_pressure(density, particles.energy) + q * density / particles.density)
+                                 pressure=self.thermal_pressure(density, particles.energy)
+                                 + q * density / particles.density)
 
     def stable_dt(self, particles: Particles, grid, cfl: float) -> float:
         """``dt = CFL h_min / max_p (c_p + |v_p|)``."""
