@@ -6,10 +6,12 @@ import pytest
 from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
 
 from mpm_fem.exact_stages import stage as exact_stages
-from mpm_fem.exact_stages.stage import RiemannFields, exact_projection, fe_mass, nodal_values, quadrature
+from mpm_fem.exact_stages.stage import exact_projection, fe_mass, nodal_values, quadrature
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.problems import sod
+from mpm_fem.problems.burgers import SmoothBurgersFields
+from mpm_fem.problems.sod import RiemannFields
 from mpm_fem.core.shape import make_shape
 from mpm_fem.core.step import Stages, Walls, explicit_step
 from mpm_fem.core.transfer import particle_mass_matrix
@@ -91,7 +93,7 @@ def test_sod_lumped_mass_sums_to_the_exact_total_mass():
 def test_unit_density_gives_the_textbook_p1_mass_matrix():
     """rho = 1: ``M = h/6 [2 1; 1 2]`` per cell, i.e. 2h/3 and h/6 inside, h/3 at the ends."""
     h = 0.1
-    M, m = fe_mass(uniform_grid(0.0, 1.0, h), "mpm", exact_stages.SmoothBurgersFields(_Flat(), 0.1), 0.0)
+    M, m = fe_mass(uniform_grid(0.0, 1.0, h), "mpm", SmoothBurgersFields(_Flat(), 0.1), 0.0)
     A = M.toarray()
     np.testing.assert_allclose(np.diag(A), [h / 3] + [2 * h / 3] * 9 + [h / 3], rtol=1e-14)
     np.testing.assert_allclose(np.diag(A, 1), h / 6, rtol=1e-14)

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from mpm_fem.exact_stages.stage import (RiemannFields, exact_projection, fe_mass, fe_mass_operator, nodal_sums,
+from mpm_fem.exact_stages.stage import (exact_projection, fe_mass, fe_mass_operator, nodal_sums,
                                   nodal_sums_numpy, quadrature_rule)
+from mpm_fem.problems.sod import RiemannFields
 from mpm_fem.core.grid import uniform_grid
 
 SOD = RiemannFields((1.0, 0.0, 1.0), (0.125, 0.0, 0.1), 0.5, 1.4, 0.01)

@@ -17,7 +17,7 @@ readable reference.
                  the two powers are left to numpy (:func:`sample`): numpy's vectorised ``pow``
                  differs from the C library's in the last bit, and the numpy reference uses it.
     profile      ``U(xi)``, ``F(xi) = int U`` and ``G = F - xi U`` of the piecewise-linear
-                 self-similar velocity (:class:`~mpm_fem.exact_stages.stage.RiemannFields`):
+                 self-similar velocity (:class:`~mpm_fem.problems.sod.RiemannFields`):
 
                      U = U_k + m_k d,   F = F_k + U_k d + m_k d^2 / 2,
                      G = F_k - U_k xi_k + m_k d^2 / 2 - xi m_k d,      d = xi - xi_k,

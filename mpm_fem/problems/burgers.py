@@ -29,7 +29,6 @@ import numpy as np
 from baselines.exact import burgers as exact_burgers
 
 from mpm_fem.core.norms import norms
-from mpm_fem.exact_stages.stage import SmoothBurgersFields
 from mpm_fem.core.grid import Grid, uniform_grid
 from mpm_fem.fused.step import check_kernel
 from mpm_fem.core.models.burgers import FORCES, ViscousBurgers
@@ -146,8 +145,34 @@ def initial_particles(settings: BurgersSettings, grid: Grid) -> Particles:
     return make_particles(x, volume, 1.0, settings.exact.v(x, 0.0))
 
 
+@dataclass(frozen=True)
+class SmoothBurgersFields:
+    """Viscous Burgers ``Dv/Dt = eps v_xx`` from a smooth exact solution, as the exact stages need
+    it (:class:`~mpm_fem.exact_stages.fields.ExactFields`): point values, no breakpoints.
+
+    Unit density; stress ``sigma = eps v_x``; reference ``(v*, v*_x, a*) = (v, v_x, eps v_xx)``.
+    """
+
+    solution: object  # baselines.exact.burgers solution: .fields(x, t) -> (v, v_x, v_xx, v_t)
+    eps: float
+
+    def integrand(self, x, t):
+        v, v_x, _, _ = self.solution.fields(x, t)
+        return np.ones_like(v), v, self.eps * v_x
+
+    def breakpoints(self, t):
+        return np.empty(0)
+
+    def reference(self, x, t):
+        v, v_x, v_xx, _ = self.solution.fields(x, t)
+        return v, v_x, self.eps * v_xx
+
+    def velocity_gradient(self, x, t):
+        return self.solution.fields(x, t)[1]
+
+
 def exact_fields(settings: BurgersSettings) -> SmoothBurgersFields:
-    """The exact fields of the exact stages (:mod:`mpm_fem.exact_stages.stage`): point values."""
+    """The exact fields of the exact stages (:class:`SmoothBurgersFields`): point values."""
     return SmoothBurgersFields(settings.exact, settings.eps)
 
 
