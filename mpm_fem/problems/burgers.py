@@ -27,17 +27,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from baselines.exact import burgers as exact_burgers
-
-from mpm_fem.core.norms import norms
 from mpm_fem.core.grid import Grid, uniform_grid
-from mpm_fem.fused.step import check_kernel
 from mpm_fem.core.models.burgers import FORCES, ViscousBurgers
+from mpm_fem.core.norms import norms
 from mpm_fem.core.particles import Particles, make_particles, seed_positions
 from mpm_fem.core.shape import locate
 from mpm_fem.core.solve import Problem, Result, run
 from mpm_fem.core.step import ACCELERATIONS, Dirichlet
+from mpm_fem.fused.step import check_kernel
 from mpm_fem.problems import Cost, RunSettings, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
-
 
 WEIGHTS = ("volume", "cell")
 DT_RULES = ("stable", "advective")
@@ -228,7 +226,8 @@ def conservation(settings: BurgersSettings, result: Result) -> dict:
 
     def exact_totals(t):
         v = solution.v(x, t)
-        return {"mass": float(x[-1] - x[0]), "momentum": float(np.trapezoid(v, x)), "energy": float(np.trapezoid(0.5 * v * v, x))}
+        return {"mass": float(x[-1] - x[0]), "momentum": float(np.trapezoid(v, x)),
+                "energy": float(np.trapezoid(0.5 * v * v, x))}
 
     exact0, exactT = exact_totals(0.0), exact_totals(result.t)
     expected = {k: exactT[k] - exact0[k] for k in start}

@@ -15,16 +15,24 @@ from functools import cached_property
 import numpy as np
 
 from baselines.exact import riemann
-
-from mpm_fem.core.norms import norms
-from mpm_fem.exact_stages import kernels
-from mpm_fem.fused.step import check_kernel
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.norms import norms
 from mpm_fem.core.particles import make_particles, seed_positions
-from mpm_fem.problems import Cost, RunSettings, check_non_negative, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
 from mpm_fem.core.solve import Problem, Result, run
 from mpm_fem.core.step import Walls
+from mpm_fem.exact_stages import kernels
+from mpm_fem.fused.step import check_kernel
+from mpm_fem.problems import (
+    Cost,
+    RunSettings,
+    check_non_negative,
+    check_run_settings,
+    check_stable_cfl,
+    relative_change,
+    run_cost,
+    totals,
+)
 
 DOMAIN = (0.0, 1.0)
 
