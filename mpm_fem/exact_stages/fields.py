@@ -11,11 +11,12 @@ At one time ``t`` and points ``x`` (any shape; every returned array has the shap
                                                 approximate, ``a* = Dv*/Dt = dv*/dt + v* v*_x``
     velocity_gradient(x, t)  v*_x               the second entry of ``reference`` alone
 
-Invariant: ``integrand`` is piecewise polynomial between the breakpoints up to the quadrature's
-degree (:mod:`mpm_fem.exact_stages.quadrature`), or the exact stages are exact only to the rule's
-error. A smooth solution gives point values as the reference (``v* = v``). Across a shock ``v_x``
-and ``Dv/Dt`` are Dirac masses, so a problem with shocks gives finite averages that equal ``v`` to
-``O(l^2)`` where it is smooth (Sod: :class:`mpm_fem.problems.sod.RiemannFields`).
+The projection and the FE mass are exact to round-off where ``integrand`` is a polynomial between
+the breakpoints of no higher degree than the quadrature integrates exactly
+(:mod:`mpm_fem.exact_stages.quadrature`); a smooth non-polynomial solution (Burgers) leaves the
+rule's own error. A smooth solution gives point values as the reference (``v* = v``). Across a shock
+``v_x`` and ``Dv/Dt`` are Dirac masses, so a problem with shocks gives finite averages that equal
+``v`` to ``O(l^2)`` where it is smooth (Sod: :class:`mpm_fem.problems.sod.RiemannFields`).
 
 The problems implement the protocol beside their set-ups (:mod:`mpm_fem.problems`); this package
 never imports them (the problems import it).

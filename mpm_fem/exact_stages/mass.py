@@ -1,6 +1,6 @@
 """The exact form of the mass stage: the FE mass matrices of the exact density.
 
-    M_ij = int rho S_i S_j dx      (n_nodes, n_nodes), sparse, symmetric,
+    M_ij = int rho S_i S_j dx      (n_nodes, n_nodes), sparse, symmetric to round-off,
     m_i  = sum_j M_ij = int rho S_i dx      (the grid functions sum to 1),
 
 with ``S_i`` the grid functions (P1 hats, or the quadratic B-splines) and ``rho`` the density of the

@@ -1,10 +1,10 @@
 """The exact projection's quadrature: composite Gauss-Legendre on pieces of the grid's domain.
 
 The domain is cut at every node, every cell midpoint (the knots of the quadratic B-splines) and
-every breakpoint of the exact fields inside it (:func:`_pieces`). Each piece ``[a, a + w]`` carries
+every breakpoint of the exact fields inside it (:func:`_pieces`). Each piece ``[a, a + d]`` carries
 ``GAUSS_POINTS`` points and weights
 
-    x_g = (a + w/2) + (w/2) xi_g,      w_g = (w/2) W_g,      (xi_g, W_g): Gauss-Legendre on [-1, 1],
+    x_g = (a + d/2) + (d/2) xi_g,      w_g = (d/2) W_g,      (xi_g, W_g): Gauss-Legendre on [-1, 1],
 
 exact for polynomials of degree ``2 GAUSS_POINTS - 1`` on a piece: to round-off for the integrands
 of piecewise-polynomial fields. :func:`quadrature` gives the points and weights flat,
@@ -31,7 +31,6 @@ from mpm_fem.core.shape import Shape, make_shape
 
 GAUSS_POINTS = 5  # exact for polynomials of degree 9 (Sod's fan: rho u S_i has degree 7)
 _XI, _W = np.polynomial.legendre.leggauss(GAUSS_POINTS)
-
 
 
 def _pieces(grid: Grid, breakpoints=()) -> np.ndarray:

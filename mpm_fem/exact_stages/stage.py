@@ -58,7 +58,7 @@ class ExactGridStage:
 
     Built at the start of a step it holds the exact nodal data and ``v_i``:
 
-        projection exact   the quadrature data ``quad`` replace the particles'
+        projection exact   the quadrature's data ``quad`` in place of the particles'
                            (:func:`~mpm_fem.exact_stages.projection.exact_projection`)
         mass exact         v_i = v*_i + [solve(MPM data) - solve(exact data)] (``solve``: the lumped
                            division; exact data with the FE mass when the projection is MPM)

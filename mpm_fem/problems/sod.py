@@ -94,8 +94,8 @@ class RiemannFields:
     with ``v*`` crosses a shock with the Rankine-Hugoniot density ratio, since
     ``int v*_x dt = int_{u_1}^{u_2} du/(s - u) = log((s - u_1)/(s - u_2))``.
 
-    In closed form: the solution is self-similar, ``u(x, t) = U(xi)`` with ``xi = (x - x0)/t``, and ``U`` is
-    piecewise linear between the wave speeds (constant states, linear fans). With
+    In closed form: the solution is self-similar, ``u(x, t) = U(xi)`` with ``xi = (x - x0)/t``, and
+    ``U`` is piecewise linear between the wave speeds (constant states, linear fans). With
     ``F(xi) = int U``, ``alpha = (x - l - x0)/t`` and ``beta = (x + l - x0)/t``:
 
         v*   = t (F(beta) - F(alpha)) / (2l),      v*_x = (U(beta) - U(alpha)) / (2l),
