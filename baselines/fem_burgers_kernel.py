@@ -1,9 +1,8 @@
 """The compiled time loop of the Burgers FEM baseline (:mod:`baselines.fem_burgers`), numba.
 
-:func:`baselines.fem_burgers.solve` takes hundreds of thousands of SSP-RK3 steps on the finest
-meshes (the viscous limit ``dt <= cfl_visc h^2 / (2 eps)``), and in numpy each stage is a dozen
-array calls on a few thousand nodes: call overhead, not arithmetic. :func:`steps` takes a block of
-steps in one compiled call with the numpy step's operations in the same order:
+:func:`steps` takes a block of the SSP-RK3 steps of :func:`baselines.fem_burgers.solve` in one
+compiled call, with the numpy step's operations in the same order (why compiled:
+``docs/perf-exact.md``):
 
     R_i      = sum over the cells with a = i of  -(v_b - v_a)(2 v_a + v_b)/6 + eps (v_b - v_a)/h_e
              + sum over the cells with b = i of  -(v_b - v_a)(v_a + 2 v_b)/6 - eps (v_b - v_a)/h_e
@@ -24,10 +23,6 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from mpm_fem.core import frame_chunks
-
-frame_chunks.install()  # numba's compiler crosses CPython 3.11's frame-chunk starts: reuse the chunks
-
 
 def tridiagonal_factors(M_II: sp.spmatrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(l, w, u)``: the LU factors of a tridiagonal ``M_II`` without pivoting (it is symmetric
@@ -47,7 +42,8 @@ def tridiagonal_factors(M_II: sp.spmatrix) -> tuple[np.ndarray, np.ndarray, np.n
 
 @njit(cache=True)
 def _factor(d, lower, upper):
-    """The recursion of :func:`tridiagonal_factors`: ``l_i = lower_{i-1} / w_{i-1}``, ``w_i = d_i - l_i upper_{i-1}``."""
+    """The recursion of :func:`tridiagonal_factors`: ``l_i = lower_{i-1} / w_{i-1}``,
+    ``w_i = d_i - l_i upper_{i-1}``."""
     w, l = d.copy(), np.zeros(d.size)
     for i in range(1, d.size):
         l[i] = lower[i - 1] / w[i - 1]
@@ -93,8 +89,9 @@ def _derivative(v, k, g_t, a, b, h, eps, interior, boundary, lumped, consistent,
 
 @njit(cache=True)
 def steps(v, first, count, dt, g, g_t, a, b, h, eps, interior, boundary, lumped, consistent, l, w, u, M_IB):
-    """(``l, w, u``: :func:`tridiagonal_factors`, ``w`` inverted.) Steps ``first ... first + count - 1`` of SSP-RK3 on ``v`` (in place). Returns ``(-1, -1)``,
-    or the step (counted from 1) and the first node at which ``v`` stopped being finite."""
+    """Steps ``first ... first + count - 1`` of SSP-RK3 on ``v`` (in place; ``l, w, u``:
+    :func:`tridiagonal_factors`, ``w`` inverted). Returns ``(-1, -1)``, or the step (counted from
+    1) and the first node at which ``v`` stopped being finite."""
     n_nodes = v.size
     R1, R2 = np.empty(n_nodes), np.empty(n_nodes)
     L, v1, v2 = np.empty(n_nodes), np.empty(n_nodes), np.empty(n_nodes)

@@ -8,7 +8,9 @@ import pytest
 
 from baselines.exact import riemann
 from mpm_fem.measure.decomposition import decompose, label
-from mpm_fem.exact_stages.stage import RiemannFields, exact_projection, quadrature
+from mpm_fem.exact_stages.projection import exact_projection
+from mpm_fem.exact_stages.quadrature import quadrature
+from mpm_fem.problems.sod import RiemannFields
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.problems import burgers, sod

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from baselines.exact import riemann
-from mpm_fem.exact_stages.stage import RiemannFields, quadrature, quadrature_rule
+from mpm_fem.exact_stages.quadrature import quadrature, quadrature_rule
+from mpm_fem.problems.sod import RiemannFields
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.shape import make_shape
 

@@ -1,15 +1,20 @@
-"""The FE + mass lumping stage's mass matrices, assembled by scikit-fem (mpm_fem.exact_stages.stage.fe_mass),
+"""The FE + mass lumping stage's mass matrices, assembled by scikit-fem (mpm_fem.exact_stages.mass.fe_mass),
 against the particle mass matrix on Gauss points, an exact matrix, and where the step uses them."""
 
 import numpy as np
 import pytest
 from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
 
-from mpm_fem.exact_stages import stage as exact_stages
-from mpm_fem.exact_stages.stage import RiemannFields, exact_projection, fe_mass, nodal_values, quadrature
+from mpm_fem.exact_stages import projection
+from mpm_fem.exact_stages.grid_data import nodal_values
+from mpm_fem.exact_stages.mass import fe_mass, fe_mass_operator
+from mpm_fem.exact_stages.projection import exact_projection
+from mpm_fem.exact_stages.quadrature import _pieces, quadrature
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.problems import sod
+from mpm_fem.problems.burgers import SmoothBurgersFields
+from mpm_fem.problems.sod import RiemannFields
 from mpm_fem.core.shape import make_shape
 from mpm_fem.core.step import Stages, Walls, explicit_step
 from mpm_fem.core.transfer import particle_mass_matrix
@@ -40,7 +45,7 @@ def rebuilt_fe_mass(grid, basis, fields, t):
     nodes, half cells and breakpoints, the form ``rho u v``, and ``M = E^T M_pieces E`` with
     ``E_ki = S_i(y_k)`` at the degrees of freedom (the grid functions are polynomials on a piece)."""
     kernel = "bspline" if basis.startswith("bspline") else "mpm"
-    edges = exact_stages._pieces(grid, fields.breakpoints(t))
+    edges = _pieces(grid, fields.breakpoints(t))
     pieces = Basis(MeshLine(edges), ElementLineP2() if kernel == "bspline" else ElementLineP1(), intorder=9)
     rho = fields.integrand(np.asarray(pieces.global_coordinates()[0]).ravel(), t)[0].reshape(pieces.nelems, -1)
     y = pieces.doflocs[0]
@@ -60,8 +65,8 @@ def test_the_operator_built_once_equals_scikit_fem_assembling_from_scratch(basis
         want = rebuilt_fe_mass(grid, basis, fields, time)
         gap = np.abs((M - want).toarray()).max()
         assert gap < 1e-14 * np.abs(want.toarray()).max(), f"t = {time}: largest difference {gap:.2e}"
-    assert exact_stages.fe_mass_operator(grid, "bspline" if basis.startswith("bspline") else "mpm") is \
-        exact_stages.fe_mass_operator(grid, "bspline" if basis.startswith("bspline") else "mpm")  # built once
+    assert fe_mass_operator(grid, "bspline" if basis.startswith("bspline") else "mpm") is \
+        fe_mass_operator(grid, "bspline" if basis.startswith("bspline") else "mpm")  # built once
 
 
 @pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline", "bspline_gimp"])
@@ -91,7 +96,7 @@ def test_sod_lumped_mass_sums_to_the_exact_total_mass():
 def test_unit_density_gives_the_textbook_p1_mass_matrix():
     """rho = 1: ``M = h/6 [2 1; 1 2]`` per cell, i.e. 2h/3 and h/6 inside, h/3 at the ends."""
     h = 0.1
-    M, m = fe_mass(uniform_grid(0.0, 1.0, h), "mpm", exact_stages.SmoothBurgersFields(_Flat(), 0.1), 0.0)
+    M, m = fe_mass(uniform_grid(0.0, 1.0, h), "mpm", SmoothBurgersFields(_Flat(), 0.1), 0.0)
     A = M.toarray()
     np.testing.assert_allclose(np.diag(A), [h / 3] + [2 * h / 3] * 9 + [h / 3], rtol=1e-14)
     np.testing.assert_allclose(np.diag(A, 1), h / 6, rtol=1e-14)
@@ -119,13 +124,13 @@ def test_only_the_exact_mass_stage_assembles_with_scikit_fem(monkeypatch):
     :func:`fe_mass`; the FE + mass lumping stage does, once a step, and its nodal values differ
     from those with the Gauss-point sums by round-off only."""
     calls = []
-    real = exact_stages.fe_mass
+    real = projection.fe_mass
 
     def spy(*args, **kwargs):
         calls.append(args[1])
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(exact_stages, "fe_mass", spy)
+    monkeypatch.setattr(projection, "fe_mass", spy)
     for stages in (Stages(), Stages(mass="consistent"), Stages(projection="exact"),
                    Stages(projection="exact", mass="consistent"), Stages(projection="exact", mass="exact")):
         _sod_step(stages)
@@ -138,7 +143,7 @@ def test_only_the_exact_mass_stage_assembles_with_scikit_fem(monkeypatch):
         M = particle_mass_matrix(make_shape(grid, x, w, "mpm"), w * fields.integrand(x, t)[0])
         return M, np.asarray(M.sum(axis=1)).ravel()
 
-    monkeypatch.setattr(exact_stages, "fe_mass", gauss_sums)
+    monkeypatch.setattr(projection, "fe_mass", gauss_sums)
     _, with_sums = _sod_step(Stages(mass="exact"))
     for name in ("velocity", "acceleration"):
         a, b = getattr(with_fe, name), getattr(with_sums, name)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from mpm_fem.core import solve
-from mpm_fem.exact_stages.stage import RiemannFields
+from mpm_fem.problems.sod import RiemannFields
 from mpm_fem.fused.step import FusedStep, supported
 from mpm_fem.core.grid import grid_from_nodes, uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers

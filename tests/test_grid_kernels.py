@@ -3,8 +3,10 @@
 import numpy as np
 import pytest
 
-from mpm_fem.exact_stages.stage import (RiemannFields, exact_projection, fe_mass, fe_mass_operator, nodal_sums,
-                                  nodal_sums_numpy, quadrature_rule)
+from mpm_fem.exact_stages.mass import fe_mass, fe_mass_operator
+from mpm_fem.exact_stages.projection import exact_projection, nodal_sums, nodal_sums_numpy
+from mpm_fem.exact_stages.quadrature import quadrature_rule
+from mpm_fem.problems.sod import RiemannFields
 from mpm_fem.core.grid import uniform_grid
 
 SOD = RiemannFields((1.0, 0.0, 1.0), (0.125, 0.0, 0.1), 0.5, 1.4, 0.01)
@@ -106,7 +108,7 @@ def test_the_fe_mass_sums_a_symmetric_entry_once(functions):
 @pytest.mark.parametrize("basis", ["mpm", "bspline"])
 def test_the_exact_mass_stage_solve_equals_numpy_bit_for_bit(basis):
     """``v*_i + P_i / m_i - P*_i / m*_i`` compiled, against :func:`nodal_values` (a node without mass included)."""
-    from mpm_fem.exact_stages.stage import ExactGridStage, GridData
+    from mpm_fem.exact_stages import ExactGridStage, GridData
     from mpm_fem.core.step import Stages, Walls
 
     grid = uniform_grid(0.0, 1.0, 0.01)

@@ -8,7 +8,7 @@ Notation (slides, "MPM Basis Overview"): nodes ``x_i``, cells ``I_i = [x_{i-1}, 
 assembled with a scikit-fem ``BilinearForm``; the lumped mass is its row sum ``diag(M 1)``. The
 fixed-mesh baselines solve with these; the MPM step solves with the particle mass
 (:mod:`mpm_fem.core.transfer`), and its exact FE + mass lumping stage with the same form weighted by
-the exact density (:func:`mpm_fem.exact_stages.stage.fe_mass`).
+the exact density (:func:`mpm_fem.exact_stages.mass.fe_mass`).
 """
 
 from __future__ import annotations

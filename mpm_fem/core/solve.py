@@ -37,7 +37,7 @@ class Problem:
 
     ``particle_boundary(particles, grid, t) -> particles`` removes particles that left the grid
     and adds inflow particles (Burgers); ``exact_acceleration(x_i, t)`` serves the exact stage;
-    ``exact`` (:class:`~mpm_fem.exact_stages.stage.ExactFields`) serves the exact projection, mass and
+    ``exact`` (:class:`~mpm_fem.exact_stages.fields.ExactFields`) serves the exact projection, mass and
     interpolation stages; ``dt``, if given, is a fixed time step instead of the CFL step.
     """
 

@@ -12,7 +12,7 @@ The particle state (density, energy, pressure) is updated from the velocity grad
     MUSL (modified USL): as USL, with v_i^{n+1} re-projected from the updated particle velocities.
 
 Each stage of the step has a switch (:class:`Stages`); the exact forms used by the error budget
-are supplied by the problem (``exact_acceleration``, and :class:`~mpm_fem.exact_stages.stage.
+are supplied by the problem (``exact_acceleration``, and :class:`~mpm_fem.exact_stages.fields.
 ExactFields` for the projection, mass and interpolation switches; their equations are in
 :mod:`mpm_fem.exact_stages.stage`). The default stages run the plain MPM step below, untouched.
 """
@@ -105,7 +105,7 @@ class Stages(StageSwitches):
 
     @property
     def uses_exact_fields(self) -> bool:
-        """Whether a stage needs the problem's :class:`~mpm_fem.exact_stages.stage.ExactFields`."""
+        """Whether a stage needs the problem's :class:`~mpm_fem.exact_stages.fields.ExactFields`."""
         return self.projection == "exact" or self.interpolation == "exact" or self.mass == "exact"
 
 

@@ -1,11 +1,10 @@
 """Compiled sums of the exact grid stage (numba): the quadrature's nodal sums and the FE mass.
 
-The exact grid stage (:class:`~mpm_fem.exact_stages.stage.ExactGridStage`) runs every step on a few
-thousand Gauss points and a few hundred nodes; in numpy its cost is mostly the overhead of many
-small array calls. The kernels below make the same sums with the same floating-point operations in
-the same order, so they equal the numpy ones bit for bit (tested: ``tests/test_grid_kernels.py``);
-the numpy forms (:mod:`mpm_fem.core.transfer`, :meth:`~mpm_fem.exact_stages.stage.FEMass.entries_numpy`) stay
-the readable reference.
+The kernels of the exact grid stage (:class:`~mpm_fem.exact_stages.stage.ExactGridStage`) make the
+same sums as its numpy forms with the same floating-point operations in the same order, so they
+equal them bit for bit (tested: ``tests/test_grid_kernels.py``); the numpy forms
+(:mod:`mpm_fem.core.transfer`, :meth:`~mpm_fem.exact_stages.mass.FEMass.entries_numpy`) stay the
+readable reference. Why compiled: ``docs/perf-exact.md``.
 
     project     m_i = sum_q (w_q rho_q) S_qi,   P_i = sum_q ((w_q rho_q) v_q) S_qi,
                 F_i = - sum_q (w_q sigma_q) G_qi,
@@ -13,16 +12,17 @@ the readable reference.
                 adds its weights (one after the other, from 0).
     cut_pieces  the pieces (nodes and half cells) that breakpoints cut, their sub-pieces' Gauss
                 points ``x = (a + w/2) + (w/2) xi_g`` and weights ``(w/2) w_g`` and the rows of the
-                grid functions there (:meth:`~mpm_fem.exact_stages.stage.QuadratureRule.cuts`): P1 hats
+                grid functions there (:meth:`~mpm_fem.exact_stages.quadrature.QuadratureRule.cuts`): P1 hats
                 ``S = (1 - xi, xi)``, ``G = (-1, 1)/h_c`` or quadratic B-splines (:func:`mpm_fem.core.shape.
                 point_shape`, :func:`~mpm_fem.core.shape.bspline_shape`, their point location
                 :func:`~mpm_fem.core.shape.locate` included).
     splice      the rows of the fixed pieces with each cut piece replaced by its sub-pieces
-                (:meth:`~mpm_fem.exact_stages.stage.QuadratureRule.splice`): copies only.
+                (:meth:`~mpm_fem.exact_stages.quadrature.QuadratureRule.splice`): copies only.
     fe_entries  the entries of the FE mass, ``M_e = sum_q A_eq (dx_q rho_q)`` (scipy's CSR
                 matrix-vector product: each row summed from 0 in its stored order; ``M_ji`` copied
-                from ``M_ij`` where their rows of ``A`` are equal), the cut pieces' points weighted 0, then the sub-pieces' products ``(dx_q rho_q) S_qi S_qj`` summed
-                from 0 into their entries in the order of ``np.bincount`` and added.
+                from ``M_ij`` where their rows of ``A`` are equal), the cut pieces' points weighted
+                0, then the sub-pieces' products ``(dx_q rho_q) S_qi S_qj`` summed from 0 into
+                their entries in the order of ``np.bincount`` and added.
     corrected   the exact mass stage's nodal value ``u*_i + rhs_i / m_i - rhs*_i / m*_i``, each
                 lumped division 0 where its mass is not positive
                 (:func:`~mpm_fem.core.transfer.divide_by_lumped`), added in that order.
@@ -32,10 +32,6 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-
-from mpm_fem.core import frame_chunks
-
-frame_chunks.install()  # numba's compiler crosses CPython 3.11's frame-chunk starts: reuse the chunks
 
 
 @njit(cache=True)
@@ -87,7 +83,7 @@ def _bspline(r):
 @njit(cache=True)
 def cut_pieces(edges, bp, xi, wq, nodes, h, inv_spacing, bspline):
     """The pieces ``edges`` (n_pieces + 1,) that the breakpoints ``bp`` inside them cut, and their
-    sub-pieces (module docstring; :meth:`~mpm_fem.exact_stages.stage.QuadratureRule.cuts_numpy`):
+    sub-pieces (module docstring; :meth:`~mpm_fem.exact_stages.quadrature.QuadratureRule.cuts_numpy`):
     ``(cut, first, x, w, rows, S, G, cell)`` with ``first`` each cut piece's first sub-piece and
     then their number, ``x``, ``w``, ``cell`` (n_sub, n_gauss) and ``rows``, ``S``, ``G`` (n_sub,
     n_gauss, k), ``k = 4`` for the B-splines (``bspline``) and 2 for the hats."""

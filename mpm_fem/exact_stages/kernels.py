@@ -1,11 +1,11 @@
 """Compiled point evaluations of Sod's exact fields for the exact stages (numba).
 
-The exact stages (:mod:`mpm_fem.exact_stages.stage`) evaluate the Riemann solution every step on the
-projection's Gauss points and on the particles; in numpy each evaluation is a few dozen array
-passes (``np.select`` over the wave regions, fancy indexing per piece). The kernels below make one
-pass per point with the same floating-point operations in the same order, so they equal the numpy
-evaluations bit for bit (tested: ``tests/test_exact_kernels.py``); the numpy versions stay the
-readable reference.
+:class:`~mpm_fem.problems.sod.RiemannFields` evaluates the Riemann solution for the exact stages
+(:mod:`mpm_fem.exact_stages.stage`) on the projection's Gauss points and on the particles through
+these kernels. Each makes one pass over the points with the same floating-point operations in the
+same order as the numpy evaluation it replaces, so the two are equal bit for bit (tested:
+``tests/test_exact_kernels.py``); the numpy versions stay the readable reference. Why compiled:
+``docs/perf-exact.md``.
 
     sample       Toro's sampling (section 4.5) at ``S = (x - x0)/t``: left of the contact the
                  left wave, right of it the mirror image of a left wave (``S -> -S``, ``u -> -u``).
@@ -17,7 +17,7 @@ readable reference.
                  the two powers are left to numpy (:func:`sample`): numpy's vectorised ``pow``
                  differs from the C library's in the last bit, and the numpy reference uses it.
     profile      ``U(xi)``, ``F(xi) = int U`` and ``G = F - xi U`` of the piecewise-linear
-                 self-similar velocity (:class:`~mpm_fem.exact_stages.stage.RiemannFields`):
+                 self-similar velocity (:class:`~mpm_fem.problems.sod.RiemannFields`):
 
                      U = U_k + m_k d,   F = F_k + U_k d + m_k d^2 / 2,
                      G = F_k - U_k xi_k + m_k d^2 / 2 - xi m_k d,      d = xi - xi_k,
@@ -34,10 +34,6 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-
-from mpm_fem.core import frame_chunks
-
-frame_chunks.install()  # numba's compiler crosses CPython 3.11's frame-chunk starts: reuse the chunks
 
 # the layout of a wave's constants (:func:`wave_constants`)
 RHO, U, P, A, SHOCK, SPEED, HEAD, TAIL, RHO_STAR = range(9)

@@ -27,18 +27,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from baselines.exact import burgers as exact_burgers
-
-from mpm_fem.core.norms import norms
-from mpm_fem.exact_stages.stage import SmoothBurgersFields
 from mpm_fem.core.grid import Grid, uniform_grid
-from mpm_fem.fused.step import check_kernel
 from mpm_fem.core.models.burgers import FORCES, ViscousBurgers
+from mpm_fem.core.norms import norms
 from mpm_fem.core.particles import Particles, make_particles, seed_positions
 from mpm_fem.core.shape import locate
 from mpm_fem.core.solve import Problem, Result, run
 from mpm_fem.core.step import ACCELERATIONS, Dirichlet
+from mpm_fem.fused.step import check_kernel
 from mpm_fem.problems import Cost, RunSettings, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
-
 
 WEIGHTS = ("volume", "cell")
 DT_RULES = ("stable", "advective")
@@ -146,8 +143,34 @@ def initial_particles(settings: BurgersSettings, grid: Grid) -> Particles:
     return make_particles(x, volume, 1.0, settings.exact.v(x, 0.0))
 
 
+@dataclass(frozen=True)
+class SmoothBurgersFields:
+    """Viscous Burgers ``Dv/Dt = eps v_xx`` from a smooth exact solution, as the exact stages need
+    it (:class:`~mpm_fem.exact_stages.fields.ExactFields`): point values, no breakpoints.
+
+    Unit density; stress ``sigma = eps v_x``; reference ``(v*, v*_x, a*) = (v, v_x, eps v_xx)``.
+    """
+
+    solution: object  # baselines.exact.burgers solution: .fields(x, t) -> (v, v_x, v_xx, v_t)
+    eps: float
+
+    def integrand(self, x, t):
+        v, v_x, _, _ = self.solution.fields(x, t)
+        return np.ones_like(v), v, self.eps * v_x
+
+    def breakpoints(self, t):
+        return np.empty(0)
+
+    def reference(self, x, t):
+        v, v_x, v_xx, _ = self.solution.fields(x, t)
+        return v, v_x, self.eps * v_xx
+
+    def velocity_gradient(self, x, t):
+        return self.solution.fields(x, t)[1]
+
+
 def exact_fields(settings: BurgersSettings) -> SmoothBurgersFields:
-    """The exact fields of the exact stages (:mod:`mpm_fem.exact_stages.stage`): point values."""
+    """The exact fields of the exact stages (:class:`SmoothBurgersFields`): point values."""
     return SmoothBurgersFields(settings.exact, settings.eps)
 
 
@@ -203,7 +226,8 @@ def conservation(settings: BurgersSettings, result: Result) -> dict:
 
     def exact_totals(t):
         v = solution.v(x, t)
-        return {"mass": float(x[-1] - x[0]), "momentum": float(np.trapezoid(v, x)), "energy": float(np.trapezoid(0.5 * v * v, x))}
+        return {"mass": float(x[-1] - x[0]), "momentum": float(np.trapezoid(v, x)),
+                "energy": float(np.trapezoid(0.5 * v * v, x))}
 
     exact0, exactT = exact_totals(0.0), exact_totals(result.t)
     expected = {k: exactT[k] - exact0[k] for k in start}

@@ -10,20 +10,29 @@ T = 0.2, walls at both ends. Errors are measured against the exact Riemann solut
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from baselines.exact import riemann
-
-from mpm_fem.core.norms import norms
-from mpm_fem.exact_stages.stage import RiemannFields
-from mpm_fem.fused.step import check_kernel
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.norms import norms
 from mpm_fem.core.particles import make_particles, seed_positions
-from mpm_fem.problems import Cost, RunSettings, check_non_negative, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
 from mpm_fem.core.solve import Problem, Result, run
 from mpm_fem.core.step import Walls
+from mpm_fem.exact_stages import kernels
+from mpm_fem.fused.step import check_kernel
+from mpm_fem.problems import (
+    Cost,
+    RunSettings,
+    check_non_negative,
+    check_run_settings,
+    check_stable_cfl,
+    relative_change,
+    run_cost,
+    totals,
+)
 
 DOMAIN = (0.0, 1.0)
 
@@ -72,8 +81,154 @@ def exact(settings: SodSettings, x: np.ndarray, t: float):
     return riemann.sample(x, t, settings.left, settings.right, x0=settings.x0, gamma=settings.gamma)
 
 
+@dataclass(frozen=True)
+class RiemannFields:
+    """Sod's tube (any Riemann problem without vacuum) as the exact stages need it
+    (:class:`~mpm_fem.exact_stages.fields.ExactFields`): the exact ``(rho, u, -p)`` for the
+    projection, and reference fields averaged over a particle domain ``[x - l, x + l]`` (the GIMP
+    ``chi_p``, ``l = half_width``), since across a shock ``v*_x`` and ``a*`` are Dirac masses:
+
+        v*(x) = 1/(2l) int_{x-l}^{x+l} u dy,   v*_x = (u(x+l) - u(x-l)) / (2l),   a* = dv*/dt + v* v*_x,
+
+    which is ``u + O(l^2)`` where ``u`` is smooth, finite at a shock, and consistent: a point moving
+    with ``v*`` crosses a shock with the Rankine-Hugoniot density ratio, since
+    ``int v*_x dt = int_{u_1}^{u_2} du/(s - u) = log((s - u_1)/(s - u_2))``.
+
+    In closed form: the solution is self-similar, ``u(x, t) = U(xi)`` with ``xi = (x - x0)/t``, and
+    ``U`` is piecewise linear between the wave speeds (constant states, linear fans). With
+    ``F(xi) = int U``, ``alpha = (x - l - x0)/t`` and ``beta = (x + l - x0)/t``:
+
+        v*   = t (F(beta) - F(alpha)) / (2l),      v*_x = (U(beta) - U(alpha)) / (2l),
+        dv*/dt = (G(beta) - G(alpha)) / (2l),      G = F - xi U,
+
+    the last from differentiating ``t (F(beta) - F(alpha))`` in ``t``. At ``t = 0`` the limits.
+    """
+
+    left: tuple
+    right: tuple
+    x0: float
+    gamma: float
+    half_width: float
+
+    def __post_init__(self):
+        if not self.half_width > 0:
+            raise ValueError(f"the averaging half-width must be positive, got {self.half_width}")
+
+    @cached_property
+    def _speeds(self) -> np.ndarray:
+        """Sorted speeds of the wave fronts (fan heads and tails, contact, shocks)."""
+        waves = riemann.wave_positions(1.0, self.left, self.right, self.x0, self.gamma)
+        fronts = [v for k, v in waves.items() if k.startswith(("left_", "right_")) or k == "contact"]
+        return np.sort(np.array(fronts) - self.x0)
+
+    @cached_property
+    def _pieces(self) -> tuple[np.ndarray, ...]:
+        """Per piece ``k`` of ``U`` (0: left of the first speed, ...): anchor ``xi_k``, ``F(xi_k)``,
+        ``U(xi_k^+)`` and slope ``m_k``, so that ``U = U_k + m_k (xi - xi_k)`` on the piece."""
+        knots = self._speeds
+        anchor = np.concatenate(([knots[0]], knots))
+        end = np.concatenate((knots, [knots[-1] + 1.0]))
+        width = end - anchor
+        probe = np.where(width > 0, width, 1.0)
+        a, b = anchor + 0.25 * probe, anchor + 0.75 * probe
+        a[0], b[0] = knots[0] - 1.0, knots[0] - 0.5  # the outer states: constant
+        _, ua, _ = self._sample(self.x0 + a, 1.0)
+        _, ub, _ = self._sample(self.x0 + b, 1.0)
+        slope = np.where(width > 0, (ub - ua) / (b - a), 0.0)
+        slope[0] = slope[-1] = 0.0
+        value = ua - slope * (a - anchor)
+        value[0] = ua[0]
+        F = np.zeros_like(anchor)
+        inner = np.diff(knots)
+        for k in range(2, anchor.size):  # a handful of wave fronts, not particles
+            w = inner[k - 2]
+            F[k] = F[k - 1] + value[k - 1] * w + 0.5 * slope[k - 1] * w * w
+        return anchor, F, value, slope
+
+    def _profile(self, xi):
+        """``U(xi)``, ``F(xi)`` and ``G(xi) = F - xi U`` for finite ``xi``: the compiled
+        :func:`~mpm_fem.exact_stages.kernels.profile`, equal bit for bit to :meth:`_profile_numpy`."""
+        xi = np.asarray(xi, dtype=float)
+        U, F, G = kernels.profile(np.ascontiguousarray(xi).ravel(), self._speeds, *self._pieces)
+        return U.reshape(xi.shape), F.reshape(xi.shape), G.reshape(xi.shape)
+
+    def _profile_numpy(self, xi):
+        """The readable reference of :meth:`_profile`: ``U = U_k + m_k d``, ``F = F_k + U_k d + m_k
+        d^2 / 2``, ``G = F - xi U`` with ``d = xi - xi_k``, ``k`` the piece holding ``xi``."""
+        anchor, F0, U0, m = self._pieces
+        k = np.searchsorted(self._speeds, xi, side="right")
+        d = xi - anchor[k]
+        U = U0[k] + m[k] * d
+        F = F0[k] + U0[k] * d + 0.5 * m[k] * d * d
+        G = F0[k] - U0[k] * anchor[k] + 0.5 * m[k] * d * d - xi * m[k] * d
+        return U, F, G
+
+    @cached_property
+    def _waves(self) -> tuple:
+        """``(p_star, u_star)`` and the left and mirrored right waves as the compiled sampler reads them."""
+        p_star, u_star, left, right = riemann.waves(self.left, self.right, self.gamma)
+        mirrored = (float(self.right[0]), -float(self.right[1]), float(self.right[2]))
+        return (p_star, u_star, kernels.wave_constants(self.left, left, self.gamma),
+                kernels.wave_constants(mirrored, right, self.gamma))
+
+    def _sample(self, x, t):
+        """The Riemann solution ``(rho, u, p)`` at ``x`` and ``t``: for ``t > 0`` the compiled
+        :func:`~mpm_fem.exact_stages.kernels.sample`, equal bit for bit to :func:`baselines.exact.riemann.sample`."""
+        if t > 0:
+            return kernels.sample(x, t, self.x0, self.gamma, *self._waves)
+        return riemann.sample(x, t, self.left, self.right, x0=self.x0, gamma=self.gamma)
+
+    def breakpoints(self, t):
+        return self.x0 + self._speeds * t
+
+    def integrand(self, x, t):
+        rho, u, p = self._sample(x, t)
+        return rho, u, -p
+
+    def _initial(self, x):
+        """``(v*, v*_x, dv*/dt)`` at ``t = 0``: averages of the step data and their limits."""
+        l = self.half_width
+        u_l, u_r = self.left[1], self.right[1]
+        lo, hi = x - l, x + l
+        left_part = np.clip(self.x0 - lo, 0.0, 2 * l)
+        v = (u_l * left_part + u_r * (2 * l - left_part)) / (2 * l)
+        inside = (lo < self.x0) & (self.x0 <= hi)
+        anchor, F0, U0, _ = self._pieces
+        g_left, g_right = F0[0] - U0[0] * anchor[0], F0[-1] - U0[-1] * anchor[-1]
+        return v, np.where(inside, (u_r - u_l) / (2 * l), 0.0), np.where(inside, (g_right - g_left) / (2 * l), 0.0)
+
+    def velocity_gradient(self, x, t):
+        x = np.asarray(x, dtype=float)
+        if t == 0:
+            return self._initial(x)[1]
+        return self._averaged(x, t, False)[1]
+
+    def reference(self, x, t):
+        x = np.asarray(x, dtype=float)
+        if t == 0:
+            return self._initial(x)
+        return self._averaged(x, t, True)
+
+    def _averaged(self, x, t, full):
+        """``(v*, v*_x, a*)`` at ``t > 0`` in one compiled pass (:func:`~mpm_fem.exact_stages.kernels.averaged`;
+        ``full=False``: ``v*_x`` only), equal bit for bit to :meth:`_averaged_numpy`."""
+        out = kernels.averaged(np.ascontiguousarray(x).ravel(), float(t), float(self.half_width), float(self.x0),
+                                     full, self._speeds, *self._pieces)
+        return tuple(a.reshape(x.shape) if a.size == x.size else a for a in out)
+
+    def _averaged_numpy(self, x, t):
+        """The readable reference of :meth:`_averaged` (class docstring), from :meth:`_profile_numpy`."""
+        l = self.half_width
+        U_hi, F_hi, G_hi = self._profile_numpy((x + l - self.x0) / t)
+        U_lo, F_lo, G_lo = self._profile_numpy((x - l - self.x0) / t)
+        v = t * (F_hi - F_lo) / (2 * l)
+        v_x = (U_hi - U_lo) / (2 * l)
+        v_t = (G_hi - G_lo) / (2 * l)
+        return v, v_x, v_t + v * v_x
+
+
 def exact_fields(settings: SodSettings) -> RiemannFields:
-    """The exact fields of the exact stages (:mod:`mpm_fem.exact_stages.stage`): the Riemann solution,
+    """The exact fields of the exact stages (:class:`RiemannFields`): the Riemann solution,
     averaged over one cell (half-width ``h / 2``) where a stage needs ``v_x`` or ``Dv/Dt``, which
     are Dirac masses at the shock. One cell, not one particle: the artificial viscosity's length
     is the cell size, and a gradient spread over ``h / N_p`` makes it overheat the shock."""
