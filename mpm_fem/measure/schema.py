@@ -117,7 +117,8 @@ BURGERS_LUMPING = Table("burgers/lumping", (
 
 # ----------------------------------------------------------------------------- time (C1, C2)
 
-TIME_ORDER = Table("time/time_order", ("problem", "basis", "quantity", "refine", "dt", "error", "order", "fitted_order"))
+TIME_ORDER = Table("time/time_order", (
+    "problem", "basis", "quantity", "refine", "dt", "error", "order", "fitted_order"))
 TIME_LOCAL_ERROR = Table("time/local_error", ("problem", "basis", "quantity", "dt", "error", "order", "fitted_order"))
 TIME_CROSSING_SUMMARY = Table("time/crossing_summary", (
     "basis", "acceleration", "crossings", "median_ratio", "max_ratio_error", "max_abs_ratio", "median_abs_measured"))

@@ -19,7 +19,7 @@ SHAPLEY = BUDGET_SHAPLEY.name
 
 
 def _trend(shares: list[float]) -> str:
-    steps = [b - a for a, b in zip(shares, shares[1:])]
+    steps = [b - a for a, b in zip(shares, shares[1:], strict=False)]
     if not steps:
         return "one mesh"
     return "grows as h shrinks" if all(d > 0 for d in steps) else "falls as h shrinks" if all(d < 0 for d in steps) \
@@ -65,7 +65,8 @@ def _e1(problem: str) -> Criterion:
         for norm in norms[1:]:
             other, ok = budget_verdicts(rows, norm)
             closes &= ok
-            parts.append(f"{norm} L1: " + ", ".join(f"{b} {f['ranked'][0][0]} {f['ranked'][0][1]:.0%}" for b, f in other.items()))
+            parts.append(f"{norm} L1: " + ", ".join(f"{b} {f['ranked'][0][0]} {f['ranked'][0][1]:.0%}"
+                                                    for b, f in other.items()))
         dominated = sum(f["dominant"] is not None for f in found.values())
         verdict = ("refuted" if not closes else "confirmed" if dominated == len(found) else "partly")
         return verdict, f"{norms[0]} L1, largest Shapley share: " + "; ".join(parts) + (
@@ -109,8 +110,9 @@ def _e2(t: Tables) -> tuple[str, str]:
     for basis in dict.fromkeys(r["basis"] for r in rows):
         sub = sorted(select(rows, basis=basis), key=lambda r: -num(r, "h"))[-2:]
         if len(sub) == 2:
-            last[basis] = {k: math.log(num(sub[0], k) / num(sub[1], k)) / math.log(num(sub[0], "h") / num(sub[1], "h"))
-                           for k in ("particles_L1", "nodes_L1")} | {"h": sub[1]["h"], "noise": num(sub[1], "plateau_noise")}
+            last[basis] = ({k: math.log(num(sub[0], k) / num(sub[1], k)) / math.log(num(sub[0], "h") / num(sub[1], "h"))
+                            for k in ("particles_L1", "nodes_L1")}
+                           | {"h": sub[1]["h"], "noise": num(sub[1], "plateau_noise")})
     if "mpm" not in last or len(last) < 2:
         return "not measured", "fewer than two meshes or no point-mass row"
     p1, smooth = last["mpm"]["particles_L1"], {b: v["particles_L1"] for b, v in last.items() if b != "mpm"}

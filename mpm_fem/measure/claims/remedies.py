@@ -66,16 +66,17 @@ def _series(rows: list[dict], problem: str) -> dict[str, list[dict]]:
     return out
 
 
-@claim("E5", source="the goal set for the remedies: an MPM variant whose Sod density error keeps converging on every "
-                    "mesh, over nodes and over particles, within 1.5x of the FV error at every h, and that converges at "
-                    "first order or better on Burgers with 4 particles per cell",
+@claim("E5", source="the goal set for the remedies: an MPM variant whose Sod density error keeps converging on "
+                    "every mesh, over nodes and over particles, within 1.5x of the FV error at every h, and that "
+                    "converges at first order or better on Burgers with 4 particles per cell",
        tables=(REMEDY_ERRORS,), study="remedies",
        thresholds=f"a remedy removes the plateau when its observed orders over nodes and over particles stay >= "
                   f"{PLATEAU_ORDER} between every pair of successive meshes (on Sod: run on every mesh of the "
                   f"table); a remedy that removes it on Sod, stays within {FV_FACTOR}x of the FV error at every h "
                   f"(nodes and particles) and on Burgers removes it with fitted orders >= {BURGERS_ORDER} -> "
-                  "confirmed (named); one that only removes the Sod plateau -> partly; none -> refuted. The remedy named "
-                  "meets most of the three conditions and, among those, has the smallest largest FV ratio. Wall time enters no verdict. The evidence adds which stage carries the largest Shapley "
+                  "confirmed (named); one that only removes the Sod plateau -> partly; none -> refuted. The remedy "
+                  "named meets most of the three conditions and, among those, has the smallest largest FV ratio. "
+                  "Wall time enters no verdict. The evidence adds which stage carries the largest Shapley "
                   "share of the named remedy's remaining error, from the error budget of its basis at its finest "
                   "mesh (budget/shapley, when the budget was run)")
 def _e5(t: Tables) -> tuple[str, str]:
@@ -105,8 +106,10 @@ def _e5(t: Tables) -> tuple[str, str]:
     text = (f"{name}: lowest Sod order {s['min_order_nodes_L1']:.2f} (nodes) / {s['min_order_particles_L1']:.2f} "
             f"(particles) over h = {max(own):g}..{min(own):g}, at most {s['max_fv_ratio_nodes_L1']:.2f}x / "
             f"{s['max_fv_ratio_particles_L1']:.2f}x the FV error")
-    text += (f"; Burgers (4 per cell) fitted orders {b['fitted_order_nodes_L1']:.2f} / {b['fitted_order_particles_L1']:.2f}, "
-             f"lowest successive {min(b['min_order_nodes_L1'], b['min_order_particles_L1']):.2f}" if b else "; Burgers not run")
+    text += (f"; Burgers (4 per cell) fitted orders {b['fitted_order_nodes_L1']:.2f} / "
+             f"{b['fitted_order_particles_L1']:.2f}, "
+             f"lowest successive {min(b['min_order_nodes_L1'], b['min_order_particles_L1']):.2f}"
+             if b else "; Burgers not run")
     text += "; " + remedy_budget(t, name)
     removers = [f"{n} ({sc['max_fv_ratio_nodes_L1']:.2f}x / {sc['max_fv_ratio_particles_L1']:.2f}x FV)"
                 for _, n, sc, *_ in scored if sc["removes_plateau"]]

@@ -17,15 +17,16 @@ LUMPING_GAIN, MASS_SHARE = 0.9, 0.1
 
 def ppc_claim(groups: dict[str, list[dict]], keys: tuple[str, ...]) -> tuple[str, str]:
     """C3 on one problem: per group (method, mesh) and error ``key``, the fewest N_p near the best."""
-    found = {f"{g}, {k.split('_')[0]}": saturation(rows, k, within=SATURATION) for g, rows in groups.items() for k in keys}
+    found = {f"{g}, {k.split('_')[0]}": saturation(rows, k, within=SATURATION)
+             for g, rows in groups.items() for k in keys}
     hits = sum(OPTIMAL_PPC[0] <= n <= OPTIMAL_PPC[1] for n in found.values())
     return count_verdict(hits, len(found), "differs"), (
         f"N_p within {SATURATION:.0%} of the smallest error: " + "; ".join(f"{g}: {n}" for g, n in found.items()))
 
 
 PPC_RULE = (f"the fewest particles per cell within {SATURATION:.0%} of the smallest error lies in "
-             f"[{OPTIMAL_PPC[0]}, {OPTIMAL_PPC[1]}] on every mesh and error -> confirmed, on some -> partly, "
-             "on none -> differs")
+            f"[{OPTIMAL_PPC[0]}, {OPTIMAL_PPC[1]}] on every mesh and error -> confirmed, on some -> partly, "
+            "on none -> differs")
 
 
 def mass_shares(rows: list[dict]) -> dict[str, float]:
@@ -50,7 +51,7 @@ def lumping_claim(ratios: dict[str, float], shares: dict[str, float]) -> tuple[s
 
 
 LUMPING_RULE = (f"the consistent mass lowers the error below {LUMPING_GAIN} x the lumped one for every method and "
-                 f"mesh, and the error budget's mass stage (FE + mass lumping) carries a Shapley share of at least "
-                 f"{MASS_SHARE:.0%} (in magnitude: adding to the error or compensating the other stages) of v(all MPM) "
-                 "- v(all exact) at the finest mesh of every basis and norm -> confirmed; some of these -> partly; "
-                 "none -> differs")
+                f"mesh, and the error budget's mass stage (FE + mass lumping) carries a Shapley share of at least "
+                f"{MASS_SHARE:.0%} (in magnitude: adding to the error or compensating the other stages) of v(all MPM) "
+                "- v(all exact) at the finest mesh of every basis and norm -> confirmed; some of these -> partly; "
+                "none -> differs")

@@ -65,7 +65,8 @@ def _c12(t: Tables) -> tuple[str, str]:
     hits = sum(w >= WAVE_SHARE for w in waves)
     return count_verdict(hits, len(rows), "differs"), (
         f"waves carry {waves[-1]:.0%} of the nodal L1 at h = {rows[-1]['h']} ({waves[0]:.0%} at h = {rows[0]['h']}); "
-        f"the smooth region {smooth[0]:.0%} -> {smooth[-1]:.0%}; above {WAVE_SHARE:.0%} on {hits} of {len(rows)} meshes")
+        f"the smooth region {smooth[0]:.0%} -> {smooth[-1]:.0%}; above {WAVE_SHARE:.0%} on {hits} of {len(rows)} "
+        "meshes")
 
 
 @claim("C14", source="new extrema appear where particles cross cells", tables=(SOD_EXTREMA.name,), study="sod",
@@ -89,8 +90,8 @@ def _c3_sod(t: Tables) -> tuple[str, str]:
     return ppc_claim(groups, ("nodes_L1", "particles_L1"))
 
 
-@claim("C15", source="one of four error sources", tables=(SOD_MASS.name, BUDGET_SHAPLEY.name), study="sod", problem="sod",
-       thresholds=LUMPING_RULE)
+@claim("C15", source="one of four error sources", tables=(SOD_MASS.name, BUDGET_SHAPLEY.name), study="sod",
+       problem="sod", thresholds=LUMPING_RULE)
 def _c15_sod(t: Tables) -> tuple[str, str]:
     """In MPM the consistent particle mass matrix spreads the crossing noise rather than removing it. In
     the budget the mass stage compensates the projection on Sod: the lumped solve of the MPM data lowers
@@ -108,9 +109,11 @@ def _c15_sod(t: Tables) -> tuple[str, str]:
 def _e3(t: Tables) -> tuple[str, str]:
     rows = t[CONVERGENCE]
     full = [r for r in rows if all(math.isfinite(num(r, c)) for c in SIDE_BY_SIDE.values())]
-    fv = setting(t, CONVERGENCE, "fv.scheme", "FV") + ("" if setting(t, CONVERGENCE, "fv.limiter") else ", limiter not recorded")
+    fv = setting(t, CONVERGENCE, "fv.scheme", "FV") + ("" if setting(t, CONVERGENCE, "fv.limiter")
+                                                       else ", limiter not recorded")
     fem = "FEM: " + setting(t, CONVERGENCE, "fem.viscosity", "viscosity variant not recorded")
     last = rows[-1]
     verdict = count_verdict(len(full), len(rows), "not measured")
-    return verdict, (f"density L1 at h = {last['h']}: " + ", ".join(f"{m} {num(last, c):.3g}" for m, c in SIDE_BY_SIDE.items())
+    return verdict, (f"density L1 at h = {last['h']}: "
+                     + ", ".join(f"{m} {num(last, c):.3g}" for m, c in SIDE_BY_SIDE.items())
                      + f"; all four on {len(full)} of {len(rows)} meshes; FV: {fv}; {fem}")

@@ -23,7 +23,8 @@ CROSSING_TOLERANCE, NO_JUMP = 0.1, 0.1
 def _c1(t: Tables) -> tuple[str, str]:
     """With the point-mass basis node crossings make the solution a rough function of dt (C2), so its
     orders between successive refinements scatter about the fitted one."""
-    fits = {(r["problem"], r["basis"], r["quantity"]): num(r, "fitted_order") for r in select(t[TIME_ORDER.name], order="")}
+    fits = {(r["problem"], r["basis"], r["quantity"]): num(r, "fitted_order")
+            for r in select(t[TIME_ORDER.name], order="")}
     local = {(r["problem"], r["basis"]): num(r, "fitted_order")
              for r in select(t[TIME_LOCAL_ERROR.name], order="", quantity="x")}
     off = [" ".join(k) for k, o in fits.items() if not GLOBAL_ORDER[0] <= o <= GLOBAL_ORDER[1]]
