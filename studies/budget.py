@@ -60,6 +60,7 @@ from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import PositivityError
 from mpm_fem.app.plots import Curve, Plot, plt, save
 from mpm_fem.problems import burgers, sod
+from mpm_fem.measure import schema
 from mpm_fem.measure.regions import REGION_NAMES, l1_by_region, plateau_velocity, sod_regions
 from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.measure.timing import field_on
@@ -207,10 +208,10 @@ def run(options: StudyOptions) -> None:
     rows = subset_rows(ok)
     shapley, interactions = decomposition_rows(rows)
     reference = decomposition_rows(subset_rows({k: r for k, r in got["roundoff"].items() if r["ok"] and k in ok}))[0]
-    publish(folder, {"subsets": rows, "shapley": shapley, "interactions": interactions, "regions": region_rows(ok),
+    publish(folder, {"subsets": rows, schema.BUDGET_SHAPLEY: shapley, "interactions": interactions, "regions": region_rows(ok),
                      "runs": [{"problem": p, "h": h, "basis": b, **x} for (p, h, b), r in got["budget"].items() for x in r["runs"]],
-                     "bases": [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()],
-                     "roundoff": share_changes(shapley, reference)}, settings, figures=(BASES_PLOT,))
+                     schema.BUDGET_BASES: [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()],
+                     schema.BUDGET_ROUNDOFF: share_changes(shapley, reference)}, settings, figures=(BASES_PLOT,))
     for problem in sorted({r["problem"] for r in shapley}):
         shapley_figure(folder / f"shapley_{problem}.png", [r for r in shapley if r["problem"] == problem])
         finest = {b: min(h for p, h, bb in ok if p == problem and bb == b) for p, _, b in ok if p == problem}
@@ -250,7 +251,7 @@ def region_rows(got: dict) -> list[dict]:
 
 # ---------------------------------------------------------------- figures
 
-BASES_PLOT = Plot("bases.png", "E2: Sod density L1 with each basis, MPM stages", "bases", "h", (
+BASES_PLOT = Plot("bases.png", "E2: Sod density L1 with each basis, MPM stages", schema.BUDGET_BASES.stem, "h", (
     Curve("{basis}, nodes", "nodes_L1", "o-", {"ok": True}, group=("basis",)),
     Curve("{basis}, particles", "particles_L1", "s--", {"ok": True}, group=("basis",))), ylabel="density L1", slopes=(1,))
 

@@ -19,6 +19,7 @@ from mpm_fem.measure import source
 from mpm_fem.measure.claims import BURGERS_SHOWN
 from mpm_fem.measure.errors import fitted_order, observed_orders, orders_row
 from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.measure.schema import BURGERS_LUMPING, BURGERS_ORDERS, BURGERS_PPC
 from mpm_fem.problems import burgers
 from mpm_fem.app.study import StudyOptions, publish, script_main
 
@@ -140,10 +141,11 @@ def run(options: StudyOptions) -> None:
                 "source_corrections": "exponents of the entries marked * in docs/claims.md moved by one power of ten",
                 "time_h": QUICK["TIME_H"] if options.quick else TIME_H, "problem": burgers.BurgersSettings().as_dict()}
     errors, orders = _errors(got)
-    tables = {"errors": errors, "orders": orders, "norms": _norms(got), "timestep": _timestep(got, settings["time_h"]),
-              "ppc": _ppc(got), "lumping": _lumping(got), "diagnosis": _diagnosis(got) if got.get("diagnosis") else []}
+    tables = {"errors": errors, BURGERS_ORDERS: orders, "norms": _norms(got),
+              "timestep": _timestep(got, settings["time_h"]), BURGERS_PPC: _ppc(got), BURGERS_LUMPING: _lumping(got),
+              "diagnosis": _diagnosis(got) if got.get("diagnosis") else []}
     extra = {"timestep": {"refine": list(REFINE), "meaning": "time_error = |E(dt) - E(dt/16)|; time_below_space: time "
-                          "error < E(dt/16) (the space error)"}, "lumping": {"mpm_cfl": LUMPING_CFL},
+                          "error < E(dt/16) (the space error)"}, BURGERS_LUMPING.stem: {"mpm_cfl": LUMPING_CFL},
              "diagnosis": {"diagnosis": dict(DIAGNOSIS), "solution": DEFAULT}}
     publish(folder, tables, settings, extra, PLOTS)
     _profiles(folder / "profiles.png", got)
@@ -268,9 +270,9 @@ PLOTS = (
          "errors", "h", _beside_source(solution=DEFAULT), split=("eps",), size=(4.2, 4.0), **_ERROR),
     Plot("solutions.png", "Every candidate exact solution: velocity error against h", "errors", "h",
          _beside_source(eps=(EPS[0], EPS[-1])), split=("eps", "solution"), ncols=len(SOLUTIONS), size=(4.2, 3.8), **_ERROR),
-    Plot("ppc.png", f"C3, Burgers: error against N_p ({DEFAULT}, eps = {EPS[0]})", "ppc", "ppc",
+    Plot("ppc.png", f"C3, Burgers: error against N_p ({DEFAULT}, eps = {EPS[0]})", BURGERS_PPC.stem, "ppc",
          _curves(_MPM, "{m}, h = {h}", group=("h",)), xlabel="particles per cell N_p", ylabel=_ERROR["ylabel"]),
-    Plot("lumping.png", f"C15: lumped against consistent mass ({DEFAULT}, eps = {EPS[0]}; MPM CFL {LUMPING_CFL})", "lumping",
+    Plot("lumping.png", f"C15: lumped against consistent mass ({DEFAULT}, eps = {EPS[0]}; MPM CFL {LUMPING_CFL})", BURGERS_LUMPING.stem,
          "h", _curves(_MPM + ("fem_consistent", "fem_lumped"), "{m}, {mass}", "L2", ("mass",)), **{**_ERROR, "ylabel": "velocity error (L2)"}),
     Plot("timestep.png", f"Time error at fixed h: dt / {', '.join(map(str, REFINE))}", "timestep", "dt",
          _curves(_MPM + ("mpm_exact_dt_h",), "{m}, eps = {eps}", group=("eps",)), xlabel="dt (smallest step of the run)",

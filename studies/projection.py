@@ -32,8 +32,9 @@ from mpm_fem.measure.quadrature import cell_points, discrepancy_d2, estimate_c, 
 from mpm_fem.app import plots
 from mpm_fem.measure.claims import BAND_TOLERANCE
 from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.measure.schema import PROJECTION_BOUNDS, PROJECTION_D2_CONSTANT, PROJECTION_ORDERS
 from mpm_fem.measure.source import D2_C, PROJECTION_BANDS, band_text
-from mpm_fem.app.study import StudyOptions, script_main, write_table
+from mpm_fem.app.study import StudyOptions, publish, script_main
 
 NAME = "projection"
 CELLS = [10 * 2**k for k in range(9)]  # h = 1/10 ... 1/2560
@@ -159,7 +160,8 @@ def tables(results: list[tuple[dict, dict]]) -> dict[str, list[dict]]:
         bound_rows.append({"check": check, "layout": lay, "N_p": n, "h": 1.0 / k,
                            "min_ratio": float(min(b["min_ratio"] for b in bs)),
                            "entries": int(sum(b["entries"] for b in bs)), "holds": "yes" if min(b["min_ratio"] for b in bs) >= 1 else "no"})
-    return {"errors": error_rows, "orders": order_rows, "d2": d2_rows, "d2_constant": c_rows, "bounds": bound_rows}
+    return {"errors": error_rows, PROJECTION_ORDERS.stem: order_rows, "d2": d2_rows, PROJECTION_D2_CONSTANT.stem: c_rows,
+            PROJECTION_BOUNDS.stem: bound_rows}
 
 
 def settings(options: StudyOptions) -> dict:
@@ -186,8 +188,8 @@ def run(options: StudyOptions) -> None:
     results = options.sweep(NAME, case, cs)
     t = tables(list(zip(cs, results)))
     s = settings(options)
-    for name, rows in t.items():
-        write_table(folder, name, rows, s)
+    declared = {table.stem: table for table in (PROJECTION_ORDERS, PROJECTION_D2_CONSTANT, PROJECTION_BOUNDS)}
+    publish(folder, {declared.get(name, name): rows for name, rows in t.items()}, s)
     figures(folder, t, [(c, r) for c, r in zip(cs, results)])
 
 
@@ -251,7 +253,8 @@ def figures(folder: Path, t: dict, results: list) -> None:
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
     labels = {"cell_rho": "cell mean of rho: bound (1)", "node_m": "nodal mass E_m^i: two-cell bound",
               "node_F": "nodal force E_F^i: two-cell bound"}
-    smallest = {r["check"]: min(x["min_ratio"] for x in t["bounds"] if x["check"] == r["check"]) for r in t["bounds"]}
+    bounds = t[PROJECTION_BOUNDS.stem]
+    smallest = {r["check"]: min(x["min_ratio"] for x in bounds if x["check"] == r["check"]) for r in bounds}
     for ax, check in zip(axes, labels):
         lo, hi = np.inf, 0.0
         for lay in LAYOUT_NAMES:

@@ -45,6 +45,7 @@ from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import PositivityError
 from mpm_fem.problems import burgers, sod
 from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.measure.schema import REMEDIES_ERRORS
 from mpm_fem.measure.shock_tube import exact_density
 from mpm_fem.app.study import StudyOptions, publish, script_main
 from studies.sod import FEM, FV, H, MPM as SOD_MPM
@@ -140,7 +141,7 @@ def run(options: StudyOptions) -> None:
                 "fv": FV,
                 "criterion": {"plateau_order": PLATEAU_ORDER}, "quick": options.quick}
     rows, cost = _errors(got), _cost_rows(got)
-    publish(folder, {"errors": rows, "orders": _summary(rows), "cost": cost}, settings, figures=PLOTS)
+    publish(folder, {REMEDIES_ERRORS: rows, "orders": _summary(rows), "cost": cost}, settings, figures=PLOTS)
     _cost_figure(folder, cost)
 
 
@@ -208,7 +209,7 @@ def _cost_rows(got) -> list[dict]:
 _SOD, _FV = {"problem": "sod"}, {"problem": "sod", "remedy": "MPM"}
 PLOTS = (
     Plot("errors.png", "E5: L1 error against h for each remedy; Sod density with the FV reference, Burgers velocity",
-         "errors", "h", (
+         REMEDIES_ERRORS.stem, "h", (
              Curve("{remedy}", "nodes_L1", where=_SOD, panel="Sod density, grid nodes", group=("remedy",)),
              Curve("FV reference", "fv_L1", "k--", where=_FV, panel="Sod density, grid nodes"),
              Curve("{remedy}", "particles_L1", where=_SOD, panel="Sod density, particles", group=("remedy",)),

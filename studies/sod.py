@@ -21,6 +21,7 @@ from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import PositivityError
 from mpm_fem.problems import sod
 from mpm_fem.measure.regions import REGION_NAMES, ExtremaCounter, describe
+from mpm_fem.measure.schema import SOD_CONVERGENCE, SOD_EXTREMA, SOD_MASS, SOD_PPC, SOD_REGIONS
 from mpm_fem.app.plots import Curve, Plot
 from mpm_fem.app.study import StudyOptions, publish, script_main
 
@@ -113,13 +114,13 @@ def run(options: StudyOptions) -> None:
     settings = {"mpm": MPM, "fem": {**FEM, "viscosity": _viscosity(FEM).name}, "fv": {**FV, "scheme": fv_euler.label(FV["limiter"])},
                 "region_half_width": REGION_HALF_WIDTH, "T": T,
                 "quick": options.quick, "problem": sod.SodSettings().as_dict()}
-    tables = {"convergence": _convergence(got), "regions": _regions(got), "extrema": _extrema(got), "ppc": _ppc(got),
-              "mass": _mass(got), "plateau": _plateau(got) if got["plateau"] else []}
+    tables = {SOD_CONVERGENCE: _convergence(got), SOD_REGIONS: _regions(got), SOD_EXTREMA: _extrema(got),
+              SOD_PPC: _ppc(got), SOD_MASS: _mass(got), "plateau": _plateau(got) if got["plateau"] else []}
     waves = riemann.wave_positions(T, sod.SodSettings.left, sod.SodSettings.right)
-    extra = {"regions": {"regions": describe(REGION_HALF_WIDTH, waves, T)}, "extrema": {
+    extra = {SOD_REGIONS.stem: {"regions": describe(REGION_HALF_WIDTH, waves, T)}, SOD_EXTREMA.stem: {
         "rtol": 1e-9, "definition": "new strict local extremum among position-ordered particles"}}
     publish(folder, tables, settings, extra, PLOTS)
-    plots.stacked_shares(folder / "regions.png", tables["regions"], REGION_NAMES, f"C12: density L1 error by region of "
+    plots.stacked_shares(folder / "regions.png", tables[SOD_REGIONS], REGION_NAMES, f"C12: density L1 error by region of "
                          f"the exact solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
     _profiles(folder, got)
 
@@ -230,18 +231,18 @@ def _plateau(got) -> list[dict]:
 
 _STYLES = {"density": "o-", "energy": "s--"}
 PLOTS = (
-    Plot("convergence.png", f"Sod, T = {T}: density L1 error against h, beside the source's table", "convergence", "h", (
+    Plot("convergence.png", f"Sod, T = {T}: density L1 error against h, beside the source's table", SOD_CONVERGENCE.stem, "h", (
         Curve("MPM, grid nodes", "mpm_nodes_L1"), Curve("MPM, particles", "mpm_particles_L1", "s-"),
         Curve("FEM consistent", "fem_consistent_L1", "^--"), Curve("FEM lumped", "fem_lumped_L1", "v--"),
         Curve(fv_euler.label(FV["limiter"]), "fv_L1", "x-."), Curve("source (slides)", "source_L1", "k*")),
         ylabel="density error (L1)", slopes=(0.5, 1)),
-    Plot("extrema.png", "C14: new extrema of particle density and energy, per step and per particle-step", "extrema", "h",
+    Plot("extrema.png", "C14: new extrema of particle density and energy, per step and per particle-step", SOD_EXTREMA.stem, "h",
          tuple(Curve(n, f"{n}_new_per_step", f, panel="new extrema per step") for n, f in _STYLES.items())
          + tuple(Curve(f"{n}: {who}", f"{n}_rate_{k}", f, panel="new extrema per particle-step", options=o)
                  for n, f in _STYLES.items() for k, who, o in (("crossing", "particles crossing a node", {}),
                                                                ("elsewhere", "other particles", {"alpha": 0.5}))),
          ylabel="new extrema", size=(4.5, 3.6)),
-    Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", "ppc", "ppc", tuple(
+    Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", SOD_PPC.stem, "ppc", tuple(
         Curve("h = {h}", f"{w}_L1", panel=f"over {name}", group=("h",), where={"ok": True})
         for w, name in (("nodes", "grid nodes"), ("particles", "particles"))),
         xlabel="particles per cell N_p", ylabel="density error (L1)", size=(4.5, 3.6)),

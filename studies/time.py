@@ -24,7 +24,8 @@ from mpm_fem.app.plots import Curve, Plot, draw, plt, save
 from mpm_fem.problems import burgers
 from mpm_fem.core.solve import Problem
 from mpm_fem.core.step import Dirichlet
-from mpm_fem.app.study import StudyOptions, script_main, write_table
+from mpm_fem.app.study import StudyOptions, publish, script_main
+from mpm_fem.measure.schema import TIME_CROSSING_SUMMARY, TIME_LOCAL_ERROR, TIME_ORDER
 from mpm_fem.measure.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, observed_order,
                             pulse_setup, simulate_pulse, state_at)
 
@@ -122,13 +123,11 @@ def run(options: StudyOptions) -> None:
                 "crossing_particle": CROSSING_PARTICLE, "time_refines": TIME_REFINES,
                 "time_reference": TIME_REFERENCE, "local_substeps": LOCAL_SUBSTEPS, "local_refines": LOCAL_REFINES}
     rows, local_rows = time_rows(got["time"])
-    write_table(folder, "time_order", rows, settings)
-    write_table(folder, "local_error", local_rows, settings)
+    crossings = crossing_rows(got["crossing"])
+    publish(folder, {TIME_ORDER: rows, TIME_LOCAL_ERROR: local_rows, "crossing": crossings,
+                     TIME_CROSSING_SUMMARY: crossing_summary(crossings)}, settings)
     draw(folder, TIME_PLOT, rows + [{**r, "quantity": "local " + r["quantity"]} for r in local_rows])
-    rows = crossing_rows(got["crossing"])
-    write_table(folder, "crossing", rows, settings)
-    write_table(folder, "crossing_summary", crossing_summary(rows), settings)
-    crossing_figure(folder / "crossing.png", got["crossing"], rows)
+    crossing_figure(folder / "crossing.png", got["crossing"], crossings)
 
 
 # ---------------------------------------------------------------- tables
@@ -177,7 +176,7 @@ def crossing_summary(rows: list[dict]) -> list[dict]:
 
 GLOBAL_SLOPE, LOCAL_SLOPE = 1, 2  # C1: the orders in dt the guides show
 LOCAL_PANEL = f"one step: local error of x_p (slope {LOCAL_SLOPE})"
-TIME_PLOT = Plot("time_order.png", "C1: error against dt at fixed h and particles", "time_order", "dt", tuple(
+TIME_PLOT = Plot("time_order.png", "C1: error against dt at fixed h and particles", TIME_ORDER.stem, "dt", tuple(
     Curve(label, "error", fmt, where, panel, ("basis",)) for label, fmt, where, panel in (
         ("{basis}", "o-", {"problem": "pulse", "quantity": "velocity"}, f"pulse: global velocity error (slope {GLOBAL_SLOPE})"),
         ("{basis}", "o-", {"problem": "burgers", "quantity": "velocity"}, f"Burgers: global velocity error (slope {GLOBAL_SLOPE})"),
