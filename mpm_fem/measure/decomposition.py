@@ -125,7 +125,8 @@ def _unwrap(d: dict) -> dict:
     return {k: _number_or_array(a) for k, a in d.items()}
 
 
-def share_changes(shapley: list[dict], reference: list[dict], key=("problem", "h", "basis", "norm", "stage")) -> list[dict]:
+def share_changes(shapley: list[dict], reference: list[dict],
+                  key=("problem", "h", "basis", "norm", "stage")) -> list[dict]:
     """Two decompositions of the same runs made with two arithmetics (a budget's Shapley rows and
     its rerun's, each with ``share``, ``mpm_error`` = v(N) and ``exact_error`` = v({})): per row
     present in both, both values (the reference's as ``*_numpy``: the budget's reference arithmetic is

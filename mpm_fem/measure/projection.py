@@ -44,12 +44,19 @@ from typing import Callable
 
 import numpy as np
 
-from mpm_fem.measure.errors import norms
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import seed_positions
-from mpm_fem.measure.quadrature import cell_mean_error, cell_points, derivative_l2, discrepancy_d2, hickernell_bound, integrate_cells
 from mpm_fem.core.shape import make_shape, point_shape
 from mpm_fem.core.transfer import divide_by_lumped, nodal_internal_force, nodal_mass, nodal_momentum
+from mpm_fem.measure.errors import norms
+from mpm_fem.measure.quadrature import (
+    cell_mean_error,
+    cell_points,
+    derivative_l2,
+    discrepancy_d2,
+    hickernell_bound,
+    integrate_cells,
+)
 
 Field = Callable[[np.ndarray], np.ndarray]
 QUANTITIES = ("E_m", "E_P", "E_F", "E_a", "E_a_pred", "E_v", "E_v1", "E_VG", "E_VG_proj")
@@ -231,7 +238,8 @@ def quadrature_checks(grid: Grid, x: np.ndarray, fields: Fields) -> dict[str, Bo
     falling = np.sqrt(integrate_cells(grid, lambda y, xi, hh: (-fields.rho(y) / hh + (1 - xi) * fields.drho(y)) ** 2))
     bound_m = d2 * h**1.5 * rising, d2 * h**1.5 * falling
     return {
-        "cell_rho": BoundCheck(cell_mean_error(grid, x, fields.rho), hickernell_bound(d2, h, derivative_l2(grid, fields.drho))),
+        "cell_rho": BoundCheck(cell_mean_error(grid, x, fields.rho),
+                               hickernell_bound(d2, h, derivative_l2(grid, fields.drho))),
         "node_m": BoundCheck(errors.E_m, bound_m[0][:-1] + bound_m[1][1:]),
         "node_F": BoundCheck(errors.E_F, bound_p[:-1] + bound_p[1:]),
     }

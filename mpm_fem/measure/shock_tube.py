@@ -12,10 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from baselines.exact import riemann
-
 from mpm_fem.measure.errors import norms
-from mpm_fem.problems.sod import SodSettings, conservation
 from mpm_fem.measure.regions import by_region, head_shift, sod_regions
+from mpm_fem.problems.sod import SodSettings, conservation
 
 
 def exact_density(x, t: float = SodSettings.T):

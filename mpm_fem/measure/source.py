@@ -25,7 +25,8 @@ _BURGERS_ROWS = {  # eps: (exact acceleration, calculated acceleration), each on
     0.02: ((2.97e-4, 1.24e-4, 6.16e-5, 3.10e-5, 1.55e-5), (3.73e-4, 1.93e-4, 9.91e-5, 4.95e-5, 2.47e-5)),
     0.01: ((5.34e-4, 1.58e-4, 6.18e-5, 3.10e-5, 1.55e-5), (4.12e-4, 1.51e-4, 6.52e-5, 3.20e-5, 1.60e-5)),
 }
-BURGERS = {row: {eps: values[k] for eps, values in _BURGERS_ROWS.items()} for k, row in enumerate(("exact", "calculated"))}
+BURGERS = {row: {eps: values[k] for eps, values in _BURGERS_ROWS.items()}
+           for k, row in enumerate(("exact", "calculated"))}
 #: (row, eps, h) of the entries whose exponent the slide misprints; corrected by one power of ten
 #: to the sequence they belong to (``docs/claims.md``, "Corrections").
 BURGERS_CORRECTED = {("exact", e, 0.0025) for e in (0.04, 0.03, 0.02, 0.01)} | {
