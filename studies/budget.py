@@ -5,7 +5,8 @@ Caption. Sod's tube (16 particles per cell, CFL 0.05, von Neumann-Richtmyer visc
 USL, lumped mass) and viscous Burgers (the rarefaction, eps = 0.045, 4 particles per cell, CFL
 0.5, calculated acceleration) are run for each mesh and basis (point-mass P1 "mpm", GIMP, the C1
 quadratic B-spline "bspline", and E5's closest remedy, the B-spline averaged over the particle
-domain "bspline_gimp", whose exact stages use the same quadratic B-splines) with every subset ``S`` of the four stages {projection, mass
+domain "bspline_gimp", whose exact stages use the same quadratic B-splines) with every subset ``S`` of
+the four stages {projection, mass
 (FE + mass lumping), interpolation, time} in MPM form and the others in their exact form
 (:mod:`mpm_fem.exact_stages.stage`). The error field ``e_S(x)`` is the piecewise-linear field through
 the particle values (Sod density, Burgers velocity) minus the exact solution, on fixed points
@@ -28,7 +29,8 @@ cores); Burgers 0.04 ... 0.01. A Sod case is 16 runs, all on the fused step
 (:mod:`mpm_fem.fused.step`): the fourteen with an exact stage run its compiled particle passes around the
 numpy step's grid stage (the quadrature projection, the FE mass and the exact nodal values; the exact
 fields compiled, :mod:`mpm_fem.exact_stages.kernels`, the quadrature rows cached per grid, the cut pieces, the
-nodal sums and the FE mass entries compiled, :mod:`mpm_fem.exact_stages.grid_kernels`, bit for bit). Four exact-stage runs (every stage exact, the exact interpolation, projection, mass alone),
+nodal sums and the FE mass entries compiled, :mod:`mpm_fem.exact_stages.grid_kernels`, bit for bit). Four
+exact-stage runs (every stage exact, the exact interpolation, projection, mass alone),
 CPU seconds on the shared 2-core machine, the numpy step -> the fused one: P1 at h = 0.0025 8.9 -> 5.8;
 GIMP at 0.005 8.3 -> 2.4; the particle-domain B-spline at 0.005 9.6 -> 3.4; then the compiled grid
 stage, the four runs with the exact mass: P1 at 0.0025 7.95 -> 3.90, the B-spline at 0.005 4.55 -> 2.22,
@@ -55,14 +57,15 @@ from pathlib import Path
 import numpy as np
 
 from baselines.exact import riemann
-from mpm_fem.measure.decomposition import decompose, label, share_changes, subsets
+from mpm_fem.app.plots import Curve, Plot, plt, save
+from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import PositivityError
-from mpm_fem.app.plots import Curve, Plot, plt, save
-from mpm_fem.problems import burgers, sod
+from mpm_fem.measure import schema
+from mpm_fem.measure.decomposition import decompose, label, share_changes, subsets
 from mpm_fem.measure.regions import REGION_NAMES, l1_by_region, plateau_velocity, sod_regions
-from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.measure.timing import field_on
+from mpm_fem.problems import burgers, sod
 
 NAME = "budget"
 BASES = ("mpm", "gimp", "bspline")  # E2's bases
@@ -93,7 +96,8 @@ def plan(quick: bool) -> dict:
     hs, bases = (QUICK["h"], QUICK["bases"]) if quick else (H, BUDGET_BASES)
     budget = {(p, h, b): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K}
               for p, meshes in hs.items() for h in meshes for b in bases if h >= FINEST.get((p, b), 0)}
-    e2 = {(h, b): {"kind": "bases", "h": h, "basis": b} for h in (QUICK["bases_h"] if quick else BASES_H) for b in BASES}
+    e2 = {(h, b): {"kind": "bases", "h": h, "basis": b}
+          for h in (QUICK["bases_h"] if quick else BASES_H) for b in BASES}
     roundoff = {key: {**case, "kernel": "numpy"} for key, case in budget.items() if key[::2] == ROUNDOFF}
     return {"budget": budget, "bases": e2, "roundoff": roundoff}
 
@@ -132,7 +136,8 @@ def _run(problem: str, settings, points: np.ndarray) -> tuple[dict, dict]:
         extra = plateau_velocity(P.x, P.velocity, _sod_waves(), 3 * settings.h)  # the study's T and states
     else:
         fields, extra = {"particles": field_on(points, P.x, P.velocity) - settings.exact.v(points, result.t)}, {}
-    errors = (sod if problem == "sod" else burgers).errors(settings, result)["density" if problem == "sod" else "velocity"]
+    errors = (sod if problem == "sod" else burgers).errors(settings, result)[
+        "density" if problem == "sod" else "velocity"]
     return {"ok": True, "steps": result.steps, "wall_s": result.wall_s, "particles_L1": errors["particles"]["L1"],
             "nodes_L1": errors["nodes"]["L1"], **extra}, fields
 
@@ -166,7 +171,8 @@ def budget_case(case: dict) -> dict:
     """One (problem, h, basis): v(S) per norm and subset, the runs, the Shapley error fields
     (sampled for the figure) and, for Sod, their L1 by region."""
     problem, h, basis = case["problem"], case["h"], case["basis"]
-    fields, weights, points, runs = subset_fields(problem, h, basis, {"kernel": case["kernel"]} if "kernel" in case else None)
+    kernel = {"kernel": case["kernel"]} if "kernel" in case else None
+    fields, weights, points, runs = subset_fields(problem, h, basis, kernel)
     if fields is None:
         return {"ok": False, "runs": runs}
     out = {"ok": True, "runs": runs, "subsets": {norm: {label(S): float(np.sum(w * np.abs(f[norm])))
@@ -207,14 +213,17 @@ def run(options: StudyOptions) -> None:
     rows = subset_rows(ok)
     shapley, interactions = decomposition_rows(rows)
     reference = decomposition_rows(subset_rows({k: r for k, r in got["roundoff"].items() if r["ok"] and k in ok}))[0]
-    publish(folder, {"subsets": rows, "shapley": shapley, "interactions": interactions, "regions": region_rows(ok),
-                     "runs": [{"problem": p, "h": h, "basis": b, **x} for (p, h, b), r in got["budget"].items() for x in r["runs"]],
-                     "bases": [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()],
-                     "roundoff": share_changes(shapley, reference)}, settings, figures=(BASES_PLOT,))
+    publish(folder, {"subsets": rows, schema.BUDGET_SHAPLEY: shapley, "interactions": interactions,
+                     "regions": region_rows(ok),
+                     "runs": [{"problem": p, "h": h, "basis": b, **x}
+                              for (p, h, b), r in got["budget"].items() for x in r["runs"]],
+                     schema.BUDGET_BASES: [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()],
+                     schema.BUDGET_ROUNDOFF: share_changes(shapley, reference)}, settings, figures=(BASES_PLOT,))
     for problem in sorted({r["problem"] for r in shapley}):
         shapley_figure(folder / f"shapley_{problem}.png", [r for r in shapley if r["problem"] == problem])
         finest = {b: min(h for p, h, bb in ok if p == problem and bb == b) for p, _, b in ok if p == problem}
-        fields_figure(folder / f"fields_{problem}.png", problem, {b: (h, ok[(problem, h, b)]["fields"]) for b, h in finest.items()})
+        fields_figure(folder / f"fields_{problem}.png", problem,
+                      {b: (h, ok[(problem, h, b)]["fields"]) for b, h in finest.items()})
 
 
 def subset_rows(got: dict) -> list[dict]:
@@ -244,21 +253,23 @@ def decomposition_rows(rows: list[dict]) -> tuple[list, list]:
 def region_rows(got: dict) -> list[dict]:
     """``regions.csv``: L1 of each Shapley error field (particles) and its share in each region of C12."""
     return [{"problem": p, "h": h, "basis": b, "field": name, "L1": sum(parts),
-             **{f"share_{n.replace(' ', '_')}": x / sum(parts) for n, x in zip(REGION_NAMES, parts)}}
+             **{f"share_{n.replace(' ', '_')}": x / sum(parts) for n, x in zip(REGION_NAMES, parts, strict=True)}}
             for (p, h, b), r in got.items() for name, parts in r.get("regions", {}).items()]
 
 
 # ---------------------------------------------------------------- figures
 
-BASES_PLOT = Plot("bases.png", "E2: Sod density L1 with each basis, MPM stages", "bases", "h", (
+BASES_PLOT = Plot("bases.png", "E2: Sod density L1 with each basis, MPM stages", schema.BUDGET_BASES.stem, "h", (
     Curve("{basis}, nodes", "nodes_L1", "o-", {"ok": True}, group=("basis",)),
-    Curve("{basis}, particles", "particles_L1", "s--", {"ok": True}, group=("basis",))), ylabel="density L1", slopes=(1,))
+    Curve("{basis}, particles", "particles_L1", "s--", {"ok": True}, group=("basis",))),
+    ylabel="density L1", slopes=(1,))
 
 
 def shapley_figure(path: Path, rows: list[dict]) -> None:
     """Per mesh: v(all exact) as a grey bar, beside it each stage's Shapley value stacked from that
     floor (up when positive, down when negative), ending at v(all MPM) (black mark)."""
-    norms, bases = list(dict.fromkeys(r["norm"] for r in rows)), [b for b in BUDGET_BASES if any(r["basis"] == b for r in rows)]
+    norms = list(dict.fromkeys(r["norm"] for r in rows))
+    bases = [b for b in BUDGET_BASES if any(r["basis"] == b for r in rows)]
     fig, axes = plt.subplots(len(norms), len(bases), figsize=(4.2 * len(bases), 3.6 * len(norms)), squeeze=False)
     for (i, norm), (k, basis) in ((a, b) for a in enumerate(norms) for b in enumerate(bases)):
         ax, sub = axes[i][k], [r for r in rows if r["norm"] == norm and r["basis"] == basis]
@@ -269,22 +280,24 @@ def shapley_figure(path: Path, rows: list[dict]) -> None:
             ax.bar(j - 0.25, floor, width=0.3, color="lightgray", label="all exact" if j == 0 else None)
             for s in STAGES:
                 x = at[s]["shapley"]
-                ax.bar(j + 0.1, x, bottom=up if x >= 0 else down, width=0.4, color=COLORS[s], label=s if j == 0 else None)
+                ax.bar(j + 0.1, x, bottom=up if x >= 0 else down, width=0.4, color=COLORS[s],
+                       label=s if j == 0 else None)
                 up, down = (up + x, down) if x >= 0 else (up, down + x)
-            ax.plot([j - 0.4, j + 0.3], [at[STAGES[0]]["mpm_error"]] * 2, "k-", lw=2, label="all MPM" if j == 0 else None)
+            ax.plot([j - 0.4, j + 0.3], [at[STAGES[0]]["mpm_error"]] * 2, "k-", lw=2,
+                    label="all MPM" if j == 0 else None)
         ax.axhline(0, color="k", lw=0.5)
         ax.set_xticks(range(len(hs)), [f"{h:g}" for h in hs])
         ax.set(xlabel="h", ylabel=f"{norm} L1 error", title=f"{rows[0]['problem']}, {basis}, {norm}")
     axes[0][-1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
-    save(fig, path, caption=f"{rows[0]['problem']}: v(all exact) as the grey floor, each stage's Shapley value stacked on "
-                            "it (signed), ending at v(all MPM) (black mark)")
+    save(fig, path, caption=f"{rows[0]['problem']}: v(all exact) as the grey floor, each stage's Shapley value "
+                            "stacked on it (signed), ending at v(all MPM) (black mark)")
 
 
 def fields_figure(path: Path, problem: str, fields: dict) -> None:
     """Each stage's Shapley error field against x at the finest mesh of each basis (Sod: the wave
     positions dotted); the thin black line is e_MPM - e_exact, their sum."""
     fig, axes = plt.subplots(len(fields), 1, figsize=(10, 2.6 * len(fields)), squeeze=False)
-    for ax, (basis, (h, f)) in zip(axes[:, 0], fields.items()):
+    for ax, (basis, (h, f)) in zip(axes[:, 0], fields.items(), strict=True):
         for s in STAGES:
             ax.plot(f["x"], f[s], "-", lw=0.8, color=COLORS[s], label=s)
         ax.plot(f["x"], f[GAP], "k-", lw=0.4, label=GAP)
@@ -292,8 +305,9 @@ def fields_figure(path: Path, problem: str, fields: dict) -> None:
             ax.axvline(_sod_waves()[w], color="gray", ls=":", lw=0.8)
         ax.set(xlabel="x", ylabel="Shapley error field", title=f"{problem}, {basis}, h = {h:g}: error field by stage")
     axes[0, 0].legend(fontsize=7, ncol=5)
-    save(fig, path, caption=f"{problem}: each stage's Shapley error field at the finest mesh of each basis; they add up "
-                            "to e_MPM - e_exact (black) at every point" + (", waves dotted" if problem == "sod" else ""))
+    save(fig, path, caption=f"{problem}: each stage's Shapley error field at the finest mesh of each basis; they "
+                            "add up to e_MPM - e_exact (black) at every point"
+                            + (", waves dotted" if problem == "sod" else ""))
 
 
 if __name__ == "__main__":

@@ -15,12 +15,13 @@ import numpy as np
 from baselines import fem_burgers
 from baselines.exact.burgers import make_solution
 from mpm_fem.app import plots
+from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.measure import source
 from mpm_fem.measure.claims import BURGERS_SHOWN
 from mpm_fem.measure.errors import fitted_order, observed_orders, orders_row
-from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.measure.schema import BURGERS_LUMPING, BURGERS_ORDERS, BURGERS_PPC
 from mpm_fem.problems import burgers
-from mpm_fem.app.study import StudyOptions, publish, script_main
 
 NAME = "burgers"
 H = source.BURGERS_H
@@ -91,7 +92,8 @@ def _rounded(arrays: dict) -> dict:
 def method_case(method: str, solution: str, eps: float, h: float, **changes) -> dict:
     """The case of ``method`` (a key of :data:`METHODS`) with ``changes`` to its settings."""
     _, solver, fixed, _ = METHODS[method]
-    return {"solver": solver, "solution": solution, "eps": eps, "h": h, **(FEM if solver == "fem" else MPM), **fixed, **changes}
+    return {"solver": solver, "solution": solution, "eps": eps, "h": h, **(FEM if solver == "fem" else MPM), **fixed,
+            **changes}
 
 
 def _cost(case: dict) -> float:
@@ -106,21 +108,24 @@ def _cost(case: dict) -> float:
 
 def _plan(quick: bool) -> dict:
     q = QUICK if quick else {}
-    eps_list, skip, time_h, fem = q.get("eps", EPS), q.get("skip", ()), q.get("TIME_H", TIME_H), ("fem_consistent", "fem_lumped")
+    eps_list, skip, time_h = q.get("eps", EPS), q.get("skip", ()), q.get("TIME_H", TIME_H)
+    fem = ("fem_consistent", "fem_lumped")
     kept = lambda m, h: m not in skip and not (quick and (h not in q["H"] or (m in q["short"] and h not in q["H"][:2])))  # noqa: E731
     return {
         "table": {(s, m, e, h): method_case(m, s, e, h) for s in q.get("solutions", SOLUTIONS)
-                  for m, hs in MESHES["default" if s == DEFAULT else "other"].items() for e in eps_list for h in hs if kept(m, h)},
+                  for m, hs in MESHES["default" if s == DEFAULT else "other"].items()
+                  for e in eps_list for h in hs if kept(m, h)},
         "profile": {(m, e): {**method_case(m, DEFAULT, e, PROFILE_H), "profile": True}
                     for e in (EPS[0], EPS[-1]) if e in eps_list for m in METHODS if m not in skip},
         "timestep": {(m, e, k): method_case(m, DEFAULT, e, time_h, **({"refine": k} if k > 1 else {}))
-                     for e in q.get("time_eps", (EPS[0], EPS[-1])) for m in q.get("time_methods", _MPM + ("mpm_exact_dt_h",))
-                     for k in REFINE},
+                     for e in q.get("time_eps", (EPS[0], EPS[-1]))
+                     for m in q.get("time_methods", _MPM + ("mpm_exact_dt_h",)) for k in REFINE},
         "ppc": {(m, h, n): method_case(m, DEFAULT, EPS[0], h, ppc=n) for m in _MPM for h in q.get("PPC_H", PPC_H)
                 for n in q.get("PPC", PPC)},
-        "lumping": {**{(m, mass, h): method_case(m, DEFAULT, EPS[0], h, mass=mass, cfl=LUMPING_CFL) for h in q.get("lumping_H", H[:3])
-                       for m in _MPM for mass in ("lumped", "consistent")},
-                    **{(m, METHODS[m][2]["mass"], h): method_case(m, DEFAULT, EPS[0], h) for h in q.get("lumping_H", H[:3]) for m in fem}},
+        "lumping": {**{(m, mass, h): method_case(m, DEFAULT, EPS[0], h, mass=mass, cfl=LUMPING_CFL)
+                       for h in q.get("lumping_H", H[:3]) for m in _MPM for mass in ("lumped", "consistent")},
+                    **{(m, METHODS[m][2]["mass"], h): method_case(m, DEFAULT, EPS[0], h)
+                       for h in q.get("lumping_H", H[:3]) for m in fem}},
         "diagnosis": {(label, h): method_case("mpm_calculated", DEFAULT, EPS[0], h, **changes)
                       for h in q.get("diagnosis_H", H[:3]) for label, changes in DIAGNOSIS.items()},
     }
@@ -132,18 +137,22 @@ def run(options: StudyOptions) -> None:
     folder = options.folder(NAME)
     settings = {"quick": options.quick, "mpm": MPM, "fem": FEM, "T": T, "domain": [0, 2], "default_solution": DEFAULT,
                 "compared_norm": f"{NORM} over {WHERE}",
-                "methods": {k: {"label": v[0], "solver": v[1], "settings": v[2], "source_row": v[3]} for k, v in METHODS.items()},
+                "methods": {k: {"label": v[0], "solver": v[1], "settings": v[2], "source_row": v[3]}
+                            for k, v in METHODS.items()},
                 "time_steps": {
                     "mpm_calculated and mpm_exact": f"dt = CFL min(h/max|v_p|, h^2/(2 eps)), CFL {MPM['cfl']}",
-                    "mpm_exact_dt_h": f"dt = CFL h/max|v_p|, CFL {MPM['cfl']} (no viscous limit: no viscous force computed)",
-                    "fem": f"dt = min(cfl h/max|v(x,0)|, cfl_visc h^2/(2 eps)), cfl {FEM['cfl']}, cfl_visc {FEM['cfl_visc']}, SSP-RK3"},
+                    "mpm_exact_dt_h": f"dt = CFL h/max|v_p|, CFL {MPM['cfl']} "
+                                      "(no viscous limit: no viscous force computed)",
+                    "fem": f"dt = min(cfl h/max|v(x,0)|, cfl_visc h^2/(2 eps)), cfl {FEM['cfl']}, "
+                           f"cfl_visc {FEM['cfl_visc']}, SSP-RK3"},
                 "source_corrections": "exponents of the entries marked * in docs/claims.md moved by one power of ten",
                 "time_h": QUICK["TIME_H"] if options.quick else TIME_H, "problem": burgers.BurgersSettings().as_dict()}
     errors, orders = _errors(got)
-    tables = {"errors": errors, "orders": orders, "norms": _norms(got), "timestep": _timestep(got, settings["time_h"]),
-              "ppc": _ppc(got), "lumping": _lumping(got), "diagnosis": _diagnosis(got) if got.get("diagnosis") else []}
+    tables = {"errors": errors, BURGERS_ORDERS: orders, "norms": _norms(got),
+              "timestep": _timestep(got, settings["time_h"]), BURGERS_PPC: _ppc(got), BURGERS_LUMPING: _lumping(got),
+              "diagnosis": _diagnosis(got) if got.get("diagnosis") else []}
     extra = {"timestep": {"refine": list(REFINE), "meaning": "time_error = |E(dt) - E(dt/16)|; time_below_space: time "
-                          "error < E(dt/16) (the space error)"}, "lumping": {"mpm_cfl": LUMPING_CFL},
+                          "error < E(dt/16) (the space error)"}, BURGERS_LUMPING.stem: {"mpm_cfl": LUMPING_CFL},
              "diagnosis": {"diagnosis": dict(DIAGNOSIS), "solution": DEFAULT}}
     publish(folder, tables, settings, extra, PLOTS)
     _profiles(folder / "profiles.png", got)
@@ -163,9 +172,11 @@ def _errors(got: dict) -> tuple[list, list]:
     for (sol, m, eps, h), r in sorted(got["table"].items(), key=key):
         src = source.burgers_value(METHODS[m][3], eps, h)
         row = {"solution": sol, "method": m, "eps": eps, "h": h, **_norms_of(r)}
-        row.update({"source": src if src is not None else "", "source_corrected": "yes" if (METHODS[m][3], eps, h) in CORRECTED else "",
+        row.update({"source": src if src is not None else "",
+                    "source_corrected": "yes" if (METHODS[m][3], eps, h) in CORRECTED else "",
                     f"ratio_{WHERE}_{NORM}": row[f"{WHERE}_{NORM}"] / src if src else "",
-                    "steps": r.get("steps", ""), "dt": r.get("dt", ""), "particles": r.get("n_p", ""), "error": r.get("error", "")})
+                    "steps": r.get("steps", ""), "dt": r.get("dt", ""), "particles": r.get("n_p", ""),
+                    "error": r.get("error", "")})
         rows.append(row)
         series[(sol, m, eps)][h] = row
     for (sol, m, eps), by_h in series.items():
@@ -175,7 +186,8 @@ def _errors(got: dict) -> tuple[list, list]:
             for norm in ("L1", "L2", "max"):
                 v = np.array([by_h[h][f"{where}_{norm}"] for h in hs])
                 if len(hs) > 1 and np.all(np.isfinite(v) & (v > 0)):
-                    order_rows.append({"solution": sol, "method": m, "eps": eps, "where": where, "norm": norm, **orders_row(hs, v),
+                    order_rows.append({"solution": sol, "method": m, "eps": eps, "where": where, "norm": norm,
+                                       **orders_row(hs, v),
                                        **({"source_fitted": fitted_order(hs, src)} if None not in src else {})})
     return rows, order_rows
 
@@ -186,7 +198,8 @@ def _norms(got: dict) -> list[dict]:
     groups = defaultdict(list)
     for (sol, m, eps, h), r in got["table"].items():
         src = source.burgers_value(METHODS[m][3], eps, h)
-        for (where, norm), v in ({} if src is None else {tuple(k.split("_")): v for k, v in _norms_of(r).items()}).items():
+        measured = {} if src is None else {tuple(k.split("_")): v for k, v in _norms_of(r).items()}
+        for (where, norm), v in measured.items():
             if np.isfinite(v) and v > 0:
                 groups[(sol, m, where, norm)].append((eps, h, v, src))
     rows = []
@@ -194,11 +207,12 @@ def _norms(got: dict) -> list[dict]:
         ratio = np.array([v / s for _, _, v, s in vals])
         finest = min(h for _, h, _, _ in vals)
         fine = [(v, s) for _, h, v, s in vals if h == finest]
-        spread = lambda xs: float(max(xs) / min(xs)) if len(fine) > 1 else ""  # noqa: E731
+        spread = lambda xs, fine=fine: float(max(xs) / min(xs)) if len(fine) > 1 else ""  # noqa: E731
         rows.append({"solution": sol, "method": m, "where": where, "norm": norm, "cells": len(vals),
                      "median_ratio": float(np.median(ratio)), "ratio_spread": float(ratio.max() / ratio.min()),
                      "log10_ratio_rms": float(np.sqrt(np.mean(np.log10(ratio) ** 2))),
-                     "eps_spread_finest": spread([v for v, _ in fine]), "source_eps_spread_finest": spread([s for _, s in fine]),
+                     "eps_spread_finest": spread([v for v, _ in fine]),
+                     "source_eps_spread_finest": spread([s for _, s in fine]),
                      "finest_h": finest})
     return rows
 
@@ -212,13 +226,15 @@ def _timestep(got: dict, time_h: float) -> list[dict]:
             v, ref = _value(r, WHERE, norm), _value(finest, WHERE, norm)
             row.update({f"{WHERE}_{norm}": v, f"time_error_{norm}": abs(v - ref) if k != REFINE[-1] else ""})
         ref = _value(finest, WHERE, NORM)
-        row["time_below_space"] = ("yes" if abs(row[f"{WHERE}_{NORM}"] - ref) < ref else "no") if k != REFINE[-1] else ""
+        row["time_below_space"] = (("yes" if abs(row[f"{WHERE}_{NORM}"] - ref) < ref else "no")
+                                   if k != REFINE[-1] else "")
         rows.append(row)
     return rows
 
 
 def _ppc(got: dict) -> list[dict]:
-    rows = [{"method": m, "eps": EPS[0], "h": h, "ppc": n, **_norms_of(r), "steps": r.get("steps", ""), "error": r.get("error", "")}
+    rows = [{"method": m, "eps": EPS[0], "h": h, "ppc": n, **_norms_of(r), "steps": r.get("steps", ""),
+             "error": r.get("error", "")}
             for (m, h, n), r in sorted(got["ppc"].items(), key=lambda kv: (kv[0][0], -kv[0][1], kv[0][2]))]
     for m, h in {(r["method"], r["h"]) for r in rows}:
         sub = [r for r in rows if r["method"] == m and r["h"] == h and np.isfinite(r[f"{WHERE}_{NORM}"])]
@@ -235,31 +251,35 @@ def _lumping(got: dict) -> list[dict]:
 
 
 def _diagnosis(got: dict) -> list[dict]:
-    rows = [{"variant": label, "changes": repr(DIAGNOSIS[label]), "eps": EPS[0], "h": h, **_norms_of(r), "error": r.get("error", "")}
+    rows = [{"variant": label, "changes": repr(DIAGNOSIS[label]), "eps": EPS[0], "h": h, **_norms_of(r),
+             "error": r.get("error", "")}
             for (label, h), r in got["diagnosis"].items()]
     for label in DIAGNOSIS:
         sub = sorted((r for r in rows if r["variant"] == label), key=lambda r: -r["h"])
         v = np.array([r[f"{WHERE}_L1"] for r in sub])
         if len(sub) > 1 and np.all(np.isfinite(v) & (v > 0)):
-            for r, o in zip(sub[1:], observed_orders([r["h"] for r in sub], v)):
+            for r, o in zip(sub[1:], observed_orders([r["h"] for r in sub], v), strict=True):
                 r["order_L1"] = float(o)
     return rows
 
 
-STYLE = {"mpm_calculated": ("o-", "tab:blue"), "mpm_calculated_16": ("o--", "tab:purple"), "mpm_exact": ("s-", "tab:orange"),
-         "mpm_exact_dt_h": ("D-", "tab:red"), "fem_consistent": ("^--", "tab:green"), "fem_lumped": ("v--", "tab:olive")}
+STYLE = {"mpm_calculated": ("o-", "tab:blue"), "mpm_calculated_16": ("o--", "tab:purple"),
+         "mpm_exact": ("s-", "tab:orange"), "mpm_exact_dt_h": ("D-", "tab:red"),
+         "fem_consistent": ("^--", "tab:green"), "fem_lumped": ("v--", "tab:olive")}
 
 
 def _curves(methods, label="{m}", y=None, group=(), **where) -> tuple[Curve, ...]:
     """A curve per method in its style (``{m}`` in ``label``: its name); ``y`` defaults to the compared
     norm (FEM: over nodes)."""
     return tuple(Curve(label.replace("{m}", METHODS[m][0]), y or f"{'nodes' if m.startswith('fem') else WHERE}_{NORM}",
-                       STYLE[m][0], {**where, "method": m}, group=group, options={"color": STYLE[m][1]}) for m in methods)
+                       STYLE[m][0], {**where, "method": m}, group=group, options={"color": STYLE[m][1]})
+                 for m in methods)
 
 
 def _beside_source(**where) -> tuple[Curve, ...]:
+    sources = (("exact", "ks", "mpm_exact_dt_h"), ("calculated", "ko", "mpm_calculated"))
     return _curves(METHODS, **where) + tuple(Curve(f"source, {row} a", "source", fmt, {**where, "method": m})
-                                             for row, fmt, m in (("exact", "ks", "mpm_exact_dt_h"), ("calculated", "ko", "mpm_calculated")))
+                                             for row, fmt, m in sources)
 
 
 _ERROR = dict(ylabel=f"velocity error ({NORM}; MPM over {WHERE}, FEM over nodes)", slopes=(1, 2))
@@ -267,14 +287,16 @@ PLOTS = (
     Plot("convergence.png", f"Burgers, T = {T}: velocity error against h ({DEFAULT} solution), open black: the source",
          "errors", "h", _beside_source(solution=DEFAULT), split=("eps",), size=(4.2, 4.0), **_ERROR),
     Plot("solutions.png", "Every candidate exact solution: velocity error against h", "errors", "h",
-         _beside_source(eps=(EPS[0], EPS[-1])), split=("eps", "solution"), ncols=len(SOLUTIONS), size=(4.2, 3.8), **_ERROR),
-    Plot("ppc.png", f"C3, Burgers: error against N_p ({DEFAULT}, eps = {EPS[0]})", "ppc", "ppc",
+         _beside_source(eps=(EPS[0], EPS[-1])), split=("eps", "solution"), ncols=len(SOLUTIONS), size=(4.2, 3.8),
+         **_ERROR),
+    Plot("ppc.png", f"C3, Burgers: error against N_p ({DEFAULT}, eps = {EPS[0]})", BURGERS_PPC.stem, "ppc",
          _curves(_MPM, "{m}, h = {h}", group=("h",)), xlabel="particles per cell N_p", ylabel=_ERROR["ylabel"]),
-    Plot("lumping.png", f"C15: lumped against consistent mass ({DEFAULT}, eps = {EPS[0]}; MPM CFL {LUMPING_CFL})", "lumping",
-         "h", _curves(_MPM + ("fem_consistent", "fem_lumped"), "{m}, {mass}", "L2", ("mass",)), **{**_ERROR, "ylabel": "velocity error (L2)"}),
+    Plot("lumping.png", f"C15: lumped against consistent mass ({DEFAULT}, eps = {EPS[0]}; MPM CFL {LUMPING_CFL})",
+         BURGERS_LUMPING.stem, "h", _curves(_MPM + ("fem_consistent", "fem_lumped"), "{m}, {mass}", "L2", ("mass",)),
+         **{**_ERROR, "ylabel": "velocity error (L2)"}),
     Plot("timestep.png", f"Time error at fixed h: dt / {', '.join(map(str, REFINE))}", "timestep", "dt",
-         _curves(_MPM + ("mpm_exact_dt_h",), "{m}, eps = {eps}", group=("eps",)), xlabel="dt (smallest step of the run)",
-         ylabel=_ERROR["ylabel"]),
+         _curves(_MPM + ("mpm_exact_dt_h",), "{m}, eps = {eps}", group=("eps",)),
+         xlabel="dt (smallest step of the run)", ylabel=_ERROR["ylabel"]),
     Plot("diagnosis.png", f"Why the calculated acceleration stalls ({DEFAULT}, eps = {EPS[0]}): one change at a time",
          "diagnosis", "h", (Curve("{variant}", f"{WHERE}_L1", "o-", group=("variant",)),),
          ylabel=f"velocity error (L1 over {WHERE})", slopes=(1, 2), size=(6.2, 4.6)),
@@ -294,7 +316,8 @@ def _profiles(path, got) -> None:
             rows[row].append((METHODS[m][0], x, {"velocity": u, "error at T": u - v(x, T)}, "." if mpm else "-",
                               {"ms" if mpm else "lw": 1.5 if mpm else 0.9, "color": STYLE[m][1]}))
     if rows:
-        plots.profile_grid(path, exact, rows, f"{DEFAULT} solution at T = {T}, h = {PROFILE_H}: particles (MPM), nodes (FEM)")
+        plots.profile_grid(path, exact, rows,
+                           f"{DEFAULT} solution at T = {T}, h = {PROFILE_H}: particles (MPM), nodes (FEM)")
 
 
 if __name__ == "__main__":

@@ -12,8 +12,9 @@ also with the volumes ``V_p`` the run carries. Hickernell's ``D2`` and bound
 
 Tables (``figures/projection/``): ``errors.csv`` (quantity, layout, weights, N_p, h, norm, value,
 spread), ``orders.csv`` (least-squares order over all h, the orders between the two coarsest and
-the two finest meshes and between every pair of successive meshes, the source's band, inside), ``d2.csv``, ``d2_constant.csv`` (the C of
-``D2 ~ [1/(12 N^2) + C h^2]^{1/2}``), ``bounds.csv`` (smallest bound/error ratio). Figures:
+the two finest meshes and between every pair of successive meshes, the source's band, inside),
+``d2.csv``, ``d2_constant.csv`` (the C of ``D2 ~ [1/(12 N^2) + C h^2]^{1/2}``), ``bounds.csv``
+(smallest bound/error ratio). Figures:
 ``errors_vs_h.png``, ``errors_vs_h_random.png``, ``d2.png``, ``hickernell.png``.
 """
 
@@ -25,15 +26,24 @@ from pathlib import Path
 
 import numpy as np
 
-from mpm_fem.measure.errors import fitted_order, observed_orders
-from mpm_fem.core.grid import uniform_grid
-from mpm_fem.measure.projection import QUANTITIES, Advection, cell_weights, layout, projection_errors, quadrature_checks, smooth_fields
-from mpm_fem.measure.quadrature import cell_points, discrepancy_d2, estimate_c, expected_offset, offset_term
 from mpm_fem.app import plots
-from mpm_fem.measure.claims import BAND_TOLERANCE
 from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.app.study import StudyOptions, publish, script_main
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.measure.claims import BAND_TOLERANCE
+from mpm_fem.measure.errors import fitted_order, observed_orders
+from mpm_fem.measure.projection import (
+    QUANTITIES,
+    Advection,
+    cell_weights,
+    layout,
+    projection_errors,
+    quadrature_checks,
+    smooth_fields,
+)
+from mpm_fem.measure.quadrature import cell_points, discrepancy_d2, estimate_c, expected_offset, offset_term
+from mpm_fem.measure.schema import PROJECTION_BOUNDS, PROJECTION_D2_CONSTANT, PROJECTION_ORDERS
 from mpm_fem.measure.source import D2_C, PROJECTION_BANDS, band_text
-from mpm_fem.app.study import StudyOptions, script_main, write_table
 
 NAME = "projection"
 CELLS = [10 * 2**k for k in range(9)]  # h = 1/10 ... 1/2560
@@ -108,10 +118,11 @@ def tables(results: list[tuple[dict, dict]]) -> dict[str, list[dict]]:
             bounds[(check, c["layout"], c["ppc"], c["cells"])].append(b)
 
     error_rows = []
-    for (q, lay, weights, basis, n, k, norm), v in sorted(errs.items(), key=lambda kv: (QUANTITIES.index(kv[0][0]),) + kv[0][1:]):
+    by_quantity = sorted(errs.items(), key=lambda kv: (QUANTITIES.index(kv[0][0]),) + kv[0][1:])
+    for (q, lay, weights, basis, n, k, norm), v in by_quantity:
         v = np.asarray(v)
-        error_rows.append({"quantity": q, "layout": lay, "weights": weights, "basis": basis, "N_p": n, "h": 1.0 / k, "norm": norm,
-                           "value": float(v.mean()), "spread": float(v.std()), "min": float(v.min()),
+        error_rows.append({"quantity": q, "layout": lay, "weights": weights, "basis": basis, "N_p": n, "h": 1.0 / k,
+                           "norm": norm, "value": float(v.mean()), "spread": float(v.std()), "min": float(v.min()),
                            "max": float(v.max()), "seeds": int(v.size)})
 
     series = defaultdict(dict)  # (layout, weights, basis, N_p, norm) -> {quantity: (h, values)}
@@ -133,13 +144,14 @@ def tables(results: list[tuple[dict, dict]]) -> dict[str, list[dict]]:
 
     d2_rows = []
     for (lay, n, k), ds in sorted(d2s.items()):
-        mean = lambda key: float(np.mean([d[key] for d in ds]))  # noqa: E731
+        mean = lambda key, ds=ds: float(np.mean([d[key] for d in ds]))  # noqa: E731
         expected = expected_offset(lay, n) if lay != "advected" else float("nan")
         d2_rows.append({"layout": lay, "N_p": n, "h": 1.0 / k, "D2_mean": mean("mean"),
                         "D2_min": float(min(d["min"] for d in ds)), "D2_max": float(max(d["max"] for d in ds)),
                         "D2_times_N": mean("mean") * n, "delta_mean": mean("delta_mean"), "delta_expected": expected,
                         "empty_cells": int(max(d["empty_cells"] for d in ds)),
-                        "count_min": int(min(d["count_min"] for d in ds)), "count_max": int(max(d["count_max"] for d in ds)),
+                        "count_min": int(min(d["count_min"] for d in ds)),
+                        "count_max": int(max(d["count_max"] for d in ds)),
                         "seeds": len(ds)})
 
     c_rows = []
@@ -158,8 +170,10 @@ def tables(results: list[tuple[dict, dict]]) -> dict[str, list[dict]]:
     for (check, lay, n, k), bs in sorted(bounds.items()):
         bound_rows.append({"check": check, "layout": lay, "N_p": n, "h": 1.0 / k,
                            "min_ratio": float(min(b["min_ratio"] for b in bs)),
-                           "entries": int(sum(b["entries"] for b in bs)), "holds": "yes" if min(b["min_ratio"] for b in bs) >= 1 else "no"})
-    return {"errors": error_rows, "orders": order_rows, "d2": d2_rows, "d2_constant": c_rows, "bounds": bound_rows}
+                           "entries": int(sum(b["entries"] for b in bs)),
+                           "holds": "yes" if min(b["min_ratio"] for b in bs) >= 1 else "no"})
+    return {"errors": error_rows, PROJECTION_ORDERS.stem: order_rows, "d2": d2_rows,
+            PROJECTION_D2_CONSTANT.stem: c_rows, PROJECTION_BOUNDS.stem: bound_rows}
 
 
 def settings(options: StudyOptions) -> dict:
@@ -184,11 +198,11 @@ def run(options: StudyOptions) -> None:
     folder = options.folder(NAME)
     cs = cases(options)
     results = options.sweep(NAME, case, cs)
-    t = tables(list(zip(cs, results)))
+    t = tables(list(zip(cs, results, strict=True)))
     s = settings(options)
-    for name, rows in t.items():
-        write_table(folder, name, rows, s)
-    figures(folder, t, [(c, r) for c, r in zip(cs, results)])
+    declared = {table.stem: table for table in (PROJECTION_ORDERS, PROJECTION_D2_CONSTANT, PROJECTION_BOUNDS)}
+    publish(folder, {declared.get(name, name): rows for name, rows in t.items()}, s)
+    figures(folder, t, [(c, r) for c, r in zip(cs, results, strict=True)])
 
 
 # ----------------------------------------------------------------------------- figures
@@ -196,17 +210,20 @@ def run(options: StudyOptions) -> None:
 COLORS = {"regular": "tab:blue", "jittered": "tab:orange", "random": "tab:green", "advected": "tab:red"}
 
 N_SHOW = 4  # the particle count of the per-layout figure (in every plan)
-_VARIANT = {("cell", "mpm"): ("", "o-"), ("volume", "mpm"): (", V_p weights", "s--"), ("volume", "gimp"): (", GIMP, V_p", "^:")}
+_VARIANT = {("cell", "mpm"): ("", "o-"), ("volume", "mpm"): (", V_p weights", "s--"),
+            ("volume", "gimp"): (", GIMP, V_p", "^:")}
 _PANELS = dict(split=("quantity",), ncols=3, slopes=(1, 2), ylabel="error (L1; E_VG over particles)", size=(4.0, 3.5))
 PLOTS = (
-    Plot("errors_vs_h.png", f"Projection errors against h, N_p = {N_SHOW} (mean over seeds): point mass with the slides' "
-         "weights h/N_p^i unless marked", "errors", "h", tuple(
+    Plot("errors_vs_h.png", f"Projection errors against h, N_p = {N_SHOW} (mean over seeds): point mass with the "
+         "slides' weights h/N_p^i unless marked", "errors", "h", tuple(
              Curve(lay + suffix, "value", fmt, {"layout": lay, "weights": w, "basis": b, "N_p": N_SHOW, "norm": "L1"},
                    options={"color": COLORS[lay]})
-             for lay in LAYOUT_NAMES for (w, b), (suffix, fmt) in _VARIANT.items() if b == "mpm" or lay in ("advected", "random")),
+             for lay in LAYOUT_NAMES for (w, b), (suffix, fmt) in _VARIANT.items()
+             if b == "mpm" or lay in ("advected", "random")),
          **_PANELS),
     Plot("errors_vs_h_random.png", "Projection errors against h, random layouts (mean over seeds), one line per N_p",
-         "errors", "h", (Curve("N_p = {N_p}", "value", "o-", {"layout": "random", "basis": "mpm", "norm": "L1"}, group=("N_p",)),),
+         "errors", "h", (Curve("N_p = {N_p}", "value", "o-", {"layout": "random", "basis": "mpm", "norm": "L1"},
+                               group=("N_p",)),),
          **_PANELS),
 )
 
@@ -238,21 +255,23 @@ def figures(folder: Path, t: dict, results: list) -> None:
     a1.set_title("D2 vs N_p; lines: the closed forms with the expected offsets", fontsize=9)
     a1.legend(fontsize=7)
     hh = np.array(sorted({r["h"] for r in d2}))
-    for c, ls in zip(SLIDES_C, ("--", "-.")):
+    for c, ls in zip(SLIDES_C, ("--", "-."), strict=True):
         a2.loglog(hh, np.sqrt(1 / (12 * n_show**2) + c * hh**2), ls, color="gray", lw=0.9,
                   label=f"slides: [1/(12N^2) + {c:.3g} h^2]^1/2")
     a2.set_xlabel("h")
     a2.set_ylabel(f"mean D2 over cells (N_p = {n_show})")
     a2.set_title("D2 vs h: scale-free, no h-dependence", fontsize=9)
     a2.legend(fontsize=7)
-    plots.save(fig, folder / "d2.png", caption="D2 against N_p and against h, beside the closed forms and the slides' formula")
+    plots.save(fig, folder / "d2.png",
+               caption="D2 against N_p and against h, beside the closed forms and the slides' formula")
 
     # measured quadrature error against Hickernell's bound
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
     labels = {"cell_rho": "cell mean of rho: bound (1)", "node_m": "nodal mass E_m^i: two-cell bound",
               "node_F": "nodal force E_F^i: two-cell bound"}
-    smallest = {r["check"]: min(x["min_ratio"] for x in t["bounds"] if x["check"] == r["check"]) for r in t["bounds"]}
-    for ax, check in zip(axes, labels):
+    bounds = t[PROJECTION_BOUNDS.stem]
+    smallest = {r["check"]: min(x["min_ratio"] for x in bounds if x["check"] == r["check"]) for r in bounds}
+    for ax, check in zip(axes, labels, strict=True):
         lo, hi = np.inf, 0.0
         for lay in LAYOUT_NAMES:
             pts = np.array([p for c, r in results if c["layout"] == lay for p in r["bounds"][check]["sample"]])
@@ -266,7 +285,8 @@ def figures(folder: Path, t: dict, results: list) -> None:
         ax.set_ylabel("|measured error|")
         ax.set_title(f"{labels[check]}\nsmallest bound/error = {smallest[check]:.3g}", fontsize=9)
         ax.legend(fontsize=7, markerscale=3)
-    plots.save(fig, folder / "hickernell.png", caption="Measured quadrature error against Hickernell's bound on every cell and node")
+    plots.save(fig, folder / "hickernell.png",
+               caption="Measured quadrature error against Hickernell's bound on every cell and node")
 
 
 if __name__ == "__main__":

@@ -39,15 +39,17 @@ from pathlib import Path
 import numpy as np
 
 from baselines import fem_euler, fv_euler
-from mpm_fem.measure.claims import PLATEAU_ORDER, remedy_assessment, successive_orders
-from mpm_fem.measure.errors import norms
+from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import PositivityError
-from mpm_fem.problems import burgers, sod
-from mpm_fem.app.plots import Curve, Plot
+from mpm_fem.measure.claims import PLATEAU_ORDER, remedy_assessment, successive_orders
+from mpm_fem.measure.errors import norms
+from mpm_fem.measure.schema import REMEDIES_ERRORS
 from mpm_fem.measure.shock_tube import exact_density
-from mpm_fem.app.study import StudyOptions, publish, script_main
-from studies.sod import FEM, FV, H, MPM as SOD_MPM
+from mpm_fem.problems import burgers, sod
+from studies.sod import FEM, FV, H
+from studies.sod import MPM as SOD_MPM
 
 NAME = "remedies"
 SOD_H = H[:7]  # 0.01 ... 0.00015625; each remedy runs the first SOD_MESHES[name] of them (docstring)
@@ -88,7 +90,8 @@ def run_case(case: dict) -> dict:
             r = fv_euler.solve(h, cfl=FV["cfl"], limiter=FV["limiter"])
             x, w = r.centres, np.full(r.centres.size, h)
         e = norms(r.rho - exact_density(x, r.t), w)
-        return {"ok": True, "nodes": e, "steps": r.steps, "work": r.steps * x.size, "wall_s": time.perf_counter() - start}
+        return {"ok": True, "nodes": e, "steps": r.steps, "work": r.steps * x.size,
+                "wall_s": time.perf_counter() - start}
     changes = {k: v for k, v in case.items() if k not in ("solver", "h")}
     try:
         if solver == "sod":
@@ -103,7 +106,8 @@ def run_case(case: dict) -> dict:
         return {"ok": False, "error": str(err)}
     n = int(result.particles.n)
     return {"ok": True, "nodes": e["nodes"], "particles": e["particles"], "steps": result.steps, "n_p": n,
-            "work": result.steps * n, "volume_drift": float(result.particles.volume.sum() - 1.0) if solver == "sod" else "",
+            "work": result.steps * n,
+            "volume_drift": float(result.particles.volume.sum() - 1.0) if solver == "sod" else "",
             "wall_s": time.perf_counter() - start}
 
 
@@ -140,7 +144,7 @@ def run(options: StudyOptions) -> None:
                 "fv": FV,
                 "criterion": {"plateau_order": PLATEAU_ORDER}, "quick": options.quick}
     rows, cost = _errors(got), _cost_rows(got)
-    publish(folder, {"errors": rows, "orders": _summary(rows), "cost": cost}, settings, figures=PLOTS)
+    publish(folder, {REMEDIES_ERRORS: rows, "orders": _summary(rows), "cost": cost}, settings, figures=PLOTS)
     _cost_figure(folder, cost)
 
 
@@ -157,7 +161,8 @@ def _errors(got) -> list[dict]:
             series = []
             for h in hs:
                 r = got[problem][(name, h)]
-                row = {"problem": problem, "remedy": name, "h": h, "quantity": "density" if problem == "sod" else "velocity"}
+                row = {"problem": problem, "remedy": name, "h": h,
+                       "quantity": "density" if problem == "sod" else "velocity"}
                 for where in ("nodes", "particles"):
                     for norm in ("L1", "L2"):
                         row[f"{where}_{norm}"] = _l(r, where, norm)
@@ -187,7 +192,8 @@ def _summary(rows) -> list[dict]:
             verdict = "not run on every mesh" if last["h"] != finest else "yes" if s["removes_plateau"] else "no"
             out.append({"problem": problem, "remedy": name, "h_finest": last["h"],
                         "finest_nodes_L1": last["nodes_L1"], "finest_particles_L1": last["particles_L1"],
-                        **{k: s[k] for k in s if k != "meshes" and not (problem == "burgers" and k.startswith("max_fv"))},
+                        **{k: s[k] for k in s
+                           if k != "meshes" and not (problem == "burgers" and k.startswith("max_fv"))},
                         "removes_plateau": verdict})
     return out
 
@@ -208,7 +214,7 @@ def _cost_rows(got) -> list[dict]:
 _SOD, _FV = {"problem": "sod"}, {"problem": "sod", "remedy": "MPM"}
 PLOTS = (
     Plot("errors.png", "E5: L1 error against h for each remedy; Sod density with the FV reference, Burgers velocity",
-         "errors", "h", (
+         REMEDIES_ERRORS.stem, "h", (
              Curve("{remedy}", "nodes_L1", where=_SOD, panel="Sod density, grid nodes", group=("remedy",)),
              Curve("FV reference", "fv_L1", "k--", where=_FV, panel="Sod density, grid nodes"),
              Curve("{remedy}", "particles_L1", where=_SOD, panel="Sod density, particles", group=("remedy",)),
@@ -221,14 +227,15 @@ PLOTS = (
 
 def _cost_figure(folder: Path, cost) -> None:
     """Sod density L1 against work and against wall time, one line per method (``cost.png``)."""
-    from mpm_fem.app import plots
     import matplotlib.pyplot as plt
+
+    from mpm_fem.app import plots
 
     fig, axes = plt.subplots(1, 2, figsize=(13, 4.4))
     for method in dict.fromkeys(r["method"] for r in cost):
         s = sorted((r for r in cost if r["method"] == method), key=lambda r: -r["h"])
         style = "k*--" if method.startswith("FV") else "ks:" if method.startswith("FEM") else "o-"
-        for ax, x in zip(axes, ("work", "wall_s")):
+        for ax, x in zip(axes, ("work", "wall_s"), strict=True):
             ax.loglog([r[x] for r in s], [r["density_L1"] for r in s], style, ms=3, label=method)
     axes[0].set(xlabel="particle-steps (MPM) or node/cell-steps", ylabel="Sod density L1 (nodes / cells)")
     axes[1].set(xlabel="wall time [s] (one run, shared machine)", ylabel="Sod density L1 (nodes / cells)")

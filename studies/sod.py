@@ -15,21 +15,23 @@ import numpy as np
 from baselines import fem_euler, fv_euler
 from baselines.exact import riemann
 from mpm_fem.app import plots
-from mpm_fem.measure import shock_tube, source
-from mpm_fem.measure.errors import orders_column
-from mpm_fem.core.grid import uniform_grid
-from mpm_fem.core.particles import PositivityError
-from mpm_fem.problems import sod
-from mpm_fem.measure.regions import REGION_NAMES, ExtremaCounter, describe
 from mpm_fem.app.plots import Curve, Plot
 from mpm_fem.app.study import StudyOptions, publish, script_main
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.particles import PositivityError
+from mpm_fem.measure import shock_tube, source
+from mpm_fem.measure.errors import orders_column
+from mpm_fem.measure.regions import REGION_NAMES, ExtremaCounter, describe
+from mpm_fem.measure.schema import SOD_CONVERGENCE, SOD_EXTREMA, SOD_MASS, SOD_PPC, SOD_REGIONS
+from mpm_fem.problems import sod
 
 NAME = "sod"
 H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625, 0.000078125)  # the source's meshes and two finer
 SOURCE = source.SOD
 T = sod.SodSettings.T
 # One set of MPM settings for every h (never tuned per mesh); why these: ppc.csv and plateau.csv
-MPM = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", scheme="usl", basis="mpm", layout="regular", seed=0)
+MPM = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", scheme="usl", basis="mpm",
+           layout="regular", seed=0)
 # E3: FEM with the baselines.fem_euler defaults (viscosity on every cell); FV with the stronger of its limiters
 FEM = dict(cfl=0.3, viscosity_linear=0.1, viscosity_quadratic=1.0, compression_only=False)
 FV = dict(cfl=0.8, limiter="mc")
@@ -41,8 +43,8 @@ CONSISTENT_H = H[:4]  # the consistent particle mass costs ~2x: the two finest m
 PLATEAU_H = (0.0025, 0.00125)
 PLATEAU_VARIANTS = {"study settings": {}, "CFL 0.025": {"cfl": 0.025}, "CFL 0.1": {"cfl": 0.1}, "8 ppc": {"ppc": 8},
                     "32 ppc": {"ppc": 32}, "viscosity x0.5": {"av_linear": 0.25, "av_quadratic": 1.0},
-                    "viscosity x2": {"av_linear": 1.0, "av_quadratic": 4.0}, "USF": {"scheme": "usf"}, "MUSL": {"scheme": "musl"},
-                    "GIMP": {"basis": "gimp"}, "consistent mass": {"mass": "consistent"}}
+                    "viscosity x2": {"av_linear": 1.0, "av_quadratic": 4.0}, "USF": {"scheme": "usf"},
+                    "MUSL": {"scheme": "musl"}, "GIMP": {"basis": "gimp"}, "consistent mass": {"mass": "consistent"}}
 QUICK = dict(H=H[:3], PPC_H=(0.01,), CONSISTENT_H=H[:2], PLATEAU_H=())
 
 
@@ -110,17 +112,18 @@ def run(options: StudyOptions) -> None:
     """All cases in one sweep (shared ones run once), then tables and figures."""
     got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
     folder = options.folder(NAME)
-    settings = {"mpm": MPM, "fem": {**FEM, "viscosity": _viscosity(FEM).name}, "fv": {**FV, "scheme": fv_euler.label(FV["limiter"])},
-                "region_half_width": REGION_HALF_WIDTH, "T": T,
+    settings = {"mpm": MPM, "fem": {**FEM, "viscosity": _viscosity(FEM).name},
+                "fv": {**FV, "scheme": fv_euler.label(FV["limiter"])}, "region_half_width": REGION_HALF_WIDTH, "T": T,
                 "quick": options.quick, "problem": sod.SodSettings().as_dict()}
-    tables = {"convergence": _convergence(got), "regions": _regions(got), "extrema": _extrema(got), "ppc": _ppc(got),
-              "mass": _mass(got), "plateau": _plateau(got) if got["plateau"] else []}
+    tables = {SOD_CONVERGENCE: _convergence(got), SOD_REGIONS: _regions(got), SOD_EXTREMA: _extrema(got),
+              SOD_PPC: _ppc(got), SOD_MASS: _mass(got), "plateau": _plateau(got) if got["plateau"] else []}
     waves = riemann.wave_positions(T, sod.SodSettings.left, sod.SodSettings.right)
-    extra = {"regions": {"regions": describe(REGION_HALF_WIDTH, waves, T)}, "extrema": {
+    extra = {SOD_REGIONS.stem: {"regions": describe(REGION_HALF_WIDTH, waves, T)}, SOD_EXTREMA.stem: {
         "rtol": 1e-9, "definition": "new strict local extremum among position-ordered particles"}}
     publish(folder, tables, settings, extra, PLOTS)
-    plots.stacked_shares(folder / "regions.png", tables["regions"], REGION_NAMES, f"C12: density L1 error by region of "
-                         f"the exact solution at T = {T} (half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
+    plots.stacked_shares(folder / "regions.png", tables[SOD_REGIONS], REGION_NAMES,
+                         f"C12: density L1 error by region of the exact solution at T = {T} "
+                         f"(half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
     _profiles(folder, got)
 
 
@@ -136,10 +139,10 @@ def _convergence(got) -> list[dict]:
                  for m, where in (("fem_consistent", "nodes"), ("fem_lumped", "nodes"), ("fv", "cells"))})
     orders = {k: orders_column(hs, v) for k, v in cols.items()}
     in_source = [h for h in hs if h in SOURCE]  # meshes finer than the source's have no source value
-    src_orders = dict(zip(in_source, orders_column(in_source, [SOURCE[h][0] for h in in_source])))
+    src_orders = dict(zip(in_source, orders_column(in_source, [SOURCE[h][0] for h in in_source]), strict=True))
     rows = []
-    for k, (h, r) in enumerate(zip(hs, mpm)):
-        s = dict(zip(("L1", "L2"), SOURCE.get(h, ("", ""))))
+    for k, (h, r) in enumerate(zip(hs, mpm, strict=True)):
+        s = dict(zip(("L1", "L2"), SOURCE.get(h, ("", "")), strict=True))
         row = {"h": h, "source_L1": s["L1"], "source_L2": s["L2"], "source_order_L1": src_orders.get(h, "")}
         for key in ("nodes_L1", "nodes_L2", "particles_L1", "particles_L2"):
             row.update({f"mpm_{key}": cols[key][k], f"ratio_{key}": cols[key][k] / s[key[-2:]] if h in SOURCE else ""})
@@ -166,7 +169,8 @@ def _regions(got) -> list[dict]:
             if r["ok"]:
                 parts, total = np.asarray(r["regions"][where]), r["density"][where]["L1"]
                 rows.append({"method": label, "h": h, "L1": total, "sum_of_regions": float(parts.sum()),
-                             **{f"L1_{k}_{n.replace(' ', '_')}": float(p) for k, (n, p) in enumerate(zip(REGION_NAMES, parts))},
+                             **{f"L1_{k}_{n.replace(' ', '_')}": float(p)
+                                for k, (n, p) in enumerate(zip(REGION_NAMES, parts, strict=True))},
                              **{f"share_{k}": float(p / total) for k, p in enumerate(parts)}})
     return rows
 
@@ -176,12 +180,14 @@ def _extrema(got) -> list[dict]:
     for h, r in sorted(got["mpm"].items(), reverse=True):
         if r["ok"]:
             x = r["extrema"]
-            row = {"h": h, "steps": x["steps"], "crossings": x["crossings"], "crossings_per_step": x["crossings"] / x["steps"]}
+            row = {"h": h, "steps": x["steps"], "crossings": x["crossings"],
+                   "crossings_per_step": x["crossings"] / x["steps"]}
             for name in ("density", "energy"):
                 f = x[name]
-                row.update({f"{name}_{k}": f[k] for k in ("new_at_crossing", "new_elsewhere", "new_per_step", "max_per_step",
-                                                          "rate_crossing", "rate_elsewhere")})
-                row[f"{name}_rate_ratio"] = f["rate_crossing"] / f["rate_elsewhere"] if f["rate_elsewhere"] else float("inf")
+                row.update({f"{name}_{k}": f[k] for k in ("new_at_crossing", "new_elsewhere", "new_per_step",
+                                                          "max_per_step", "rate_crossing", "rate_elsewhere")})
+                row[f"{name}_rate_ratio"] = (f["rate_crossing"] / f["rate_elsewhere"] if f["rate_elsewhere"]
+                                             else float("inf"))
             rows.append(row)
     return rows
 
@@ -190,9 +196,10 @@ def _ppc(got) -> list[dict]:
     rows = []
     for (h, n), r in sorted(got["ppc"].items(), key=lambda kv: (-kv[0][0], kv[0][1])):
         ok = r["ok"]
-        rows.append({"h": h, "ppc": n, "ok": ok, **{f"{w}_{k}": _L1(r, w, k) if ok else "" for w in ("nodes", "particles")
-                                                    for k in ("L1", "L2")},
-                     "steps": r.get("steps"), "wall_s": round(r["wall_s"], 2) if ok else "", "error": "" if ok else r["error"]})
+        rows.append({"h": h, "ppc": n, "ok": ok,
+                     **{f"{w}_{k}": _L1(r, w, k) if ok else "" for w in ("nodes", "particles") for k in ("L1", "L2")},
+                     "steps": r.get("steps"), "wall_s": round(r["wall_s"], 2) if ok else "",
+                     "error": "" if ok else r["error"]})
     return rows
 
 
@@ -221,7 +228,8 @@ def _plateau(got) -> list[dict]:
                         "nodes_smooth_L1": r["regions"]["nodes"][2], "nodes_behind_shock_L1": r["regions"]["nodes"][5],
                         "particles_behind_shock_L1": r["regions"]["particles"][5],
                         "density_new_extrema_per_step": r["extrema"]["density"]["new_per_step"],
-                        "volume_drift": r["volume_drift"], "head_shift": r["head_shift"], "steps": r["steps"], "error": ""})
+                        "volume_drift": r["volume_drift"], "head_shift": r["head_shift"], "steps": r["steps"],
+                        "error": ""})
         else:
             row["error"] = r["error"]
         rows.append(row)
@@ -230,18 +238,20 @@ def _plateau(got) -> list[dict]:
 
 _STYLES = {"density": "o-", "energy": "s--"}
 PLOTS = (
-    Plot("convergence.png", f"Sod, T = {T}: density L1 error against h, beside the source's table", "convergence", "h", (
+    Plot("convergence.png", f"Sod, T = {T}: density L1 error against h, beside the source's table",
+         SOD_CONVERGENCE.stem, "h", (
         Curve("MPM, grid nodes", "mpm_nodes_L1"), Curve("MPM, particles", "mpm_particles_L1", "s-"),
         Curve("FEM consistent", "fem_consistent_L1", "^--"), Curve("FEM lumped", "fem_lumped_L1", "v--"),
         Curve(fv_euler.label(FV["limiter"]), "fv_L1", "x-."), Curve("source (slides)", "source_L1", "k*")),
         ylabel="density error (L1)", slopes=(0.5, 1)),
-    Plot("extrema.png", "C14: new extrema of particle density and energy, per step and per particle-step", "extrema", "h",
+    Plot("extrema.png", "C14: new extrema of particle density and energy, per step and per particle-step",
+         SOD_EXTREMA.stem, "h",
          tuple(Curve(n, f"{n}_new_per_step", f, panel="new extrema per step") for n, f in _STYLES.items())
          + tuple(Curve(f"{n}: {who}", f"{n}_rate_{k}", f, panel="new extrema per particle-step", options=o)
                  for n, f in _STYLES.items() for k, who, o in (("crossing", "particles crossing a node", {}),
                                                                ("elsewhere", "other particles", {"alpha": 0.5}))),
          ylabel="new extrema", size=(4.5, 3.6)),
-    Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", "ppc", "ppc", tuple(
+    Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", SOD_PPC.stem, "ppc", tuple(
         Curve("h = {h}", f"{w}_L1", panel=f"over {name}", group=("h",), where={"ok": True})
         for w, name in (("nodes", "grid nodes"), ("particles", "particles"))),
         xlabel="particles per cell N_p", ylabel="density error (L1)", size=(4.5, 3.6)),
@@ -259,10 +269,12 @@ def _profiles(folder, got) -> None:
         mp = m["profile"]
         nodal = {"density": mp["nodal_density"], "velocity": mp["nodal_velocity"]}
         fem = [(label, r["profile"]["x"], r["profile"], fmt, {"ms": 2.5, "lw": 0.7}) for r, fmt, label in
-               ((fc, "^-", "FEM consistent"), (fl, "v-", "FEM lumped")) if r is not None and r.get("ok") and "profile" in r]
+               ((fc, "^-", "FEM consistent"), (fl, "v-", "FEM lumped"))
+               if r is not None and r.get("ok") and "profile" in r]
         plots.profile_grid(folder / f"profiles_h{h:g}.png", exact, {
-            f"MPM ({MPM['ppc']} ppc, CFL {MPM['cfl']})": [("MPM particles", mp["x"], mp, ".", {"ms": 1.5, "color": "tab:blue"}),
-                                                          ("MPM grid nodes", mp["nodes"], nodal, "x", {"ms": 3, "color": "tab:red"})],
+            f"MPM ({MPM['ppc']} ppc, CFL {MPM['cfl']})": [
+                ("MPM particles", mp["x"], mp, ".", {"ms": 1.5, "color": "tab:blue"}),
+                ("MPM grid nodes", mp["nodes"], nodal, "x", {"ms": 3, "color": "tab:red"})],
             f"FEM (P1, SSPRK3, CFL {FEM['cfl']})": fem},
             f"Sod at T = {T}, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh")
 

@@ -18,15 +18,25 @@ from pathlib import Path
 
 import numpy as np
 
+from mpm_fem.app.plots import Curve, Plot, draw, plt, save
+from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
-from mpm_fem.app.plots import Curve, Plot, draw, plt, save
-from mpm_fem.problems import burgers
 from mpm_fem.core.solve import Problem
 from mpm_fem.core.step import Dirichlet
-from mpm_fem.app.study import StudyOptions, script_main, write_table
-from mpm_fem.measure.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, observed_order,
-                            pulse_setup, simulate_pulse, state_at)
+from mpm_fem.measure.schema import TIME_CROSSING_SUMMARY, TIME_LOCAL_ERROR, TIME_ORDER
+from mpm_fem.measure.timing import (
+    PulseSettings,
+    Recorder,
+    crossing_jumps,
+    field_difference,
+    local_errors,
+    observed_order,
+    pulse_setup,
+    simulate_pulse,
+    state_at,
+)
+from mpm_fem.problems import burgers
 
 NAME = "time"
 BASES = ("mpm", "gimp", "bspline")
@@ -122,13 +132,11 @@ def run(options: StudyOptions) -> None:
                 "crossing_particle": CROSSING_PARTICLE, "time_refines": TIME_REFINES,
                 "time_reference": TIME_REFERENCE, "local_substeps": LOCAL_SUBSTEPS, "local_refines": LOCAL_REFINES}
     rows, local_rows = time_rows(got["time"])
-    write_table(folder, "time_order", rows, settings)
-    write_table(folder, "local_error", local_rows, settings)
+    crossings = crossing_rows(got["crossing"])
+    publish(folder, {TIME_ORDER: rows, TIME_LOCAL_ERROR: local_rows, "crossing": crossings,
+                     TIME_CROSSING_SUMMARY: crossing_summary(crossings)}, settings)
     draw(folder, TIME_PLOT, rows + [{**r, "quantity": "local " + r["quantity"]} for r in local_rows])
-    rows = crossing_rows(got["crossing"])
-    write_table(folder, "crossing", rows, settings)
-    write_table(folder, "crossing_summary", crossing_summary(rows), settings)
-    crossing_figure(folder / "crossing.png", got["crossing"], rows)
+    crossing_figure(folder / "crossing.png", got["crossing"], crossings)
 
 
 # ---------------------------------------------------------------- tables
@@ -148,8 +156,10 @@ def time_rows(got: dict) -> tuple[list, list]:
                                         (local_rows, r["local"], ("x", "velocity"))):
             for q in (q for q in quantities if q in runs[0]):
                 orders, fit = _orders(runs, q)
-                table += [{"problem": problem, "basis": basis, "quantity": q, **({"refine": row["refine"]} if "refine" in row else {}),
-                           "dt": row["dt"], "error": row[q], "order": o, "fitted_order": fit} for row, o in zip(runs, orders)]
+                table += [{"problem": problem, "basis": basis, "quantity": q,
+                           **({"refine": row["refine"]} if "refine" in row else {}),
+                           "dt": row["dt"], "error": row[q], "order": o, "fitted_order": fit}
+                          for row, o in zip(runs, orders, strict=True)]
     return rows, local_rows
 
 
@@ -177,10 +187,12 @@ def crossing_summary(rows: list[dict]) -> list[dict]:
 
 GLOBAL_SLOPE, LOCAL_SLOPE = 1, 2  # C1: the orders in dt the guides show
 LOCAL_PANEL = f"one step: local error of x_p (slope {LOCAL_SLOPE})"
-TIME_PLOT = Plot("time_order.png", "C1: error against dt at fixed h and particles", "time_order", "dt", tuple(
+TIME_PLOT = Plot("time_order.png", "C1: error against dt at fixed h and particles", TIME_ORDER.stem, "dt", tuple(
     Curve(label, "error", fmt, where, panel, ("basis",)) for label, fmt, where, panel in (
-        ("{basis}", "o-", {"problem": "pulse", "quantity": "velocity"}, f"pulse: global velocity error (slope {GLOBAL_SLOPE})"),
-        ("{basis}", "o-", {"problem": "burgers", "quantity": "velocity"}, f"Burgers: global velocity error (slope {GLOBAL_SLOPE})"),
+        ("{basis}", "o-", {"problem": "pulse", "quantity": "velocity"},
+         f"pulse: global velocity error (slope {GLOBAL_SLOPE})"),
+        ("{basis}", "o-", {"problem": "burgers", "quantity": "velocity"},
+         f"Burgers: global velocity error (slope {GLOBAL_SLOPE})"),
         ("pulse, {basis}", "o-", {"problem": "pulse", "quantity": "local x"}, LOCAL_PANEL),
         ("Burgers, {basis}", "s--", {"problem": "burgers", "quantity": "local x"}, LOCAL_PANEL))),
     xlabel="dt", ylabel="error", slopes=(GLOBAL_SLOPE, LOCAL_SLOPE))
@@ -188,7 +200,7 @@ TIME_PLOT = Plot("time_order.png", "C1: error against dt at fixed h and particle
 def crossing_figure(path: Path, got: dict, rows: list[dict]) -> None:
     """dA/dt along the particle's path (exact acceleration) and A itself (calculated), node crossings dotted."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.9))
-    for ax, acc in zip(axes, ("exact", "calculated")):
+    for ax, acc in zip(axes, ("exact", "calculated"), strict=True):
         for basis in (b for b in BASES if (b, acc) in got):
             t, A = (np.asarray(got[(basis, acc)]["trace"][k]) for k in ("t", "A"))
             if acc == "exact":  # d^3 x_p/dt^3 = dA/dt, by differences of successive steps

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from mpm_fem.app import guard
 from mpm_fem.app.output import ensure_writable_dir, versions, write_atomic, write_json
+from mpm_fem.measure.schema import Table
 from mpm_fem.measure.tables import read_table  # noqa: F401  (re-exported: the studies' and tests' reader)
 from mpm_fem.app.sweep import code_version, run_cases
 
@@ -59,11 +60,16 @@ class StudyOptions:
         return {g: {label: results[key(c)] for label, c in group.items()} for g, group in plan.items()}
 
 
-def write_table(folder: Path, table: str, rows: list[dict], settings: dict) -> Path:
+def write_table(folder: Path, table: str | Table, rows: list[dict], settings: dict) -> Path:
     """``<folder>/<table>.csv`` from ``rows`` (dicts with the same keys) and ``<table>.json``
-    holding ``settings``, the package versions and the code hash. Returns the CSV path."""
+    holding ``settings``, the package versions and the code hash. Returns the CSV path. ``table`` is
+    the file's name, or a table declared in :mod:`mpm_fem.measure.schema`: then the rows' columns
+    must be the declared ones (:class:`mpm_fem.measure.schema.ColumnsError` otherwise, nothing written)."""
     if not rows:
         raise ValueError(f"table {table!r} has no rows")
+    if isinstance(table, Table):
+        table.check(rows)
+        table = table.stem
     columns = list(rows[0])
     for row in rows[1:]:
         columns += [c for c in row if c not in columns]
@@ -78,18 +84,28 @@ def write_table(folder: Path, table: str, rows: list[dict], settings: dict) -> P
     return path
 
 
-def publish(folder: Path, tables: dict[str, list[dict]], settings: dict, extra: dict | None = None, figures=()) -> None:
-    """Write every non-empty table of ``tables`` (``{name: rows}``) with ``settings`` (and the
-    ``extra`` settings of that table), then draw the ``figures`` (:class:`mpm_fem.app.plots.Plot`) whose
-    table was written."""
+def publish(folder: Path, tables: dict[str | Table, list[dict]], settings: dict, extra: dict | None = None,
+            figures=()) -> None:
+    """Write every non-empty table of ``tables`` (``{name: rows}``, the name a string or a table
+    declared in :mod:`mpm_fem.measure.schema`) with ``settings`` (and the ``extra`` settings of that
+    table, keyed by file name), then draw the ``figures`` (:class:`mpm_fem.app.plots.Plot`) whose
+    table was written. The declared tables' columns are checked before any table is written."""
     from mpm_fem.app import plots
 
-    for name, rows in tables.items():
+    for table, rows in tables.items():
+        if rows and isinstance(table, Table):
+            table.check(rows)
+    named = {_stem(table): rows for table, rows in tables.items()}
+    for table, rows in tables.items():
         if rows:
-            write_table(folder, name, rows, {**settings, **(extra or {}).get(name, {})})
+            write_table(folder, table, rows, {**settings, **(extra or {}).get(_stem(table), {})})
     for plot in figures:
-        if tables.get(plot.table):
-            plots.draw(folder, plot, tables[plot.table])
+        if named.get(plot.table):
+            plots.draw(folder, plot, named[plot.table])
+
+
+def _stem(table: str | Table) -> str:
+    return table.stem if isinstance(table, Table) else table
 
 
 def _fmt(value):

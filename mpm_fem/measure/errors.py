@@ -36,4 +36,4 @@ def orders_row(h, errors) -> dict:
     orders, the meshes (``h_range``) and the order between each pair (``order_<h1>_<h2>``)."""
     o = observed_orders(h, errors)
     return {"fitted": fitted_order(h, errors), "first": float(o[0]), "last": float(o[-1]), "h_range": f"{h[0]}-{h[-1]}",
-            **{f"order_{a}_{b}": float(x) for a, b, x in zip(h[:-1], h[1:], o, strict=False)}}
+            **{f"order_{a}_{b}": float(x) for a, b, x in zip(h[:-1], h[1:], o, strict=True)}}

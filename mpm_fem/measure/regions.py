@@ -103,7 +103,7 @@ def describe(half_width: float, waves: dict, t: float) -> dict:
         "2 smooth": f"[x_H + {w}, x_T - {w}) (fan) and [x_T + {w}, x_C - {w}) (plateau)",
         "3 rarefaction tail": f"[x_T - {w}, x_T + {w})", "4 contact": f"[x_C - {w}, x_C + {w})",
         "5 behind shock": f"[x_C + {w}, x_S - {w})", "6 shock front": f"[x_S - {w}, x_S + {w})",
-        f"waves at T={t}": ", ".join(f"x_{n} = {v}" for n, v in zip("HTCS", x.values(), strict=False)),
+        f"waves at T={t}": ", ".join(f"x_{n} = {v}" for n, v in zip("HTCS", x.values(), strict=True)),
     }
 
 

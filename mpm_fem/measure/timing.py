@@ -165,7 +165,7 @@ class Recorder:
         self.a_nodes.append(state.acceleration.copy())
 
     def track(self) -> Track:
-        t, x, v, v_new, x_new = (np.array(c) for c in zip(*self.rows, strict=False))
+        t, x, v, v_new, x_new = (np.array(c) for c in zip(*self.rows, strict=True))
         dt = np.diff(np.append(t, np.nan))
         # the last step's length is unknown from t alone: use the previous one
         dt[-1] = dt[-2] if dt.size > 1 else np.nan

@@ -1,0 +1,105 @@
+"""The registry of the claims: their statements, the :class:`Claim` and the :func:`claim` decorator
+that registers a criterion in :data:`CLAIMS`.
+
+A :class:`Claim` holds its statement, the source's number or band, the tables it reads, and its
+thresholds, written in words beside the constants the criterion uses. The criterion is a small
+function ``criterion(tables) -> (verdict, evidence)``: ``tables`` maps ``"<study>/<table>"`` to rows
+as read from the CSVs (:func:`mpm_fem.measure.tables.load_tables`), the verdict is one of
+:data:`VERDICTS`, and the evidence is one line formatted from the numbers, its first clause the key
+number of the report's summary. A claim whose tables are missing is ``not measured``; no verdict is
+ever typed. The per-study modules of :mod:`mpm_fem.measure.claims` import this one, never the package.
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+VERDICTS = ("confirmed", "partly", "differs", "refuted", "not measured")
+Tables = Mapping[str, list[dict]]
+Criterion = Callable[[Tables], "tuple[str, str]"]
+
+#: Every claim of the source (C) and every extension (E), in the order the report lists them.
+STATEMENTS = {
+    "C1": "local time error O(dt^2), global O(dt)",
+    "C2": "jump of the third time derivative of x_p at a node crossing limits accuracy to first order",
+    "C3": "4-8 particles per cell is optimal in 1D",
+    "C4": "Hickernell's particle-quadrature bound with D2(P, N)",
+    "C5": "nodal mass projection error O(h^p), 1 <= p <= 2",
+    "C6": "nodal momentum projection error: same orders as mass",
+    "C7": "nodal force projection error: same orders",
+    "C8": "nodal acceleration error one order lower, 0 <= p <= 1",
+    "C9": "nodal velocity projection error 0 <= p <= 1",
+    "C10": "velocity gradient error of the same order as the velocity error",
+    "C11": "Sod: the density error stops converging as h shrinks",
+    "C12": "Sod: the error sits at the waves (rarefaction edges, contact, shock front)",
+    "C13": "Burgers: first order in h, exact and calculated acceleration",
+    "C14": "particle density/energy updates create new extrema at cell crossings",
+    "C15": "FE + mass lumping is one of the four error sources",
+    "E1": "error budget: an exact decomposition over every combination of the stages",
+    "E2": "bases: point-mass P1 vs GIMP vs C1 B-spline",
+    "E3": "MPM, fixed-mesh FEM and a finite-volume reference side by side on the same mesh",
+    "E4": "one command regenerates every table from one code version",
+    "E5": "a remedy (particle-domain B-spline, stress reconstruction, volume reset, PIC/FLIP, XPIC) removes the MPM "
+          "plateau",
+}
+
+
+@dataclass(frozen=True)
+class Claim:
+    """One claim: ``id`` (``"C5"``), the ``source``'s number or band, the ``tables`` it reads, the
+    ``thresholds`` of its verdicts in words, its ``criterion``, the ``study`` whose section shows it,
+    the ``problem`` it is measured on when it is measured on several (``"sod"``), and an
+    ``explanation`` of what the measurement means (prose without numbers)."""
+
+    id: str
+    source: str
+    tables: tuple[str, ...]
+    thresholds: str
+    criterion: Criterion
+    study: str
+    problem: str = ""
+    explanation: str = ""
+
+    @property
+    def statement(self) -> str:
+        return STATEMENTS[self.id]
+
+    @property
+    def label(self) -> str:
+        return f"{self.id} ({self.problem})" if self.problem else self.id
+
+    def verdict(self, tables: Tables) -> tuple[str, str]:
+        """``(verdict, evidence)``; ``not measured`` when a table it reads is missing or empty."""
+        missing = [name for name in self.tables if not tables.get(name)]
+        if missing:
+            return "not measured", "no table " + ", ".join(f"`{m}.csv`" for m in missing)
+        verdict, evidence = self.criterion(tables)
+        if verdict not in VERDICTS:
+            raise ValueError(f"claim {self.label}: verdict {verdict!r} is not one of {VERDICTS}")
+        return verdict, evidence
+
+
+CLAIMS: list[Claim] = []
+
+
+def claim(id: str, source: str, tables: tuple[str, ...], thresholds: str, study: str,
+          problem: str = "") -> Callable[[Criterion], Criterion]:
+    """Register the decorated criterion as a :class:`Claim` in :data:`CLAIMS`; the criterion's
+    docstring, joined into one line, is the claim's ``explanation``."""
+    if id not in STATEMENTS:
+        raise ValueError(f"claim id {id!r} is not one of {tuple(STATEMENTS)}")
+
+    def register(criterion: Criterion) -> Criterion:
+        explanation = " ".join((inspect.getdoc(criterion) or "").split())
+        CLAIMS.append(Claim(id, source, tuple(tables), thresholds, criterion, study, problem, explanation))
+        return criterion
+
+    return register
+
+
+def claims_of(study: str) -> list[Claim]:
+    """The registered claims shown in ``study``'s section, in the order of :data:`STATEMENTS`."""
+    return sorted((c for c in CLAIMS if c.study == study), key=lambda c: (list(STATEMENTS).index(c.id), c.problem))
+

@@ -1,0 +1,62 @@
+"""Reading rows: the helpers every criterion uses on the rows of a table (dicts of strings, as read
+from the CSVs)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+
+def num(row: Mapping, key: str) -> float:
+    """``row[key]`` as a float; NaN when absent or empty."""
+    value = row.get(key, "")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def select(rows: list[dict], **where) -> list[dict]:
+    """The rows whose columns equal ``where`` (numbers compared as floats, anything else as text)."""
+    def same(value, wanted):
+        if isinstance(wanted, (int, float)) and not isinstance(wanted, bool):
+            try:
+                return float(value) == float(wanted)
+            except (TypeError, ValueError):
+                return False
+        return str(value) == str(wanted)
+
+    return [r for r in rows if all(same(r.get(k, ""), v) for k, v in where.items())]
+
+
+def span(values, fmt: str = ".2f") -> str:
+    """``"lo..hi"`` of the finite values (one number when they agree, ``"-"`` when there is none)."""
+    v = [x for x in values if math.isfinite(x)]
+    if not v:
+        return "-"
+    lo, hi = format(min(v), fmt), format(max(v), fmt)
+    return lo if lo == hi else f"{lo}..{hi}"
+
+
+def count_verdict(hits: int, total: int, none: str = "refuted") -> str:
+    """``confirmed`` when every case holds, ``partly`` when some do, ``none`` when no case does."""
+    if total == 0:
+        return "not measured"
+    return "confirmed" if hits == total else ("partly" if hits else none)
+
+
+def saturation(rows: list[dict], key: str, ppc: str = "ppc", within: float = 0.05) -> int:
+    """The fewest particles per cell whose ``key`` error is within ``within`` of the smallest one."""
+    values = [(int(num(r, ppc)), num(r, key)) for r in rows if math.isfinite(num(r, key))]
+    best = min(e for _, e in values)
+    return min(n for n, e in values if e <= (1 + within) * best)
+
+
+def successive_orders(rows: list[dict], key: str) -> list[float]:
+    """Observed orders between successive rows (sorted by decreasing ``h``); NaN where a run failed."""
+    h, e = [num(r, "h") for r in rows], [num(r, key) for r in rows]
+    out = []
+    for k in range(len(rows) - 1):
+        ok = e[k] > 0 and e[k + 1] > 0
+        out.append(math.log(e[k] / e[k + 1]) / math.log(h[k] / h[k + 1]) if ok else math.nan)
+    return out

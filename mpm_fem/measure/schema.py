@@ -1,0 +1,167 @@
+"""The tables the claims read, declared once: each table's name and its columns.
+
+A study writes ``figures/<study>/<table>.csv`` and the claims (:mod:`mpm_fem.measure.claims`) read it
+as ``tables["<study>/<table>"]``. Both go through the :class:`Table` declared here: the study keys
+its rows by the declaration, the writer (:func:`mpm_fem.app.study.write_table`) checks that the
+written columns are the declared ones (:meth:`Table.check`), and the claims take the table's name
+from it. Renaming a column is then one change here, and a study or claim left behind fails at once
+instead of writing a table no claim reads (``tests/test_schema.py`` checks the committed tables
+and every column a claim reads against these declarations).
+
+``versions`` and ``settings`` are built from the JSON files by
+:func:`mpm_fem.measure.tables.load_tables`, not written by a study; they are declared for the
+claims that read them. No project imports.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+
+class ColumnsError(ValueError):
+    """Rows written to a declared table whose columns are not its declared ones."""
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table of ``figures/``: its ``name`` (``"<study>/<table>"``), the ``columns`` every written
+    table has, the ``optional`` columns only some runs write (``error`` when a run failed), and the
+    ``families`` of columns whose members depend on the meshes run: regular expressions a column
+    name matches whole (``order_<h1>_<h2>``, one per pair of successive meshes)."""
+
+    name: str
+    columns: tuple[str, ...]
+    optional: tuple[str, ...] = ()
+    families: tuple[str, ...] = ()
+
+    @property
+    def study(self) -> str:
+        """The folder of ``figures/`` the table is written to (``"sod"``)."""
+        return self.name.partition("/")[0]
+
+    @property
+    def stem(self) -> str:
+        """The file name without ``.csv`` (``"convergence"``)."""
+        return self.name.partition("/")[2]
+
+    def declares(self, column: str) -> bool:
+        """Whether ``column`` is one of the table's columns, optional ones and families included."""
+        return (column in self.columns or column in self.optional
+                or any(re.fullmatch(pattern, column) for pattern in self.families))
+
+    def mismatch(self, columns: Iterable[str]) -> tuple[list[str], list[str]]:
+        """``(missing, extra)``: the declared columns absent from ``columns``, and the columns of
+        ``columns`` the declaration does not have."""
+        columns = list(columns)
+        return [c for c in self.columns if c not in columns], [c for c in columns if not self.declares(c)]
+
+    def check(self, rows: list[dict]) -> None:
+        """Raise :class:`ColumnsError`, naming the table and the missing and extra columns, unless
+        the columns of ``rows`` (every key of every row) are the declared ones."""
+        columns = list(dict.fromkeys(key for row in rows for key in row))
+        missing, extra = self.mismatch(columns)
+        if missing or extra:
+            raise ColumnsError(f"table {self.name}: the written columns differ from its declaration in "
+                               f"mpm_fem/measure/schema.py: missing {missing or 'none'}, extra {extra or 'none'}")
+
+
+# ----------------------------------------------------------------------------- projection (C4-C10)
+
+PROJECTION_ORDERS = Table("projection/orders", (
+    "quantity", "layout", "weights", "basis", "N_p", "norm", "order", "order_coarse", "order_fine", "successive",
+    "band", "inside"))
+PROJECTION_BOUNDS = Table("projection/bounds", ("check", "layout", "N_p", "h", "min_ratio", "entries", "holds"))
+PROJECTION_D2_CONSTANT = Table("projection/d2_constant", (
+    "layout", "N_p", "C", "delta_expected", "source_band", "inside"))
+
+# ----------------------------------------------------------------------------- Sod (C3, C11, C12, C14, C15, E3)
+
+SOD_CONVERGENCE = Table("sod/convergence", (
+    "h", "source_L1", "source_L2", "source_order_L1",
+    "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "mpm_nodes_L2", "ratio_nodes_L2", "order_nodes_L2",
+    "mpm_particles_L1", "ratio_particles_L1", "order_particles_L1", "mpm_particles_L2", "ratio_particles_L2",
+    "fem_consistent_L1", "order_fem_consistent_L1", "fem_lumped_L1", "order_fem_lumped_L1", "fv_L1", "order_fv_L1",
+    "mpm_particles_mean_error_smooth", "mpm_nodes_mean_error_smooth", "mpm_volume_drift", "mpm_head_shift",
+    "fem_consistent_head_shift", "mpm_steps", "mpm_particles", "mpm_wall_s", "mpm_energy_drift"))
+SOD_REGIONS = Table("sod/regions", (
+    "method", "h", "L1", "sum_of_regions",
+    "L1_0_undisturbed", "L1_1_rarefaction_head", "L1_2_smooth", "L1_3_rarefaction_tail", "L1_4_contact",
+    "L1_5_behind_shock", "L1_6_shock_front",
+    "share_0", "share_1", "share_2", "share_3", "share_4", "share_5", "share_6"))
+SOD_EXTREMA = Table("sod/extrema", (
+    "h", "steps", "crossings", "crossings_per_step",
+    "density_new_at_crossing", "density_new_elsewhere", "density_new_per_step", "density_max_per_step",
+    "density_rate_crossing", "density_rate_elsewhere", "density_rate_ratio",
+    "energy_new_at_crossing", "energy_new_elsewhere", "energy_new_per_step", "energy_max_per_step",
+    "energy_rate_crossing", "energy_rate_elsewhere", "energy_rate_ratio"))
+SOD_PPC = Table("sod/ppc", (
+    "h", "ppc", "ok", "nodes_L1", "nodes_L2", "particles_L1", "particles_L2", "steps", "wall_s", "error"))
+SOD_MASS = Table("sod/mass", (
+    "h", "mpm_lumped_nodes_L1", "mpm_consistent_nodes_L1", "mpm_consistent_over_lumped_nodes",
+    "mpm_lumped_particles_L1", "mpm_consistent_particles_L1", "mpm_consistent_over_lumped_particles",
+    "fem_lumped_L1", "fem_consistent_L1", "fem_consistent_over_lumped", "mpm_consistent_error"))
+
+# ----------------------------------------------------------------------------- Burgers (C3, C13, C15)
+
+#: ``source_fitted`` only where the source's table has every mesh of the series.
+BURGERS_ORDERS = Table("burgers/orders", (
+    "solution", "method", "eps", "where", "norm", "fitted", "first", "last", "h_range"),
+    optional=("source_fitted",), families=(r"order_[0-9.e+-]+_[0-9.e+-]+",))
+BURGERS_PPC = Table("burgers/ppc", (
+    "method", "eps", "h", "ppc", "particles_L1", "particles_L2", "particles_max", "nodes_L1", "nodes_L2", "nodes_max",
+    "steps", "error", "best_ppc"))
+BURGERS_LUMPING = Table("burgers/lumping", (
+    "method", "mass", "eps", "h", "where", "L1", "L2", "max", "nodes_L2", "dt", "error"))
+
+# ----------------------------------------------------------------------------- time (C1, C2)
+
+TIME_ORDER = Table("time/time_order", (
+    "problem", "basis", "quantity", "refine", "dt", "error", "order", "fitted_order"))
+TIME_LOCAL_ERROR = Table("time/local_error", ("problem", "basis", "quantity", "dt", "error", "order", "fitted_order"))
+TIME_CROSSING_SUMMARY = Table("time/crossing_summary", (
+    "basis", "acceleration", "crossings", "median_ratio", "max_ratio_error", "max_abs_ratio", "median_abs_measured"))
+
+# ----------------------------------------------------------------------------- budget (E1, E2; C15, E5)
+
+BUDGET_SHAPLEY = Table("budget/shapley", (
+    "problem", "h", "basis", "norm", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error"))
+BUDGET_ROUNDOFF = Table("budget/roundoff", (
+    "problem", "h", "basis", "norm", "stage", "share", "share_numpy", "change_pp", "mpm_error", "mpm_error_numpy",
+    "exact_error", "exact_error_numpy"))
+#: ``error`` only when a run failed (its row then has no errors).
+BUDGET_BASES = Table("budget/bases", (
+    "h", "basis", "ok", "steps", "wall_s", "particles_L1", "nodes_L1", "plateau_noise", "plateau_offset"),
+    optional=("error",))
+
+# ----------------------------------------------------------------------------- remedies (E5)
+
+REMEDIES_ERRORS = Table("remedies/errors", (
+    "problem", "remedy", "h", "quantity", "nodes_L1", "nodes_L2", "particles_L1", "particles_L2", "fv_L1",
+    "ratio_fv_nodes_L1", "ratio_fv_particles_L1", "steps", "n_p", "volume_drift", "error", "order_nodes_L1",
+    "order_particles_L1"))
+
+# ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
+
+VERSIONS = Table("versions", ("table", "code", "quick"))
+SETTINGS = Table("settings", ("table", "key", "value"))
+
+#: Every declared table a study writes, by name.
+TABLES: dict[str, Table] = {t.name: t for t in (
+    PROJECTION_ORDERS, PROJECTION_BOUNDS, PROJECTION_D2_CONSTANT,
+    SOD_CONVERGENCE, SOD_REGIONS, SOD_EXTREMA, SOD_PPC, SOD_MASS,
+    BURGERS_ORDERS, BURGERS_PPC, BURGERS_LUMPING,
+    TIME_ORDER, TIME_LOCAL_ERROR, TIME_CROSSING_SUMMARY,
+    BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,
+    REMEDIES_ERRORS)}
+#: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
+BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}
+
+
+def declared(name: str) -> Table:
+    """The declaration of table ``name`` (written or built); ``KeyError`` naming it when there is none."""
+    try:
+        return {**TABLES, **BUILT}[name]
+    except KeyError:
+        raise KeyError(f"table {name!r} is not declared in mpm_fem/measure/schema.py") from None
