@@ -91,6 +91,19 @@ def test_a_billion_cells_are_refused_in_under_a_second_without_allocating(capsys
     assert "4000000000 particles, 1000000001 nodes" in err and "50% of the available memory" in err
 
 
+@pytest.mark.parametrize("argv, says", [
+    (["burgers", "--T", "1e308"], "too large to estimate"),
+    (["sod", "--T", "1e308"], "too large to estimate"),
+    (["burgers", "--h", "1e-300"], "too large to estimate"),
+    (["sod", "--h", "1e-300"], "1e+300 nodes"),
+])
+def test_a_run_too_large_to_estimate_is_refused_with_exit_2_and_one_line(argv, says, capsys, tmp_path):
+    code, err = _run([*argv, "--quiet", "--out", str(tmp_path / "x")], capsys)
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and says in lines[0] and "error:" in lines[0], err
+    assert not (tmp_path / "x").exists()
+
+
 def test_memory_and_time_limits_of_the_guard():
     cost = Cost(particles=1_000_000, nodes=100_001, steps=10)  # 400 MB + 40 MB
     assert cost.bytes == 400 * 1_000_000 + 400 * 100_001 + 32 * 10

@@ -166,7 +166,11 @@ def _prepare(args, problem: str, module, settings_cls):
         raise UsageError(str(err)) from None
     if args.save_fields is not None and args.save_fields < 1:
         raise UsageError(f"--save-fields takes a step interval >= 1, got {args.save_fields}")
-    cost = module.cost(settings)
+    try:
+        with np.errstate(all="ignore"):  # extreme settings: a non-finite estimate is refused below
+            cost = module.cost(settings)
+    except ValueError as err:  # a run too large to estimate is refused like one too large to run
+        raise UsageError(str(err)) from None
     guard.check_cost(cost, args.yes_long)
     out = Path(args.out or f"runs/{problem}-{output.settings_hash(settings.as_dict())}")
     try:

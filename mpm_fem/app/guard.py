@@ -59,6 +59,11 @@ def _size(n_bytes: float) -> str:
     raise AssertionError  # pragma: no cover
 
 
+def _count(n: int) -> str:
+    """An exact count up to ten digits, three significant digits beyond."""
+    return str(n) if n < 10**10 else f"{n:.3g}"
+
+
 def _duration(seconds: float) -> str:
     if seconds < 120:
         return f"{seconds:.2g} s"
@@ -69,7 +74,7 @@ def _duration(seconds: float) -> str:
 
 def describe(cost) -> str:
     """One line: estimated steps, particles, memory and time."""
-    return (f"estimated {cost.steps} steps, {cost.particles} particles, {cost.nodes} nodes, "
+    return (f"estimated {_count(cost.steps)} steps, {_count(cost.particles)} particles, {_count(cost.nodes)} nodes, "
             f"{_size(cost.bytes)}, ~{_duration(cost.seconds)}")
 
 
@@ -78,8 +83,8 @@ def check_cost(cost, yes_long: bool = False, memory: int | None = None) -> None:
     ``yes_long``. ``memory`` defaults to :func:`available_memory`."""
     memory = available_memory() if memory is None else memory
     if memory is not None and cost.bytes > MEMORY_SHARE * memory:
-        raise UsageError(f"the run needs about {_size(cost.bytes)} ({cost.particles} particles, {cost.nodes} nodes, "
-                         f"{cost.steps} steps), over the limit of {_size(MEMORY_SHARE * memory)} "
+        raise UsageError(f"the run needs about {_size(cost.bytes)} ({_count(cost.particles)} particles, "
+                         f"{_count(cost.nodes)} nodes, {_count(cost.steps)} steps), over the limit of {_size(MEMORY_SHARE * memory)} "
                          f"({MEMORY_SHARE:.0%} of the available memory)")
     if cost.seconds > LONG_RUN_S and not yes_long:
         raise UsageError(f"{describe(cost)}: over {LONG_RUN_S / 3600:g} h; pass --yes-long to run it")

@@ -92,7 +92,10 @@ def run_cost(settings, domain: tuple[float, float], max_speed: float, dt_cap: fl
     / refine`` (the CFL step, ``dt_cap`` a further limit such as explicit diffusion)."""
     n_cells = n_cells_for(*domain, settings.h)
     dt = settings.cfl * min(settings.h / max_speed if max_speed > 0 else math.inf, dt_cap) / settings.refine
-    steps = math.ceil(settings.T / dt) if settings.T > 0 else 0
+    ratio = settings.T / dt if settings.T > 0 and dt > 0 else (math.inf if settings.T > 0 else 0.0)
+    if not math.isfinite(ratio):
+        raise ValueError(f"the run is too large to estimate: T / dt = {settings.T:g} / {dt:g} steps is not finite")
+    steps = math.ceil(ratio)
     stages = settings.stages
     fused = settings.kernel == "fused" and not (stages.uses_exact_fields or stages.reconstruct != "none")
     return Cost(particles=n_cells * settings.ppc, nodes=n_cells + 1, steps=steps, kernel="fused" if fused else "numpy")
