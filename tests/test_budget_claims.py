@@ -16,7 +16,7 @@ def _shapley(shares: dict, problem: str = "burgers", norm: str = "particles") ->
     """``budget/shapley`` rows from ``{(h, basis): (share per stage in STAGES order)}`` (strings, as read)."""
     rows = []
     for (h, basis), values in shares.items():
-        for stage, share in zip(STAGES, values):
+        for stage, share in zip(STAGES, values, strict=False):
             rows.append({"problem": problem, "h": str(h), "basis": basis, "norm": norm, "stage": stage,
                          "shapley": repr(share * 1e-3), "share": repr(share), "mpm_error": "0.0012", "exact_error": "0.0002"})
     return rows

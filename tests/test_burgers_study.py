@@ -37,8 +37,8 @@ def test_fused_run_is_the_numpy_step(changes):
     numpy_run = burgers.simulate(replace(settings, kernel="numpy"), progress=False)
     fused = burgers.simulate(settings, progress=False)
     assert fused.steps == numpy_run.steps and fused.particles.n == numpy_run.particles.n
-    pairs = zip(_by_position(numpy_run) + (numpy_run.nodal_velocity,), _by_position(fused) + (fused.nodal_velocity,))
-    for (a, b), name in zip(pairs, ("x", "v", "V", "v_i")):
+    pairs = zip(_by_position(numpy_run) + (numpy_run.nodal_velocity,), _by_position(fused) + (fused.nodal_velocity,), strict=False)
+    for (a, b), name in zip(pairs, ("x", "v", "V", "v_i"), strict=False):
         gap = float(np.max(np.abs(a - b)) / np.max(np.abs(a)))
         assert gap <= 1e-12, f"{name}: fused and numpy runs differ by {gap:.3g} relative"
 
@@ -168,8 +168,8 @@ def test_source_table_with_corrections_falls_monotonically():
     """docs/claims.md's exponent corrections (*) put every row of the source's table in decreasing order."""
     for row, table in study.SOURCE.items():
         for eps, values in table.items():
-            assert all(a > b for a, b in zip(values, values[1:])), f"{row} eps={eps}: {values}"
-            assert all(0.8 < a / b < 4 for a, b in zip(values, values[1:])), f"{row} eps={eps}: {values}"
+            assert all(a > b for a, b in zip(values, values[1:], strict=False)), f"{row} eps={eps}: {values}"
+            assert all(0.8 < a / b < 4 for a, b in zip(values, values[1:], strict=False)), f"{row} eps={eps}: {values}"
 
 
 def test_the_reported_step_is_the_run_step_not_the_last_sliver():

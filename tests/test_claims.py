@@ -64,14 +64,14 @@ def test_c4_needs_the_bound_to_hold_and_the_constant_in_the_band():
 
 
 def _orders_column(rows, orders):
-    return {r["h"]: o for r, o in zip(rows, orders)}
+    return {r["h"]: o for r, o in zip(rows, orders, strict=False)}
 
 
 def test_c11_is_confirmed_by_a_floor_and_refuted_by_steady_convergence():
     rows = TABLES["sod/convergence"]
     hs = [r["h"] for r in rows]  # converging on the first meshes, then a floor on the last two
-    floor = dict(zip(hs, ["", 0.9, 0.9] + [0.8] * (len(hs) - 5) + [0.2, 0.1]))
-    steady = dict(zip(hs, [""] + [0.9] * (len(hs) - 1)))
+    floor = dict(zip(hs, ["", 0.9, 0.9] + [0.8] * (len(hs) - 5) + [0.2, 0.1], strict=False))
+    steady = dict(zip(hs, [""] + [0.9] * (len(hs) - 1), strict=False))
     passing = mutate(TABLES, "sod/convergence", order_nodes_L1=lambda r: str(floor[r["h"]]))
     failing = mutate(TABLES, "sod/convergence", order_nodes_L1=lambda r: str(steady[r["h"]]))
     assert_flips("C11", failing, passing)

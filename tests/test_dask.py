@@ -2,8 +2,8 @@
 
 import pytest
 
-from mpm_fem.problems.cases import sod_case
 from mpm_fem.app.sweep import run_cases
+from mpm_fem.problems.cases import sod_case
 
 distributed = pytest.importorskip("dask.distributed", reason="the [dask] extra is not installed")
 

@@ -145,7 +145,7 @@ def test_fields_returns_the_four_methods_values():
     solution = make_solution("rarefaction", 0.02)
     x, t = np.linspace(0.0, 2.0, 7), 0.3
     methods = (solution.v, solution.v_x, solution.v_xx, solution.v_t)
-    for together, method in zip(solution.fields(x, t), methods):
+    for together, method in zip(solution.fields(x, t), methods, strict=False):
         np.testing.assert_array_equal(together, method(x, t))
 
 

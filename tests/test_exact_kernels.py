@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from baselines.exact import riemann
-from mpm_fem.exact_stages.quadrature import quadrature, quadrature_rule
-from mpm_fem.problems.sod import RiemannFields
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.shape import make_shape
+from mpm_fem.exact_stages.quadrature import quadrature, quadrature_rule
+from mpm_fem.problems.sod import RiemannFields
 
 # Sod; a left shock and right rarefaction (mirror image); two shocks; two rarefactions
 CASES = {
@@ -26,7 +26,7 @@ def test_compiled_riemann_sample_equals_numpy_bit_for_bit(name):
     for t in (0.2, 1e-3, 3.0):
         got = fields._sample(x, t)
         want = riemann.sample(x, t, left, right, x0=0.5, gamma=1.4)
-        for g, w in zip(got, want):
+        for g, w in zip(got, want, strict=False):
             assert np.array_equal(g, w), f"{name} t={t}: {np.count_nonzero(g != w)} points differ"
     regions = np.unique(np.searchsorted(fields.breakpoints(0.2), x))
     assert regions.size == fields.breakpoints(0.2).size + 1  # every wave region sampled
@@ -36,7 +36,7 @@ def test_compiled_riemann_sample_equals_numpy_bit_for_bit(name):
 def test_compiled_profile_equals_numpy_bit_for_bit(name):
     fields = RiemannFields(*CASES[name], 0.5, 1.4, 0.01)
     xi = np.concatenate((np.random.default_rng(2).uniform(-4, 4, 20_000), fields._speeds))
-    for got, want in zip(fields._profile(xi), fields._profile_numpy(xi)):
+    for got, want in zip(fields._profile(xi), fields._profile_numpy(xi), strict=False):
         assert np.array_equal(got, want)
     assert np.array_equal(fields._profile(xi[:20_000].reshape(100, -1))[1], fields._profile_numpy(xi[:20_000])[1].reshape(100, -1))
 
@@ -65,7 +65,7 @@ def test_compiled_reference_fields_equal_numpy_bit_for_bit(name):
     x = np.random.default_rng(3).uniform(0, 1, 20_000)
     for t in (0.2, 0.013):
         got, want = fields.reference(x, t), fields._averaged_numpy(x, t)
-        for g, w in zip(got, want):
+        for g, w in zip(got, want, strict=False):
             assert np.array_equal(g, w)
         assert np.array_equal(fields.velocity_gradient(x, t), want[1])
     assert np.abs(want[1]).max() > 1.0  # a shock or a fan inside the sample

@@ -5,19 +5,19 @@ import numpy as np
 import pytest
 from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
 
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.shape import make_shape
+from mpm_fem.core.step import Stages, Walls, explicit_step
+from mpm_fem.core.transfer import particle_mass_matrix
 from mpm_fem.exact_stages import projection
 from mpm_fem.exact_stages.grid_data import nodal_values
 from mpm_fem.exact_stages.mass import fe_mass, fe_mass_operator
 from mpm_fem.exact_stages.projection import exact_projection
 from mpm_fem.exact_stages.quadrature import _pieces, quadrature
-from mpm_fem.core.grid import uniform_grid
-from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.problems import sod
 from mpm_fem.problems.burgers import SmoothBurgersFields
 from mpm_fem.problems.sod import RiemannFields
-from mpm_fem.core.shape import make_shape
-from mpm_fem.core.step import Stages, Walls, explicit_step
-from mpm_fem.core.transfer import particle_mass_matrix
 
 SOD = ((1.0, 0.0, 1.0), (0.125, 0.0, 0.1))
 

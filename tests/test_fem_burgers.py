@@ -6,11 +6,10 @@ from functools import lru_cache
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from skfem import Basis, ElementLineP1, LinearForm, asm
 
 from baselines.exact.burgers import make_solution
-import scipy.sparse as sp
-
 from baselines.fem_burgers import _operators, errors, residual, solve
 from baselines.fem_burgers_kernel import tridiagonal_factors
 from mpm_fem.core.grid import grid_from_nodes

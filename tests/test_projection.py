@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from skfem import Basis, ElementLineP1, LinearForm, asm
 
-from mpm_fem.measure.errors import fitted_order
 from mpm_fem.core.grid import grid_from_nodes, uniform_grid
 from mpm_fem.core.particles import seed_positions
+from mpm_fem.measure.errors import fitted_order
 from mpm_fem.measure.projection import (
     Advection,
     Fields,

@@ -1,13 +1,12 @@
 """E5 study (studies/remedies.py): the quick run writes its tables, figures and verdict."""
 
 import pytest
-
 from claim_mutations import judge
 
-from mpm_fem.fused.step import supported
+from mpm_fem.app.study import StudyOptions, read_table
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.step import Stages
-from mpm_fem.app.study import StudyOptions, read_table
+from mpm_fem.fused.step import supported
 from mpm_fem.measure.tables import load_tables
 from studies import remedies, sod
 

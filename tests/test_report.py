@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from mpm_fem.measure.claims import STATEMENTS
 from mpm_fem.app.report import Page, View, captions_of, cell, markdown_table, render, study_pages, write_report
+from mpm_fem.measure.claims import STATEMENTS
 from mpm_fem.measure.tables import load_tables
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"

@@ -11,8 +11,15 @@ from baselines import fem_euler
 from baselines.exact import riemann
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import make_particles
+from mpm_fem.measure.regions import (
+    REGION_NAMES,
+    ExtremaCounter,
+    l1_by_region,
+    mean_by_region,
+    sod_regions,
+    strict_extrema,
+)
 from mpm_fem.problems.sod import SodSettings
-from mpm_fem.measure.regions import REGION_NAMES, ExtremaCounter, l1_by_region, mean_by_region, sod_regions, strict_extrema
 from studies import sod as study
 
 RHO_POST_SHOCK = 0.26557  # Toro, Table 4.2

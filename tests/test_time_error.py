@@ -5,9 +5,16 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from mpm_fem.measure.timing import (
+    PulseSettings,
+    Recorder,
+    crossing_jumps,
+    field_difference,
+    local_errors,
+    pulse_setup,
+    state_at,
+)
 from mpm_fem.problems import burgers
-from mpm_fem.measure.timing import (PulseSettings, Recorder, crossing_jumps, field_difference, local_errors, pulse_setup,
-                            state_at)
 
 CROSSING = dict(h=0.02, ppc=4, solution="rarefaction", eps=0.045, cfl=0.05, T=0.2)
 PARTICLE = 4 * 27 + 1  # starts at x = 0.565, inside the fan

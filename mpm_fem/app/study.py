@@ -21,9 +21,9 @@ from pathlib import Path
 
 from mpm_fem.app import guard
 from mpm_fem.app.output import ensure_writable_dir, versions, write_atomic, write_json
+from mpm_fem.app.sweep import code_version, run_cases
 from mpm_fem.measure.schema import Table
 from mpm_fem.measure.tables import read_table  # noqa: F401  (re-exported: the studies' and tests' reader)
-from mpm_fem.app.sweep import code_version, run_cases
 
 
 @dataclass(frozen=True)
@@ -56,7 +56,7 @@ class StudyOptions:
             for case in group.values():
                 unique.setdefault(key(case), case)
         cases = sorted(unique.values(), key=cost, reverse=True) if cost else list(unique.values())
-        results = dict(zip(map(key, cases), self.sweep(name, fn, cases)))
+        results = dict(zip(map(key, cases), self.sweep(name, fn, cases), strict=False))
         return {g: {label: results[key(c)] for label, c in group.items()} for g, group in plan.items()}
 
 
