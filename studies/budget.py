@@ -79,6 +79,8 @@ SOD = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", sch
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}
+#: the deep tier's further budgets, (problem, h, basis): P1's Sod one mesh finer
+DEEP = (("sod", 0.000625, "mpm"),)
 FINEST = {}  # (problem, basis): the finest mesh of a basis whose budget stops above H's finest (none now)
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
@@ -92,10 +94,12 @@ COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:
 
 # ---------------------------------------------------------------- the plan
 
-def plan(quick: bool) -> dict:
+def plan(tier: str) -> dict:
+    quick = tier == "quick"
     hs, bases = (QUICK["h"], QUICK["bases"]) if quick else (H, BUDGET_BASES)
-    budget = {(p, h, b): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K}
-              for p, meshes in hs.items() for h in meshes for b in bases if h >= FINEST.get((p, b), 0)}
+    keys = [(p, h, b) for p, meshes in hs.items() for h in meshes for b in bases if h >= FINEST.get((p, b), 0)]
+    keys += list(DEEP) if tier == "deep" else []
+    budget = {(p, h, b): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K} for p, h, b in keys}
     e2 = {(h, b): {"kind": "bases", "h": h, "basis": b}
           for h in (QUICK["bases_h"] if quick else BASES_H) for b in BASES}
     roundoff = {key: {**case, "kernel": "numpy"} for key, case in budget.items() if key[::2] == ROUNDOFF}
@@ -205,7 +209,7 @@ def run_case(case: dict) -> dict:
 
 def run(options: StudyOptions) -> None:
     """Every case in one sweep (longest first), then the tables and figures."""
-    got = options.sweep_plan(NAME, run_case, plan(options.quick), cost=cost)
+    got = options.sweep_plan(NAME, run_case, plan(options.tier), cost=cost)
     folder = options.folder(NAME)
     settings = {"sod": SOD, "burgers": BURGERS, "K": K, "stages": STAGES, "exact_form": EXACT_FORM,
                 "region_half_width": REGION_HALF_WIDTH, "quick": options.quick}

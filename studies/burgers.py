@@ -41,10 +41,18 @@ METHODS = {  # name: (label, solver, settings, the source's row it stands beside
     "fem_consistent": ("FEM consistent", "fem", {"mass": "consistent"}, None),
     "fem_lumped": ("FEM lumped", "fem", {"mass": "lumped"}, None),
 }
-# Every mesh of the source's table for every row; a run costs ~ eps/h^3 (at h = 0.000625 MPM took 48-270 s)
+# The meshes of each method, by tier: a run costs ~ eps/h^3, so the deep tier takes every method to
+# every mesh of the source's table; the full tier every mesh for the rows compared with the source.
 MESHES = {
-    "default": {m: H for m in METHODS},
-    "other": {m: H for m in METHODS if m != "mpm_calculated_16"},
+    "deep": {
+        "default": {m: H for m in METHODS},
+        "other": {m: H for m in METHODS if m != "mpm_calculated_16"},
+    },
+    "full": {
+        "default": {**{m: H[:3] for m in METHODS}, "mpm_calculated": H, "mpm_exact_dt_h": H},
+        "other": {**{m: H[:3] for m in METHODS if m != "mpm_calculated_16"}, "mpm_exact_dt_h": H,
+                  "fem_consistent": H[:2], "fem_lumped": H[:2]},
+    },
 }
 _MPM = ("mpm_calculated", "mpm_exact")
 PPC, PPC_H, TIME_H, REFINE, PROFILE_H = (1, 2, 4, 8, 16, 32), (0.01, 0.0025), 0.005, (1, 4, 16), 0.01
@@ -106,14 +114,16 @@ def _cost(case: dict) -> float:
     return case["ppc"] * steps / h * case.get("refine", 1) * (3.0 if case.get("basis") == "gimp" else 1.0)
 
 
-def _plan(quick: bool) -> dict:
+def _plan(tier: str) -> dict:
+    quick = tier == "quick"
     q = QUICK if quick else {}
+    meshes = MESHES["deep" if tier == "deep" else "full"]
     eps_list, skip, time_h = q.get("eps", EPS), q.get("skip", ()), q.get("TIME_H", TIME_H)
     fem = ("fem_consistent", "fem_lumped")
     kept = lambda m, h: m not in skip and not (quick and (h not in q["H"] or (m in q["short"] and h not in q["H"][:2])))  # noqa: E731
     return {
         "table": {(s, m, e, h): method_case(m, s, e, h) for s in q.get("solutions", SOLUTIONS)
-                  for m, hs in MESHES["default" if s == DEFAULT else "other"].items()
+                  for m, hs in meshes["default" if s == DEFAULT else "other"].items()
                   for e in eps_list for h in hs if kept(m, h)},
         "profile": {(m, e): {**method_case(m, DEFAULT, e, PROFILE_H), "profile": True}
                     for e in (EPS[0], EPS[-1]) if e in eps_list for m in METHODS if m not in skip},
@@ -133,7 +143,7 @@ def _plan(quick: bool) -> dict:
 
 def run(options: StudyOptions) -> None:
     """Every case in one sweep (shared cases run once, the longest first), then tables and figures."""
-    got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
+    got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)
     folder = options.folder(NAME)
     settings = {"quick": options.quick, "mpm": MPM, "fem": FEM, "T": T, "domain": [0, 2], "default_solution": DEFAULT,
                 "compared_norm": f"{NORM} over {WHERE}",

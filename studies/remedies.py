@@ -111,7 +111,8 @@ def run_case(case: dict) -> dict:
             "wall_s": time.perf_counter() - start}
 
 
-def _plan(quick: bool) -> dict:
+def _plan(tier: str) -> dict:
+    quick = tier == "quick"
     q = QUICK if quick else {}
     names = q.get("REMEDIES", tuple(REMEDIES))
     sod_h, burgers_h = q.get("SOD_H", SOD_H), q.get("BURGERS_H", BURGERS_H)
@@ -138,7 +139,7 @@ def _cost(case: dict) -> float:
 # ---------------------------------------------------------------- the study
 
 def run(options: StudyOptions) -> None:
-    got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
+    got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)
     folder = options.folder(NAME)
     settings = {"sod": SOD_MPM, "burgers": BURGERS, "remedies": REMEDIES, "fem": {"mass": "lumped", **FEM},
                 "fv": FV,

@@ -26,7 +26,9 @@ from mpm_fem.measure.schema import SOD_CONVERGENCE, SOD_EXTREMA, SOD_MASS, SOD_P
 from mpm_fem.problems import sod
 
 NAME = "sod"
-H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625, 0.000078125)  # the source's meshes and two finer
+#: the source's meshes and one finer (full tier); the deep tier adds DEEP_H
+H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625)
+DEEP_H = (0.000078125,)
 SOURCE = source.SOD
 T = sod.SodSettings.T
 # One set of MPM settings for every h (never tuned per mesh); why these: ppc.csv and plateau.csv
@@ -92,9 +94,9 @@ def _cost(case: dict) -> float:
     return case["ppc"] / (case["h"] ** 2 * case["cfl"]) * (2.0 if case["mass"] == "consistent" else 1.0)
 
 
-def _plan(quick: bool) -> dict:
-    q = QUICK if quick else {}
-    hs, ppc_h = q.get("H", H), q.get("PPC_H", PPC_H)
+def _plan(tier: str) -> dict:
+    q = QUICK if tier == "quick" else {}
+    hs, ppc_h = q.get("H", H + DEEP_H if tier == "deep" else H), q.get("PPC_H", PPC_H)
     consistent_h, plateau_h = q.get("CONSISTENT_H", CONSISTENT_H), q.get("PLATEAU_H", PLATEAU_H)
     return {
         "mpm": {h: mpm_case(h) for h in hs},
@@ -110,7 +112,7 @@ def _plan(quick: bool) -> dict:
 
 def run(options: StudyOptions) -> None:
     """All cases in one sweep (shared ones run once), then tables and figures."""
-    got = options.sweep_plan(NAME, run_case, _plan(options.quick), cost=_cost)
+    got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)
     folder = options.folder(NAME)
     settings = {"mpm": MPM, "fem": {**FEM, "viscosity": _viscosity(FEM).name},
                 "fv": {**FV, "scheme": fv_euler.label(FV["limiter"])}, "region_half_width": REGION_HALF_WIDTH, "T": T,

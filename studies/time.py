@@ -54,7 +54,8 @@ QUICK = {"bases": ("mpm", "bspline"), "refines": (1, 2, 4), "reference": {"pulse
 
 # ---------------------------------------------------------------- the plan
 
-def plan(quick: bool) -> dict:
+def plan(tier: str) -> dict:
+    quick = tier == "quick"
     bases = QUICK["bases"] if quick else BASES
     refines, reference = (QUICK["refines"], QUICK["reference"]) if quick else (TIME_REFINES, TIME_REFERENCE)
     time = {(problem, basis): {"kind": "time", "problem": problem, "basis": basis, "h": 0.02, "refines": list(refines),
@@ -126,7 +127,7 @@ def run_case(case: dict) -> dict:
 
 def run(options: StudyOptions) -> None:
     """Every case in one sweep, then the tables and figures."""
-    got = options.sweep_plan(NAME, run_case, plan(options.quick))
+    got = options.sweep_plan(NAME, run_case, plan(options.tier))
     folder = options.folder(NAME)
     settings = {"burgers": BURGERS, "quick": options.quick, "pulse": PULSE.as_dict(), "crossing": CROSSING,
                 "crossing_particle": CROSSING_PARTICLE, "time_refines": TIME_REFINES,

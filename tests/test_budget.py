@@ -246,7 +246,7 @@ def test_the_particle_domain_bspline_runs_every_subset_and_its_shapley_values_ad
     exact = sod.exact(sod.SodSettings(), points, plain.t)[0]
     np.testing.assert_array_equal(field_on(points, plain.particles.x, plain.particles.density) - exact,
                                   fields[ALL]["particles"])
-    plan = study.plan(quick=False)["budget"]
+    plan = study.plan("full")["budget"]
     assert {h for p, h, b in plan if (p, b) == ("sod", "bspline_gimp")} == {h for p, h, b in plan if (p, b) == ("sod", "bspline")}
 
 
@@ -257,9 +257,9 @@ def test_the_roundoff_table_compares_the_two_arithmetics():
     from mpm_fem.measure.decomposition import share_changes
     from studies.budget import ROUNDOFF, plan
 
-    cases = plan(quick=False)["roundoff"]
+    cases = plan("full")["roundoff"]
     assert cases and all(key[::2] == ROUNDOFF and case["kernel"] == "numpy" for key, case in cases.items())
-    assert set(cases) == {k for k in plan(quick=False)["budget"] if k[::2] == ROUNDOFF}
+    assert set(cases) == {k for k in plan("full")["budget"] if k[::2] == ROUNDOFF}
     key = {"problem": "sod", "h": 0.01, "basis": "mpm", "norm": "particles"}
     fused = [{**key, "stage": "mass", "share": -0.5, "mpm_error": 2.0, "exact_error": 1.0},
              {**key, "stage": "time", "share": 0.25, "mpm_error": 2.0, "exact_error": 1.0},

@@ -119,7 +119,7 @@ def test_cfl_above_one_is_refused_with_a_message():
 
 
 def test_one_set_of_settings_for_every_mesh():
-    plan = study._plan(quick=False)
+    plan = study._plan("full")
     keys = set(study.MPM)
     for h, case in plan["mpm"].items():
         assert {k: case[k] for k in keys} == study.MPM, f"h={h} uses other settings"

@@ -23,7 +23,7 @@ import numpy as np
 
 from mpm_fem.app import guard, output
 from mpm_fem.app.guard import UsageError
-from mpm_fem.app.study import add_study_options, run_study, study_options
+from mpm_fem.app.study import add_study_options, add_tier_options, run_study, study_options
 from mpm_fem.core.grid import GridError
 from mpm_fem.core.particles import LAYOUTS
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS
@@ -135,15 +135,12 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("name", choices=STUDIES, help="which study")
     add_study_options(study)
     reproduce = sub.add_parser("reproduce", help="run every study and write REPORT.md: into figures/quick/ (--quick, "
-                               "the default) or figures/ (--full)",
+                               "the default), figures/ (--full) or figures/deep/ (--deep)",
                                description="Regenerate every table and figure and REPORT.md, into figures/quick/ with "
-                               "--quick (the default) or figures/ with --full (or --out DIR).")
-    size = reproduce.add_mutually_exclusive_group()
-    size.add_argument("--quick", dest="quick", action="store_true", default=True,
-                      help="a subset of meshes, a few minutes on 2 cores (default)")
-    size.add_argument("--full", dest="quick", action="store_false", help="every mesh of every study")
+                               "--quick (the default), figures/ with --full, figures/deep/ with --deep (or --out DIR).")
+    add_tier_options(reproduce, "quick")
     add_study_options(reproduce, quick_flag=False,
-                       out_help="figures folder (default: figures/quick with --quick, figures with --full)")
+                       out_help="figures folder (default: figures/quick, figures or figures/deep by tier)")
     return parser
 
 

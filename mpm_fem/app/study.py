@@ -25,26 +25,49 @@ from mpm_fem.app.sweep import code_version, run_cases
 from mpm_fem.measure.schema import Table
 from mpm_fem.measure.tables import read_table  # noqa: F401  (re-exported: the studies' and tests' reader)
 
+#: The tiers of a reproduction: ``quick`` (the README's command, a subset of meshes), ``full`` (the
+#: committed record in ``figures/``), ``deep`` (the full plan and the finest meshes and long sweeps,
+#: in ``figures/deep/``).
+TIERS = ("quick", "full", "deep")
+#: Where each tier writes by default.
+TIER_FOLDERS = {"quick": Path("figures/quick"), "full": Path("figures"), "deep": Path("figures/deep")}
+
 
 @dataclass(frozen=True)
 class StudyOptions:
-    """``quick``: the subset of meshes the README's default run uses; ``jobs``: worker processes;
-    ``scheduler``: a Dask scheduler address; ``out``: the figures folder (``figures/``)."""
+    """``quick`` / ``deep``: the tier (:data:`TIERS`; neither: ``full``); ``jobs``: worker processes;
+    ``scheduler``: a Dask scheduler address; ``out``: the figures folder (``figures/``);
+    ``cache``: the folder whose ``<study>/.cache/`` holds the finished cases (default ``out``; the
+    deep tier reads the full tier's, so that it runs only the cases the full tier has not)."""
 
     quick: bool = False
     jobs: int | None = None
     scheduler: str | None = None
     out: Path = Path("figures")
     progress: bool | None = None
+    deep: bool = False
+    cache: Path | None = None
+
+    def __post_init__(self):
+        if self.quick and self.deep:
+            raise ValueError("a study runs one tier: quick or deep, not both")
+
+    @property
+    def tier(self) -> str:
+        """``"quick"``, ``"full"`` or ``"deep"``."""
+        return "quick" if self.quick else "deep" if self.deep else "full"
 
     def folder(self, name: str) -> Path:
         path = Path(self.out) / name
         path.mkdir(parents=True, exist_ok=True)
         return path
 
+    def cache_dir(self, name: str) -> Path:
+        return Path(self.cache if self.cache is not None else self.out) / name / ".cache"
+
     def sweep(self, name: str, fn, cases: list[dict], desc: str | None = None) -> list[dict]:
         """Run ``fn`` over ``cases`` with this study's cache, workers and progress."""
-        return run_cases(fn, cases, jobs=self.jobs, cache_dir=self.folder(name) / ".cache", desc=desc or name,
+        return run_cases(fn, cases, jobs=self.jobs, cache_dir=self.cache_dir(name), desc=desc or name,
                          scheduler=self.scheduler, progress=self.progress)
 
     def sweep_plan(self, name: str, fn, plan: dict[str, dict], cost=None) -> dict[str, dict]:
@@ -114,15 +137,30 @@ def _fmt(value):
     return value
 
 
+def add_tier_options(parser: argparse.ArgumentParser, default: str) -> None:
+    """``--quick | --full | --deep``, into ``args.tier`` (``default`` when none is given)."""
+    size = parser.add_mutually_exclusive_group()
+    size.add_argument("--quick", dest="tier", action="store_const", const="quick",
+                      help="the subset of meshes of the quick reproduction (about a minute on 2 cores)")
+    size.add_argument("--full", dest="tier", action="store_const", const="full",
+                      help="every table of the committed record, figures/ (about 45 min on 2 cores)")
+    size.add_argument("--deep", dest="tier", action="store_const", const="deep",
+                      help="the full plan and the finest meshes and long sweeps, figures/deep/ (reuses the full "
+                           "tier's finished cases; hours on 2 cores, or a Dask cluster with --scheduler)")
+    parser.set_defaults(tier=default)
+
+
 def add_study_options(parser: argparse.ArgumentParser, quick_flag: bool = True, out_help: str | None = None) -> None:
-    """The options of a study run: ``--quick``, ``--jobs``, ``--scheduler``, ``--out``, ``--quiet``."""
+    """The options of a study run: the tier (``--quick``, ``--full``, ``--deep``; full by default),
+    ``--jobs``, ``--scheduler``, ``--out``, ``--quiet``."""
     if quick_flag:
-        parser.add_argument("--quick", action="store_true", help="the subset of meshes of the quick reproduction")
+        add_tier_options(parser, "full")
     parser.add_argument("--jobs", type=int, default=None,
                         help="worker processes, at most the number of cores (default: the cores, at most 8)")
     parser.add_argument("--scheduler", default=None,
                         help="address of a running Dask scheduler, tcp://HOST:PORT (checked with a 3 s connect)")
-    parser.add_argument("--out", default=None, help=out_help or "figures folder (default: figures, or figures/quick with --quick)")
+    parser.add_argument("--out", default=None,
+                        help=out_help or "figures folder (default: figures, figures/quick or figures/deep by tier)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
 
 
@@ -130,12 +168,16 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
     """:class:`StudyOptions` from parsed options; bad input raises :class:`mpm_fem.app.guard.UsageError`."""
     jobs = guard.cap_jobs(args.jobs)
     scheduler = guard.check_scheduler(args.scheduler)
-    out = args.out or ("figures/quick" if args.quick else "figures")
+    tier = args.tier
+    out = args.out or TIER_FOLDERS[tier]
+    # the deep tier's default folder reuses the full tier's finished cases
+    cache = TIER_FOLDERS["full"] if tier == "deep" and not args.out else None
     try:
         out = ensure_writable_dir(out)
     except PermissionError as err:
         raise guard.UsageError(str(err)) from None
-    return StudyOptions(quick=args.quick, jobs=jobs, scheduler=scheduler, out=out, progress=False if args.quiet else None)
+    return StudyOptions(quick=tier == "quick", deep=tier == "deep", jobs=jobs, scheduler=scheduler, out=out,
+                        cache=cache, progress=False if args.quiet else None)
 
 
 #: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
