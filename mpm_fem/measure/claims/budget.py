@@ -6,8 +6,7 @@ from __future__ import annotations
 import math
 
 from mpm_fem.measure.claims.base import Criterion, Tables, claim
-from mpm_fem.measure.claims.rows import num, select
-from mpm_fem.measure.claims.sod import CONVERGING_ORDER, FLOOR_ORDER
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select
 from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF, BUDGET_SHAPLEY
 
 #: E1: a stage dominates when its Shapley share of v(all MPM) - v(all exact) is at least DOMINANT;

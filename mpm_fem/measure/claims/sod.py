@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from mpm_fem.measure.claims.base import Tables, claim
-from mpm_fem.measure.claims.rows import count_verdict, num, select, span
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
 from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, lumping_claim, mass_shares, ppc_claim
 from mpm_fem.measure.schema import BUDGET_SHAPLEY, SOD_CONVERGENCE, SOD_EXTREMA, SOD_MASS, SOD_PPC, SOD_REGIONS
 from mpm_fem.measure.source import OPTIMAL_PPC, SOD
@@ -16,7 +16,7 @@ from mpm_fem.measure.tables import setting
 CONVERGENCE = SOD_CONVERGENCE.name
 #: C11: a floor means the nodal L1 order drops below FLOOR_ORDER between the last meshes after
 #: exceeding CONVERGING_ORDER between the first ones; it needs at least FLOOR_MESHES meshes.
-FLOOR_ORDER, CONVERGING_ORDER, FLOOR_MESHES, FLOOR_STEPS = 0.5, 0.7, 5, 2
+FLOOR_MESHES, FLOOR_STEPS = 5, 2
 #: C12: the waves (regions 1, 3, 4, 6) carry at least WAVE_SHARE of the nodal L1 error.
 WAVE_REGIONS, WAVE_SHARE = (1, 3, 4, 6), 0.5
 #: C14: a crossing particle becomes a new extremum at least EXTREMA_RATIO times as often as another one.
