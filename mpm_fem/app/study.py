@@ -122,7 +122,8 @@ def add_study_options(parser: argparse.ArgumentParser, quick_flag: bool = True, 
                         help="worker processes, at most the number of cores (default: the cores, at most 8)")
     parser.add_argument("--scheduler", default=None,
                         help="address of a running Dask scheduler, tcp://HOST:PORT (checked with a 3 s connect)")
-    parser.add_argument("--out", default=None, help=out_help or "figures folder (default: figures, or figures/quick with --quick)")
+    parser.add_argument("--out", default=None,
+                        help=out_help or "figures folder (default: figures, or figures/quick with --quick)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
 
 
@@ -135,7 +136,8 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
         out = ensure_writable_dir(out)
     except PermissionError as err:
         raise guard.UsageError(str(err)) from None
-    return StudyOptions(quick=args.quick, jobs=jobs, scheduler=scheduler, out=out, progress=False if args.quiet else None)
+    return StudyOptions(quick=args.quick, jobs=jobs, scheduler=scheduler, out=out,
+                        progress=False if args.quiet else None)
 
 
 #: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
