@@ -8,7 +8,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_fem_cost_reports_numpy_compiled_and_mpm_per_mesh():
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fem_cost.py"), "--T", "0.01", "--finest", "0.0025"],
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fem_cost.py"),
+                           "--T", "0.01", "--finest", "0.0025"],
                           capture_output=True, text=True, timeout=600, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
     rows = [line.split() for line in proc.stdout.splitlines() if line.split() and line.split()[0].startswith("0.00")]

@@ -201,14 +201,17 @@ def test_small_case_has_every_subset_and_its_shapley_values_add_up(small):
         assert abs(gap) > 0.1 * v[ALL], f"{problem} {norm}: the stages change nothing? {v}"
         assert abs(sum(d.shapley.values()) - gap) <= 1e-12 * abs(gap)
         assert abs(sum(d.moebius.values()) - v[ALL]) <= 1e-12 * v[ALL]
-    got = {(problem, h, "mpm"): {"subsets": {norm: {label(S): float(np.sum(w * np.abs(f[norm]))) for S, f in fields.items()}
+    got = {(problem, h, "mpm"): {"subsets": {norm: {label(S): float(np.sum(w * np.abs(f[norm])))
+                                                    for S, f in fields.items()}
                                              for norm, w in weights.items()}}}
     rows = study.subset_rows(got)
-    assert len(rows) == 16 * len(weights) and {r["mpm_stages"] for r in rows} >= {"none", "interpolation+mass+projection+time"}
+    assert (len(rows) == 16 * len(weights)
+            and {r["mpm_stages"] for r in rows} >= {"none", "interpolation+mass+projection+time"})
     shapley, interactions = study.decomposition_rows(rows)
     for norm in weights:
         group = [r for r in shapley if r["norm"] == norm]
-        assert abs(sum(r["shapley"] for r in group) - (group[0]["mpm_error"] - group[0]["exact_error"])) <= 1e-12 * group[0]["mpm_error"]
+        assert (abs(sum(r["shapley"] for r in group) - (group[0]["mpm_error"] - group[0]["exact_error"]))
+                <= 1e-12 * group[0]["mpm_error"])
         assert sum(r["share"] for r in group) == pytest.approx(1.0, abs=1e-12)
         assert len([r for r in interactions if r["norm"] == norm]) == 11
 
@@ -247,7 +250,8 @@ def test_the_particle_domain_bspline_runs_every_subset_and_its_shapley_values_ad
     np.testing.assert_array_equal(field_on(points, plain.particles.x, plain.particles.density) - exact,
                                   fields[ALL]["particles"])
     plan = study.plan("full")["budget"]
-    assert {h for p, h, b in plan if (p, b) == ("sod", "bspline_gimp")} == {h for p, h, b in plan if (p, b) == ("sod", "bspline")}
+    assert ({h for p, h, b in plan if (p, b) == ("sod", "bspline_gimp")}
+            == {h for p, h, b in plan if (p, b) == ("sod", "bspline")})
 
 
 def test_the_roundoff_table_compares_the_two_arithmetics():

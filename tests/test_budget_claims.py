@@ -18,7 +18,8 @@ def _shapley(shares: dict, problem: str = "burgers", norm: str = "particles") ->
     for (h, basis), values in shares.items():
         for stage, share in zip(STAGES, values, strict=False):
             rows.append({"problem": problem, "h": str(h), "basis": basis, "norm": norm, "stage": stage,
-                         "shapley": repr(share * 1e-3), "share": repr(share), "mpm_error": "0.0012", "exact_error": "0.0002"})
+                         "shapley": repr(share * 1e-3), "share": repr(share),
+                         "mpm_error": "0.0012", "exact_error": "0.0002"})
     return rows
 
 
@@ -54,7 +55,8 @@ def test_e1_sod_reads_both_norms_and_is_not_measured_without_its_table():
 
 
 def _time_tables(global_order: float, local_order: float) -> dict:
-    fits = [{"problem": p, "basis": b, "quantity": "velocity", "refine": "1", "order": "", "fitted_order": repr(global_order)}
+    fits = [{"problem": p, "basis": b, "quantity": "velocity", "refine": "1", "order": "",
+             "fitted_order": repr(global_order)}
             for p in ("pulse", "burgers") for b in ("mpm", "bspline")]
     local = [{"problem": p, "basis": b, "quantity": "x", "order": "", "fitted_order": repr(local_order)}
              for p in ("pulse", "burgers") for b in ("mpm", "bspline")]
@@ -87,7 +89,8 @@ def test_e2_follows_the_last_refinement_orders():
     meshes = sorted({r["h"] for r in TABLES["budget/bases"]}, key=float)  # the last refinement: meshes[1] -> [0]
     finest = {"h": meshes[0]}
     coarse = {r["basis"]: float(r["particles_L1"]) for r in TABLES["budget/bases"] if r["h"] == meshes[1]}
-    p1_fine = next(float(r["particles_L1"]) for r in TABLES["budget/bases"] if r["h"] == meshes[0] and r["basis"] == "mpm")
+    p1_fine = next(float(r["particles_L1"]) for r in TABLES["budget/bases"]
+                   if r["h"] == meshes[0] and r["basis"] == "mpm")
     stalled = TABLES
     for basis in ("gimp", "bspline"):  # the smooth bases level off as P1 does, a little worse (order P1's - 0.14)
         stalled = mutate(stalled, "budget/bases", {**finest, "basis": basis},
@@ -143,7 +146,9 @@ def test_e5_names_the_stage_that_dominates_the_closest_remedys_remaining_error()
     verdict, evidence = judge("E5", _e5_tables((0.7, -0.1, 0.3, 0.1)))
     assert verdict == "confirmed"
     assert ("the budget of its basis bspline_gimp at h = 0.005 (particle density L1): projection carries 70% of "
-            "the remaining error v(all MPM) - v(all exact) = 0.001, then interpolation 30%, time 10%, mass -10%") in evidence
+            "the remaining error v(all MPM) - v(all exact) = 0.001, then interpolation 30%, time 10%, "
+            "mass -10%") in evidence
     moved = judge("E5", _e5_tables((0.1, 0.1, 0.2, 0.6)))[1]
     assert "time carries 60%" in moved and "projection carries" not in moved
-    assert "no error budget of its basis bspline_gimp" in judge("E5", {**_e5_tables((0.7, 0, 0.2, 0.1)), "budget/shapley": []})[1]
+    assert "no error budget of its basis bspline_gimp" in judge(
+        "E5", {**_e5_tables((0.7, 0, 0.2, 0.1)), "budget/shapley": []})[1]

@@ -37,7 +37,8 @@ def test_fused_run_is_the_numpy_step(changes):
     numpy_run = burgers.simulate(replace(settings, kernel="numpy"), progress=False)
     fused = burgers.simulate(settings, progress=False)
     assert fused.steps == numpy_run.steps and fused.particles.n == numpy_run.particles.n
-    pairs = zip(_by_position(numpy_run) + (numpy_run.nodal_velocity,), _by_position(fused) + (fused.nodal_velocity,), strict=False)
+    pairs = zip(_by_position(numpy_run) + (numpy_run.nodal_velocity,), _by_position(fused) + (fused.nodal_velocity,),
+                strict=False)
     for (a, b), name in zip(pairs, ("x", "v", "V", "v_i"), strict=False):
         gap = float(np.max(np.abs(a - b)) / np.max(np.abs(a)))
         assert gap <= 1e-12, f"{name}: fused and numpy runs differ by {gap:.3g} relative"

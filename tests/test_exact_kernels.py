@@ -38,7 +38,8 @@ def test_compiled_profile_equals_numpy_bit_for_bit(name):
     xi = np.concatenate((np.random.default_rng(2).uniform(-4, 4, 20_000), fields._speeds))
     for got, want in zip(fields._profile(xi), fields._profile_numpy(xi), strict=False):
         assert np.array_equal(got, want)
-    assert np.array_equal(fields._profile(xi[:20_000].reshape(100, -1))[1], fields._profile_numpy(xi[:20_000])[1].reshape(100, -1))
+    assert np.array_equal(fields._profile(xi[:20_000].reshape(100, -1))[1],
+                          fields._profile_numpy(xi[:20_000])[1].reshape(100, -1))
 
 
 @pytest.mark.parametrize("functions", ["mpm", "bspline"])

@@ -36,7 +36,8 @@ def test_splice_and_nodal_sums_equal_numpy_bit_for_bit(functions, h):
             assert np.array_equal(getattr(shape, name), getattr(shape0, name)), name
         rho, v, sigma = fields.integrand(x, t)
         for with_mass in (True, False):
-            got, want = nodal_sums(shape, w, rho, v, sigma, with_mass), nodal_sums_numpy(shape, w, rho, v, sigma, with_mass)
+            got, want = (nodal_sums(shape, w, rho, v, sigma, with_mass),
+                         nodal_sums_numpy(shape, w, rho, v, sigma, with_mass))
             assert (got[0] is None) == (want[0] is None) == (not with_mass)
             for a, b in zip(got, want, strict=False):
                 assert a is None or np.array_equal(a, b)

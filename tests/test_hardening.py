@@ -35,7 +35,8 @@ def _run(argv, capsys):
 
 def _error_lines(err: str) -> list[str]:
     """stderr without the estimate line every run prints at its start."""
-    return [line for line in err.splitlines() if line.strip() and not line.startswith(("sod: estimated", "burgers: estimated"))]
+    return [line for line in err.splitlines()
+            if line.strip() and not line.startswith(("sod: estimated", "burgers: estimated"))]
 
 
 BAD = [
@@ -198,8 +199,8 @@ def test_a_failed_run_leaves_the_output_folder_untouched(tmp_path, capsys):
 
 def test_concurrent_runs_into_one_folder_leave_one_whole_run(tmp_path):
     out = tmp_path / "shared"
-    procs = [subprocess.Popen([sys.executable, "-m", "mpm_fem.app.cli", "sod", "--h", "0.02", "--T", "0.1", "--ppc", str(ppc),
-                               "--save-fields", "3", "--out", str(out), "--overwrite", "--quiet"],
+    procs = [subprocess.Popen([sys.executable, "-m", "mpm_fem.app.cli", "sod", "--h", "0.02", "--T", "0.1",
+                               "--ppc", str(ppc), "--save-fields", "3", "--out", str(out), "--overwrite", "--quiet"],
                               env=ENV, stderr=subprocess.PIPE, text=True) for ppc in (2, 3)]
     codes = [p.wait(timeout=120) for p in procs]
     assert codes == [0, 0], [p.stderr.read() for p in procs]
@@ -241,8 +242,9 @@ def _alive(pid: int) -> bool:
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_ctrl_c_prints_one_line_and_exits_130(tmp_path):
     out = tmp_path / "run"
-    proc = subprocess.Popen([sys.executable, "-m", "mpm_fem.app.cli", "sod", "--h", "0.0005", "--ppc", "16", "--kernel", "numpy",
-                             "--out", str(out)],  # the numpy step: a run of ~1 min, still going at the signal
+    proc = subprocess.Popen([sys.executable, "-m", "mpm_fem.app.cli", "sod", "--h", "0.0005", "--ppc", "16",
+                             "--kernel", "numpy",  # the numpy step: a run of ~1 min, still going at the signal
+                             "--out", str(out)],
                             env=ENV, stderr=subprocess.PIPE, text=True,
                             # a shell's background job starts with SIGINT ignored; a user's terminal does not
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
@@ -286,15 +288,16 @@ FLOAT = st.one_of(st.floats(-1.0, 3.0), st.sampled_from([math.nan, math.inf, -ma
        cfl=FLOAT, gamma=FLOAT, av=FLOAT, seed=st.integers(-3, 5), x0=FLOAT, eps=FLOAT,
        layout=st.sampled_from(["regular", "jittered", "random"]), scheme=st.sampled_from(["usl", "usf", "musl"]),
        mass=st.sampled_from(["lumped", "consistent"]), basis=st.sampled_from(["mpm", "gimp", "bspline"]))
-def test_random_options_finish_or_exit_2_on_one_line(tmp_path_factory, problem, h, ppc, T, cfl, gamma, av, seed, x0, eps,
-                                                     layout, scheme, mass, basis):
+def test_random_options_finish_or_exit_2_on_one_line(tmp_path_factory, problem, h, ppc, T, cfl, gamma, av, seed, x0,
+                                                     eps, layout, scheme, mass, basis):
     import contextlib
     import io
 
     argv = [problem, "--h", h, "--ppc", str(ppc), "--T", repr(T), "--cfl", repr(cfl), "--seed", str(seed),
             "--layout", layout, "--scheme", scheme, "--mass", mass, "--basis", basis, "--quiet",
             "--out", str(tmp_path_factory.mktemp("run") / "out")]
-    argv += ["--gamma", repr(gamma), "--av-linear", repr(av), "--x0", repr(x0)] if problem == "sod" else ["--eps", repr(eps)]
+    argv += (["--gamma", repr(gamma), "--av-linear", repr(av), "--x0", repr(x0)] if problem == "sod"
+             else ["--eps", repr(eps)])
     err = io.StringIO()
     with contextlib.redirect_stderr(err):
         try:
@@ -328,7 +331,8 @@ def test_no_module_imports_the_command_line_and_study_scripts_run_without_it():
     code = ("import sys; from mpm_fem.app.study import script_main; code = script_main('sod', ['--jobs', '0']); "
             "assert 'mpm_fem.app.cli' not in sys.modules; sys.exit(code)")
     proc = subprocess.run([sys.executable, "-c", code], env=ENV, capture_output=True, text=True, timeout=60)
-    assert proc.returncode == 2 and proc.stderr.strip() == "studies/sod.py: error: --jobs must be >= 1, got 0", proc.stderr
+    assert (proc.returncode == 2
+            and proc.stderr.strip() == "studies/sod.py: error: --jobs must be >= 1, got 0"), proc.stderr
 
 
 def test_help_texts_are_complete_and_true():

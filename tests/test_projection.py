@@ -171,5 +171,6 @@ def test_study_case_and_tables_on_a_tiny_sweep():
     t = tables([(c, case(c)) for c in cs])
     orders = {(r["quantity"], r["layout"], r["weights"], r["basis"], r["norm"]): r for r in t["orders"]}
     assert orders[("E_m", "random", "cell", "mpm", "L1")]["band"] == "[1, 2]"
-    assert ("E_F", "advected", "volume", "mpm", "L1") in orders and ("E_F", "random", "volume", "mpm", "L1") not in orders
+    assert (("E_F", "advected", "volume", "mpm", "L1") in orders
+            and ("E_F", "random", "volume", "mpm", "L1") not in orders)
     assert all(r["holds"] == "yes" for r in t["bounds"]), [r for r in t["bounds"] if r["holds"] != "yes"]

@@ -15,7 +15,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 #: Restructured on another branch (issue 17); the lead drops it from here when that branch lands.
 PENDING: set = set()
-MODULES = [p for p in sorted((ROOT / "studies").glob("*.py")) if p.name not in PENDING] + [ROOT / "mpm_fem" / "app" / "report.py"]
+MODULES = ([p for p in sorted((ROOT / "studies").glob("*.py")) if p.name not in PENDING]
+           + [ROOT / "mpm_fem" / "app" / "report.py"])
 NUMBER = re.compile(r"^[-+~]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(%|x)?$")
 PROSE_WORDS = 6
 
@@ -62,6 +63,7 @@ def test_the_check_finds_a_typed_number(tmp_path):
     try:
         path.write_text('"""Doc 1 2 3 4 5 6 7."""\nTEXT = "the order is 0.88 on every mesh of the study"\n'
                         'OK = f"the order is {x:.2f} on every mesh of the study"\n')
-        assert [h.split(": ", 1)[1] for h in typed_numbers(path)] == ["'0.88' in 'the order is 0.88 on every mesh of the study'"]
+        assert [h.split(": ", 1)[1] for h in typed_numbers(path)] == [
+            "'0.88' in 'the order is 0.88 on every mesh of the study'"]
     finally:
         path.unlink()

@@ -23,7 +23,8 @@ from mpm_fem.measure.quadrature import (
 GRADED = grid_from_nodes([0.0, 0.03, 0.1, 0.18, 0.3, 0.45, 0.62, 0.8, 1.0])
 
 
-@pytest.mark.parametrize("grid", [uniform_grid(0, 1, 0.1), uniform_grid(0, 1, 1 / 640), GRADED], ids=["h=0.1", "h=1/640", "graded"])
+@pytest.mark.parametrize("grid", [uniform_grid(0, 1, 0.1), uniform_grid(0, 1, 1 / 640), GRADED],
+                         ids=["h=0.1", "h=1/640", "graded"])
 @pytest.mark.parametrize("n", [1, 2, 3, 4, 8, 16, 32])
 def test_d2_of_regular_midpoints_is_one_over_sqrt12_n(grid, n):
     x, _ = seed_positions(grid, n, "regular")

@@ -149,7 +149,8 @@ def test_gas_state_at_a_reset_volume_keeps_mass_and_internal_energy(rng):
     np.testing.assert_array_equal(new.mass, p.mass)
     np.testing.assert_array_equal(new.energy, p.energy)
     np.testing.assert_allclose(new.density * new.volume, p.mass, rtol=1e-15)
-    np.testing.assert_allclose(new.pressure, gas.thermal_pressure(new.density, new.energy) + 0.1 * new.density, rtol=1e-14)
+    np.testing.assert_allclose(new.pressure, gas.thermal_pressure(new.density, new.energy) + 0.1 * new.density,
+                               rtol=1e-14)
 
 
 # ---------------------------------------------------------------- conservation by the step, every remedy

@@ -16,7 +16,8 @@ H = (0.01, 0.005, 0.0025, 0.00125)
 def rows(problem, remedy, nodes, particles, fv=None):
     out = []
     for k, h in enumerate(H[: len(nodes)]):
-        r = {"problem": problem, "remedy": remedy, "h": str(h), "nodes_L1": str(nodes[k]), "particles_L1": str(particles[k])}
+        r = {"problem": problem, "remedy": remedy, "h": str(h), "nodes_L1": str(nodes[k]),
+             "particles_L1": str(particles[k])}
         if fv is not None:
             r["fv_L1"] = str(fv[k])
         out.append(r)
@@ -83,8 +84,10 @@ def test_of_two_plateau_removers_the_one_nearer_the_fv_error_is_named():
     moving that ratio above the other's names the other."""
     fv = [x / 2.0 for x in GOOD_SOD["particles"]]  # 'fix': particles at 2x the FV error
     near = dict(nodes=GOOD_SOD["nodes"], particles=[x * 1.8 for x in fv])  # 1.8x the FV error
-    v, evidence = verdict(table(fv=fv, extra=rows("sod", "near", **near, fv=fv) + rows("burgers", "near", **GOOD_BURGERS)))
+    v, evidence = verdict(table(fv=fv, extra=rows("sod", "near", **near, fv=fv)
+                                + rows("burgers", "near", **GOOD_BURGERS)))
     assert v == "partly" and evidence.startswith("near:")
     far = dict(near, particles=[x * 2.2 for x in fv])  # now beyond 'fix'
-    v, evidence = verdict(table(fv=fv, extra=rows("sod", "near", **far, fv=fv) + rows("burgers", "near", **GOOD_BURGERS)))
+    v, evidence = verdict(table(fv=fv, extra=rows("sod", "near", **far, fv=fv)
+                                + rows("burgers", "near", **GOOD_BURGERS)))
     assert v == "partly" and evidence.startswith("fix:")

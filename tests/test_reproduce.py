@@ -18,7 +18,8 @@ from mpm_fem.measure.claims import STATEMENTS
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"
 TABLES = {
-    "sod/convergence.csv": (("h",), ("mpm_nodes_L1", "mpm_particles_L1", "fem_lumped_L1", "fem_consistent_L1", "fv_L1")),
+    "sod/convergence.csv": (("h",),
+                            ("mpm_nodes_L1", "mpm_particles_L1", "fem_lumped_L1", "fem_consistent_L1", "fv_L1")),
     "burgers/errors.csv": (("solution", "method", "eps", "h"), ("particles_L1", "particles_max", "nodes_L1")),
     "projection/errors.csv": (("quantity", "layout", "weights", "basis", "N_p", "h", "norm", "seeds"), ("value",)),
     "budget/subsets.csv": (("problem", "h", "basis", "norm", "mpm_stages"), ("error",)),
@@ -56,6 +57,7 @@ def test_quick_run_reproduces_the_committed_numbers(quick, table):
             if a == b:
                 continue
             if a == "" or b == "" or not np.isclose(float(a), float(b), rtol=RTOL, atol=0):
-                differ.append(f"{dict(zip(keys, (row[k] for k in keys), strict=False))} {column}: quick {a}, committed {b}")
+                differ.append(f"{dict(zip(keys, (row[k] for k in keys), strict=False))} "
+                              f"{column}: quick {a}, committed {b}")
     assert matched > 0, f"no row of the quick {table} is in the committed one"
     assert not differ, f"{len(differ)} of {matched} rows differ, e.g. " + "; ".join(differ[:3])

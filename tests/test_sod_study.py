@@ -140,7 +140,8 @@ def _check_quick_outputs(folder, hs, ppc_h):
 
     for name in ("convergence", "regions", "extrema", "ppc", "mass"):
         assert (folder / "sod" / f"{name}.csv").exists() and (folder / "sod" / f"{name}.json").exists(), name
-    for png in ("convergence", "regions", "extrema", "ppc") + tuple(f"profiles_h{h:g}" for h in study.PROFILE_H if h in hs):
+    profiles = tuple(f"profiles_h{h:g}" for h in study.PROFILE_H if h in hs)
+    for png in ("convergence", "regions", "extrema", "ppc") + profiles:
         assert (folder / "sod" / f"{png}.png").exists(), png
     tables = load_tables(folder)
     verdicts = {c.label: c.verdict(tables)[0] for c in claims_of("sod")}

@@ -66,7 +66,8 @@ def test_a_killed_sweep_resumes_without_recomputing_finished_cases(tmp_path):
     trace, cache = tmp_path / "trace", tmp_path / "cache"
     cases = [{"n": n, "trace": str(trace), "sleep": 0.3} for n in range(12)]
     script = (
-        "import sys, json; sys.path.insert(0, sys.argv[1]); import test_sweep; from mpm_fem.app.sweep import run_cases; "
+        "import sys, json; sys.path.insert(0, sys.argv[1]); import test_sweep; "
+        "from mpm_fem.app.sweep import run_cases; "
         "run_cases(test_sweep.slow_square, json.loads(sys.argv[2]), jobs=1, cache_dir=sys.argv[3], progress=False)"
     )
     import json

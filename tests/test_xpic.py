@@ -121,8 +121,10 @@ def test_xpic_one_is_the_pic_blend_bit_for_bit(basis):
     a = b = particles
     for n in range(30):
         t = n * problem.dt
-        a, _ = explicit_step(grid, a, problem.model, problem.boundary, t, problem.dt, dataclasses.replace(stages, xpic=1))
-        b, _ = explicit_step(grid, b, problem.model, problem.boundary, t, problem.dt, dataclasses.replace(stages, flip=0.0))
+        a, _ = explicit_step(grid, a, problem.model, problem.boundary, t, problem.dt,
+                             dataclasses.replace(stages, xpic=1))
+        b, _ = explicit_step(grid, b, problem.model, problem.boundary, t, problem.dt,
+                             dataclasses.replace(stages, flip=0.0))
     for name in ("x", "velocity", "density", "energy", "volume"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
     assert np.abs(a.velocity).max() > 1e-3  # the pulse moved

@@ -84,7 +84,8 @@ def check_cost(cost, yes_long: bool = False, memory: int | None = None) -> None:
     memory = available_memory() if memory is None else memory
     if memory is not None and cost.bytes > MEMORY_SHARE * memory:
         raise UsageError(f"the run needs about {_size(cost.bytes)} ({_count(cost.particles)} particles, "
-                         f"{_count(cost.nodes)} nodes, {_count(cost.steps)} steps), over the limit of {_size(MEMORY_SHARE * memory)} "
+                         f"{_count(cost.nodes)} nodes, {_count(cost.steps)} steps), "
+                         f"over the limit of {_size(MEMORY_SHARE * memory)} "
                          f"({MEMORY_SHARE:.0%} of the available memory)")
     if cost.seconds > LONG_RUN_S and not yes_long:
         raise UsageError(f"{describe(cost)}: over {LONG_RUN_S / 3600:g} h; pass --yes-long to run it")

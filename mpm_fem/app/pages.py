@@ -50,12 +50,14 @@ PAGES = (
          "discrepancy and bound are measured on every cell. Orders are least-squares slopes over all meshes.",
          views=(
              View("projection/orders", "Least-squares L1 orders per layout at the middle particle count, point mass "
-                  "with the slides' weights", ("quantity", "layout", "N_p", "order", "order_coarse", "order_fine", "band"),
+                  "with the slides' weights",
+                  ("quantity", "layout", "N_p", "order", "order_coarse", "order_fine", "band"),
                   {"norm": "L1", "weights": "cell", "basis": "mpm", "N_p": 4}, "errors_vs_h.png"),
              View("projection/orders", "The same with the volumes a run carries and with GIMP, advected particles",
                   ("quantity", "weights", "basis", "N_p", "order", "band"),
                   {"layout": "advected", "norm": "L1", "N_p": 4, "weights": "volume"}),
-             View("projection/d2_constant", "The C of the slides' D2 formula fitted per layout and N_p", (), {}, "d2.png"),
+             View("projection/d2_constant", "The C of the slides' D2 formula fitted per layout and N_p", (), {},
+                  "d2.png"),
          )),
     Page("sod", "Sod's shock tube",
          "Density error at the final time against the exact Riemann solution, with one set of MPM settings for every "
@@ -63,8 +65,9 @@ PAGES = (
          "consistent and lumped mass and a finite-volume reference on the same mesh, and beside the source's table.",
          views=(
              View("sod/convergence", "Density L1 against h, beside the source", (
-                 "h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1", "mpm_particles_L1",
-                 "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1", "order_fv_L1"), {}, "convergence.png"),
+                 "h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1",
+                 "mpm_particles_L1", "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1",
+                 "order_fv_L1"), {}, "convergence.png"),
              View("sod/convergence", "What sets the floor: volume gained by the particles, relative drift of the "
                   "total energy, signed mean error in the smooth region, position error of the rarefaction head", (
                       "h", "mpm_volume_drift", "mpm_energy_drift", "mpm_particles_mean_error_smooth",
@@ -102,8 +105,8 @@ PAGES = (
                   "timestep.png"),
              View("burgers/ppc", "Error against particles per cell", ("method", "h", "ppc", _COMPARED, "best_ppc"), {},
                   "ppc.png"),
-             View("burgers/lumping", "Lumped against consistent mass", ("method", "mass", "h", "where", "L1", "L2", "max"),
-                  {}, "lumping.png"),
+             View("burgers/lumping", "Lumped against consistent mass",
+                  ("method", "mass", "h", "where", "L1", "L2", "max"), {}, "lumping.png"),
              View("burgers/diagnosis", "Why the calculated acceleration stalls: one change at a time",
                   ("variant", "h", f"{_WHERE}_L1", "order_L1"), {}, "diagnosis.png"),
          )),
@@ -120,12 +123,15 @@ PAGES = (
              View("budget/shapley", "Burgers, particle velocity L1", _SHAPLEY, {"problem": "burgers"},
                   "shapley_burgers.png"),
              View("budget/interactions", "Sod, point-mass P1, particles: the interactions (Moebius terms of two and "
-                  "more stages)", ("h", "stages", "term", "share"), {"problem": "sod", "basis": "mpm", "norm": "particles"}),
+                  "more stages)", ("h", "stages", "term", "share"),
+                  {"problem": "sod", "basis": "mpm", "norm": "particles"}),
              View("budget/regions", "Sod, point-mass P1: share of each Shapley error field's L1 by region of the exact "
-                  "solution (C12)", ("h", "basis", "field", "L1") + tuple(f"share_{n.replace(' ', '_')}" for n in REGION_NAMES),
+                  "solution (C12)",
+                  ("h", "basis", "field", "L1") + tuple(f"share_{n.replace(' ', '_')}" for n in REGION_NAMES),
                   {"basis": "mpm"}, "fields_sod.png"),
-             View("budget/bases", "E2: Sod with each basis, MPM stages", ("basis", "h", "ok", "particles_L1", "nodes_L1",
-                  "plateau_noise", "plateau_offset"), {}, "bases.png"),
+             View("budget/bases", "E2: Sod with each basis, MPM stages",
+                  ("basis", "h", "ok", "particles_L1", "nodes_L1", "plateau_noise", "plateau_offset"), {},
+                  "bases.png"),
          )),
     Page("time", "Time error (C1) and grid crossing (C2)",
          "At a fixed mesh and fixed particles, the time step alone is refined against a much smaller step: the global "

@@ -2,10 +2,11 @@
 
 Each study's section is a :class:`~mpm_fem.app.pages.Page` (:data:`mpm_fem.app.pages.PAGES`): a title, a
 caption in words, and views of its tables (a table, the rows and columns shown, the figure beside
-it); the figures' one-line captions are those the study recorded when it drew them. The report opens with a one-screen summary (claim, verdict, key number, link), then shows
-every study's claims (verdict, evidence, the source's number, the thresholds) beside the tables and
-figures they rest on. Every number in it comes from the tables it was rendered from, so rendering the
-committed tables again gives the same bytes: ``python -m mpm_fem.app.report [--out figures]``.
+it); the figures' one-line captions are those the study recorded when it drew them. The report opens
+with a one-screen summary (claim, verdict, key number, link), then shows every study's claims
+(verdict, evidence, the source's number, the thresholds) beside the tables and figures they rest on.
+Every number in it comes from the tables it was rendered from, so rendering the committed tables
+again gives the same bytes: ``python -m mpm_fem.app.report [--out figures]``.
 """
 
 from __future__ import annotations
