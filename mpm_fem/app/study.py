@@ -160,11 +160,7 @@ def add_study_options(parser: argparse.ArgumentParser, quick_flag: bool = True, 
     parser.add_argument("--scheduler", default=None,
                         help="address of a running Dask scheduler, tcp://HOST:PORT (checked with a 3 s connect)")
     parser.add_argument("--out", default=None,
-<<<<<<< HEAD
                         help=out_help or "figures folder (default: figures, figures/quick or figures/deep by tier)")
-=======
-                        help=out_help or "figures folder (default: figures, or figures/quick with --quick)")
->>>>>>> lint
     parser.add_argument("--quiet", action="store_true", help="no progress output")
 
 
@@ -180,13 +176,8 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
         out = ensure_writable_dir(out)
     except PermissionError as err:
         raise guard.UsageError(str(err)) from None
-<<<<<<< HEAD
     return StudyOptions(quick=tier == "quick", deep=tier == "deep", jobs=jobs, scheduler=scheduler, out=out,
                         cache=cache, progress=False if args.quiet else None)
-=======
-    return StudyOptions(quick=args.quick, jobs=jobs, scheduler=scheduler, out=out,
-                        progress=False if args.quiet else None)
->>>>>>> lint
 
 
 #: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
