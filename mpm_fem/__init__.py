@@ -2,6 +2,19 @@
 
 Reproduces and extends L.-T. Tran and M. Berzins, "Error Analysis for Material Point Method and a
 case study from Gas Dynamics" (slides; the claims and the source's tables: ``docs/claims.md``).
+
+The notebook entry points, :func:`sod` and :func:`burgers` (:mod:`mpm_fem.app.api`), run one case
+with the command line's defaults: ``mpm_fem.sod(h=0.005, ppc=8).errors``. They are imported on first
+use, so that ``import mpm_fem`` stays cheap.
 """
 
 __version__ = "0.1.0"
+__all__ = ["sod", "burgers", "Run"]
+
+
+def __getattr__(name: str):
+    if name in __all__:
+        from mpm_fem.app import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'mpm_fem' has no attribute {name!r}")

@@ -37,8 +37,9 @@ FOLDERS = {
     "mpm_fem.app": 4,
     "studies": 5,
 }
-#: modules that are not in a layer folder: the package's own ``__init__`` (its version only).
-TOP = {"mpm_fem": 2}
+#: modules that are not in a layer folder: the package's own ``__init__``, whose notebook entry
+#: points (``mpm_fem.sod``) are the application's (``mpm_fem.app.api``).
+TOP = {"mpm_fem": 4}
 LAYERS = sorted(set(FOLDERS.values()))
 
 
