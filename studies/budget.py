@@ -57,7 +57,7 @@ from pathlib import Path
 import numpy as np
 
 from baselines.exact import riemann
-from mpm_fem.app.plots import Curve, Plot, plt, save
+from mpm_fem.app.plots import Curve, Plot, grid_shape, plt, save
 from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import PositivityError
@@ -274,9 +274,13 @@ def shapley_figure(path: Path, rows: list[dict]) -> None:
     floor (up when positive, down when negative), ending at v(all MPM) (black mark)."""
     norms = list(dict.fromkeys(r["norm"] for r in rows))
     bases = [b for b in BUDGET_BASES if any(r["basis"] == b for r in rows)]
-    fig, axes = plt.subplots(len(norms), len(bases), figsize=(4.2 * len(bases), 3.6 * len(norms)), squeeze=False)
-    for (i, norm), (k, basis) in ((a, b) for a in enumerate(norms) for b in enumerate(bases)):
-        ax, sub = axes[i][k], [r for r in rows if r["norm"] == norm and r["basis"] == basis]
+    pairs = [(norm, basis) for norm in norms for basis in bases]
+    nrows, ncols = grid_shape(len(pairs), (4.2, 3.6))
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.2 * ncols, 3.6 * nrows), squeeze=False)
+    for ax in axes.ravel()[len(pairs):]:
+        ax.set_visible(False)
+    for ax, (norm, basis) in zip(axes.ravel(), pairs, strict=False):
+        sub = [r for r in rows if r["norm"] == norm and r["basis"] == basis]
         hs = sorted({r["h"] for r in sub}, reverse=True)
         for j, h in enumerate(hs):
             at = {r["stage"]: r for r in sub if r["h"] == h}
@@ -292,7 +296,7 @@ def shapley_figure(path: Path, rows: list[dict]) -> None:
         ax.axhline(0, color="k", lw=0.5)
         ax.set_xticks(range(len(hs)), [f"{h:g}" for h in hs])
         ax.set(xlabel="h", ylabel=f"{norm} L1 error", title=f"{rows[0]['problem']}, {basis}, {norm}")
-    axes[0][-1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    axes[0][0].legend(fontsize=7)
     save(fig, path, caption=f"{rows[0]['problem']}: v(all exact) as the grey floor, each stage's Shapley value "
                             "stacked on it (signed), ending at v(all MPM) (black mark)")
 

@@ -266,7 +266,7 @@ def figures(folder: Path, t: dict, results: list) -> None:
                caption="D2 against N_p and against h, beside the closed forms and the slides' formula")
 
     # measured quadrature error against Hickernell's bound
-    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
+    fig, axes = plt.subplots(1, 3, figsize=(13, 5.2))
     labels = {"cell_rho": "cell mean of rho: bound (1)", "node_m": "nodal mass E_m^i: two-cell bound",
               "node_F": "nodal force E_F^i: two-cell bound"}
     bounds = t[PROJECTION_BOUNDS.stem]

@@ -232,7 +232,7 @@ def _cost_figure(folder: Path, cost) -> None:
 
     from mpm_fem.app import plots
 
-    fig, axes = plt.subplots(1, 2, figsize=(13, 4.4))
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.2))
     for method in dict.fromkeys(r["method"] for r in cost):
         s = sorted((r for r in cost if r["method"] == method), key=lambda r: -r["h"])
         style = "k*--" if method.startswith("FV") else "ks:" if method.startswith("FEM") else "o-"

@@ -200,7 +200,7 @@ TIME_PLOT = Plot("time_order.png", "C1: error against dt at fixed h and particle
 
 def crossing_figure(path: Path, got: dict, rows: list[dict]) -> None:
     """dA/dt along the particle's path (exact acceleration) and A itself (calculated), node crossings dotted."""
-    fig, axes = plt.subplots(1, 2, figsize=(11, 3.9))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4))
     for ax, acc in zip(axes, ("exact", "calculated"), strict=True):
         for basis in (b for b in BASES if (b, acc) in got):
             t, A = (np.asarray(got[(basis, acc)]["trace"][k]) for k in ("t", "A"))

@@ -90,3 +90,14 @@ def test_the_command_refuses_a_missing_folder(tmp_path, capsys):
 
     assert main(["--out", str(tmp_path / "absent")]) == 2
     assert "no folder" in capsys.readouterr().err
+
+
+def test_the_grid_of_panels_keeps_every_figure_at_most_two_and_a_half_wide():
+    from mpm_fem.app.plots import MAX_ASPECT, grid_shape
+
+    for n in range(1, 13):
+        for size in ((4.2, 3.8), (3.6, 4.4), (4.6, 3.8), (6.0, 2.0)):
+            rows, cols = grid_shape(n, size)
+            assert rows * cols >= n and (rows - 1) * cols < n, (n, size, rows, cols)
+            assert size[0] * cols <= MAX_ASPECT * size[1] * rows or cols == 1, (n, size, rows, cols)
+    assert grid_shape(4, (4.2, 3.6)) == (2, 2) and grid_shape(2, (4.2, 3.8)) == (1, 2)

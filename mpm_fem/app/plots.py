@@ -24,7 +24,8 @@ def profiles(path, x_exact, exact: dict, x_particles, particles: dict, x_nodes=N
     """One panel per field: exact (line), particles (dots), grid nodes (crosses). Saves a PNG; the
     layout is constrained, so the title (lines split by ``\\n``) fits above the panels."""
     names = list(exact)
-    fig, axes = plt.subplots(1, len(names), figsize=(max(4.2 * len(names), 6.0), 3.8), squeeze=False,
+    width = max(4.2 * len(names), 6.0)
+    fig, axes = plt.subplots(1, len(names), figsize=(width, max(3.8, width / MAX_ASPECT)), squeeze=False,
                              layout="constrained")
     for ax, name in zip(axes[0], names, strict=False):
         ax.plot(x_exact, exact[name], "k-", lw=1.2, label="exact")
@@ -51,6 +52,20 @@ def slope_guides(ax, h, e0: float, slopes=(1, 2)) -> None:
         ax.annotate(f"slope {k:g}", (h[0], e0 * (h[0] / h[-1]) ** k), fontsize=6, color="gray")
 
 
+#: The widest figure the report embeds (width : height): readable at a page width of about 900 px.
+MAX_ASPECT = 2.5
+
+
+def grid_shape(n: int, size: tuple[float, float], max_aspect: float = MAX_ASPECT) -> tuple[int, int]:
+    """``(rows, columns)`` for ``n`` panels of ``size`` (width, height): the fewest rows whose figure
+    is at most ``max_aspect`` wide for its height, and as few columns as those rows need."""
+    for ncols in range(max(n, 1), 0, -1):
+        nrows = -(-n // ncols)
+        if size[0] * ncols <= max_aspect * size[1] * nrows:
+            return nrows, -(-n // nrows)  # as few columns as these rows need
+    return n, 1
+
+
 def panels(path, content: dict, xlabel: str, ylabel: str, title: str = "", ncols: int | None = None,
            slopes=(), size=(4.2, 3.8), log: bool = True, legends: bool = False) -> None:
     """One panel per entry of ``content = {panel title: {label: (x, y, fmt, options)}}`` (``options``
@@ -59,7 +74,8 @@ def panels(path, content: dict, xlabel: str, ylabel: str, title: str = "", ncols
     like any other, drawn black and open (fmt ``"ks"``/``"ko"``/``"k*"``, ``mfc="none"``). With
     ``legends`` every panel gets its own legend (panels that show different series)."""
     names = list(content)
-    ncols = ncols or len(names)
+    widest = grid_shape(len(names), size)[1]
+    ncols = min(ncols or widest, widest)
     nrows = -(-len(names) // ncols)
     fig, axes = plt.subplots(nrows, ncols, figsize=(size[0] * ncols, size[1] * nrows), squeeze=False)
     for ax, name in zip(axes.ravel(), names, strict=False):
@@ -88,9 +104,13 @@ def stacked_shares(path, rows: list[dict], names, title: str = "", ylabel: str =
     """One panel per value of column ``group``, one stacked bar per row (labelled by ``bar``) of the
     columns ``share_0 ... share_k`` (one per entry of ``names``; each bar sums to 1), ``total`` above it."""
     groups = list(dict.fromkeys(r[group] for r in rows))
-    fig, axes = plt.subplots(1, len(groups), figsize=(3.6 * len(groups), 4.0), sharey=True, squeeze=False)
+    # the legend takes a tenth of the width (tight_layout's rect below)
+    nrows, ncols = grid_shape(len(groups), (3.6, 4.0 * 1.1))
+    fig, axes = plt.subplots(nrows, ncols, figsize=(3.6 * ncols / 0.89, 4.0 * nrows), sharey=True, squeeze=False)
     colors = plt.cm.tab10(np.arange(len(names)))
-    for ax, g in zip(axes[0], groups, strict=False):
+    for ax in axes.ravel()[len(groups):]:
+        ax.set_visible(False)
+    for ax, g in zip(axes.ravel(), groups, strict=False):
         bars = [r for r in rows if r[group] == g]
         labels, bottom = [f"{_value(r[bar]):g}" for r in bars], np.zeros(len(bars))
         for k, name in enumerate(names):
@@ -143,7 +163,8 @@ def profile_grid(path, exact: dict, rows: dict, title: str = "") -> None:
     fields it has."""
     per_row = isinstance(next(iter(exact.values())), dict)
     fields = next(iter(exact.values())) if per_row else exact
-    fig, axes = plt.subplots(len(rows), len(fields), figsize=(4 * len(fields), 3.2 * len(rows)), sharex=True,
+    height = max(3.2, 4 * len(fields) / (MAX_ASPECT * len(rows)))  # at most MAX_ASPECT wide
+    fig, axes = plt.subplots(len(rows), len(fields), figsize=(4 * len(fields), height * len(rows)), sharex=True,
                              squeeze=False)
     for axes_row, (row_label, series) in zip(axes, rows.items(), strict=False):
         for ax, (name, (xe, ye)) in zip(axes_row, (exact[row_label] if per_row else exact).items(), strict=False):
