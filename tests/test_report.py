@@ -101,3 +101,13 @@ def test_the_grid_of_panels_keeps_every_figure_at_most_two_and_a_half_wide():
             assert rows * cols >= n and (rows - 1) * cols < n, (n, size, rows, cols)
             assert size[0] * cols <= MAX_ASPECT * size[1] * rows or cols == 1, (n, size, rows, cols)
     assert grid_shape(4, (4.2, 3.6)) == (2, 2) and grid_shape(2, (4.2, 3.8)) == (1, 2)
+
+
+def test_a_key_number_is_cut_at_a_comma_to_fit_the_summary():
+    from mpm_fem.app.report import KEY_LENGTH, key_number
+
+    assert key_number("order 0.95; the rest") == "order 0.95"
+    long = ", ".join(f"mesh {k}: order 0.{k}" for k in range(20))
+    cut = key_number(long)
+    assert len(cut) <= KEY_LENGTH and cut.endswith(" ...") and long.startswith(cut[:-4])
+    assert cut[:-4].split(", ")[-1].startswith("mesh")  # whole items only

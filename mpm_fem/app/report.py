@@ -55,9 +55,23 @@ def anchor(claim: Claim) -> str:
     return claim.label.lower().replace(" (", "-").replace(")", "")
 
 
-def key_number(evidence: str) -> str:
-    """The summary's key number: the first clause of the evidence."""
-    return evidence.split(";")[0]
+#: The longest key number of the summary; the whole evidence is in the claim's section.
+KEY_LENGTH = 80
+
+
+def key_number(evidence: str, limit: int = KEY_LENGTH) -> str:
+    """The summary's key number: the first clause of the evidence, cut after its last comma-separated
+    item that fits ``limit`` characters (then ending in " ...")."""
+    first = evidence.split(";")[0].strip()
+    if len(first) <= limit:
+        return first
+    items, kept = first.split(", "), ""
+    for item in items:
+        longer = f"{kept}, {item}" if kept else item
+        if len(longer) > limit - 4:
+            break
+        kept = longer
+    return f"{kept or first[: limit - 4]} ..."
 
 
 def code_version(tables: Tables) -> str:
