@@ -5,11 +5,13 @@ table row has as many cells as its header."""
 from __future__ import annotations
 
 import re
+import shutil
+import tempfile
 from pathlib import Path
 
 import pytest
 
-from mpm_fem.app.report import Page, View, captions_of, cell, markdown_table, render, study_pages, write_report
+from mpm_fem.app.report import Page, View, cell, markdown_table, write_report
 from mpm_fem.measure.claims import STATEMENTS
 from mpm_fem.measure.tables import load_tables
 
@@ -22,8 +24,9 @@ def committed():
 
 
 def test_the_committed_report_is_the_rendering_of_the_committed_tables(committed):
-    pages = study_pages(FIGURES)
-    rendered = render(load_tables(FIGURES), pages, {p.name: captions_of(FIGURES / p.name) for p in pages}) + "\n"
+    with tempfile.TemporaryDirectory() as folder:
+        shutil.copytree(FIGURES, folder, dirs_exist_ok=True, ignore=shutil.ignore_patterns(".cache"))
+        rendered = write_report(Path(folder)).read_text()
     assert rendered == committed, "figures/REPORT.md differs from `python -m mpm_fem.app.report --out figures`"
 
 
@@ -33,9 +36,26 @@ def test_the_header_names_the_code_version_of_the_tables(committed):
 
 
 def test_every_claim_is_in_the_summary(committed):
-    summary = committed.split("## Summary")[1].split("<a id=")[0]
+    summary = committed.split("## The source's claims")[1].split("<a id=")[0]
     for cid in STATEMENTS:
         assert re.search(rf"^\| \[?{cid}[\] (|]", summary, re.M), cid
+
+
+def test_the_first_screen_holds_the_abstract_the_two_verdict_tables_and_two_figures(committed):
+    first = "\n".join(committed.splitlines()[:60])
+    for heading in ("## Abstract", "## The source's claims", "## Extensions"):
+        assert heading in first, heading
+    assert first.count("![") >= 2, "the two key figures"
+
+
+def test_every_embedded_figure_is_at_most_two_and_a_half_wide(committed):
+    import matplotlib.image as image
+
+    from mpm_fem.app.plots import MAX_ASPECT
+
+    for target in re.findall(r"!\[[^]]*\]\(([^)]+)\)", committed):
+        height, width = image.imread(FIGURES / target).shape[:2]
+        assert width <= MAX_ASPECT * height * 1.01, (target, width, height)
 
 
 def test_every_anchor_and_link_resolves_inside_the_folder(committed):

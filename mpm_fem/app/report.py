@@ -1,12 +1,14 @@
 """``REPORT.md``, rendered from the claims (:mod:`mpm_fem.measure.claims`) and the tables, never typed.
 
-Each study's section is a :class:`~mpm_fem.app.pages.Page` (:data:`mpm_fem.app.pages.PAGES`): a title, a
-caption in words, and views of its tables (a table, the rows and columns shown, the figure beside
-it); the figures' one-line captions are those the study recorded when it drew them. The report opens
-with a one-screen summary (claim, verdict, key number, link), then shows every study's claims
-(verdict, evidence, the source's number, the thresholds) beside the tables and figures they rest on.
-Every number in it comes from the tables it was rendered from, so rendering the committed tables
-again gives the same bytes: ``python -m mpm_fem.app.report [--out figures]``.
+The report reads as a paper. Its first screen: the title, an abstract formatted from the verdicts
+and their key numbers, the verdict table split into the source's claims and the extensions, the
+two figures that carry the study, and the caveats (the settings that differ from the source's, the
+tier, whether the figures lag the code). Then one section per study with one subsection per claim
+(statement, source, verdict, one figure, the evidence and the rule), then the deep tier's verdicts
+when ``<out>/deep/`` holds tables, then the appendices: each study's tables and figures
+(:class:`~mpm_fem.app.pages.Page`, :data:`mpm_fem.app.pages.PAGES`), linked from its claims. Every
+number comes from the tables it was rendered from, so rendering the committed tables again gives
+the same bytes: ``python -m mpm_fem.app.report [--out figures]``.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from pathlib import Path
 from mpm_fem.app.output import write_atomic
 from mpm_fem.app.pages import PAGES, Page, View  # noqa: F401  (View: part of this module's interface)
 from mpm_fem.app.plots import CAPTIONS
+from mpm_fem.app.sweep import code_version as current_code
 from mpm_fem.measure.claims import CLAIMS, STATEMENTS, Claim, claims_of, select
 from mpm_fem.measure.tables import Tables, load_tables
 
@@ -86,11 +89,14 @@ def is_quick(tables: Tables) -> bool:
 
 # ----------------------------------------------------------------------------- sections
 
-def summary(tables: Tables, link: str = "") -> list[str]:
+def summary(tables: Tables, link: str = "", kind: str = "") -> list[str]:
     """The one-screen summary: every claim, its verdict, key number and section (``link`` prefixes
-    the anchors, e.g. ``figures/REPORT.md`` from the README)."""
+    the anchors, e.g. ``figures/REPORT.md`` from the README); ``kind`` ``"C"`` (the source's claims)
+    or ``"E"`` (the extensions) keeps those only."""
     lines = ["| claim | statement | verdict | key number |", "|---|---|---|---|"]
     for cid, statement in STATEMENTS.items():
+        if not cid.startswith(kind):
+            continue
         found = sorted((c for c in CLAIMS if c.id == cid), key=lambda c: c.problem)
         if not found:
             lines.append(f"| {cid} | {statement} | not measured | no criterion registered |")
@@ -101,13 +107,23 @@ def summary(tables: Tables, link: str = "") -> list[str]:
     return lines
 
 
-def claim_section(c: Claim, tables: Tables) -> list[str]:
+def claim_section(c: Claim, tables: Tables, figure_lines: list[str] = (), appendix: str = "") -> list[str]:
+    """A claim: statement, verdict, its figure, the evidence, the source and the rule, the tables."""
     verdict, evidence = c.verdict(tables)
-    lines = [f'<a id="{anchor(c)}"></a>', "", f"### {c.label}: {c.statement}", "",
-             f"**{verdict}**: {evidence}.", "",
+    lines = [f'<a id="{anchor(c)}"></a>', "", f"### {c.label}: {c.statement}", "", f"**{verdict}**", "",
+             *figure_lines, f"{evidence}.", "",
              f"- Source: {c.source}.", f"- Verdict rule: {c.thresholds}.",
-             "- Tables: " + ", ".join(f"[{t}.csv]({t}.csv)" for t in c.tables if "/" in t) + "."]
+             "- Tables: " + ", ".join(f"[{t}.csv]({t}.csv)" for t in c.tables if "/" in t)
+             + (f" ([appendix](#{appendix}))." if appendix else ".")]
     return lines + ([f"- Why: {c.explanation}", ""] if c.explanation else [""])
+
+
+def claim_figure(c: Claim, page: Page | None, captions: dict) -> list[str]:
+    """The first figure of the page's views of a table the claim reads (none if no view has one)."""
+    for v in page.views if page else ():
+        if v.figure and v.table in c.tables and v.figure in captions:
+            return figure(page.name, v.figure, captions)
+    return []
 
 
 def figure(page: str, file: str, captions: dict) -> list[str]:
@@ -137,9 +153,16 @@ def view_section(page: Page, v: View, tables: Tables, captions: dict) -> list[st
 
 
 def page_section(page: Page, tables: Tables, captions: dict) -> list[str]:
+    """A study's claims, each with its figure, linking to the study's appendix."""
     lines = [f'<a id="{page.name}"></a>', "", f"## {page.title}", "", page.caption, ""]
     for c in claims_of(page.name):
-        lines += claim_section(c, tables)
+        lines += claim_section(c, tables, claim_figure(c, page, captions), f"appendix-{page.name}")
+    return lines
+
+
+def appendix_section(page: Page, tables: Tables, captions: dict) -> list[str]:
+    """A study's tables and every figure it drew."""
+    lines = [f'<a id="appendix-{page.name}"></a>', "", f"## Appendix: {page.title}", ""]
     for v in page.views:
         lines += view_section(page, v, tables, captions)
     shown = {v.figure for v in page.views}
@@ -158,24 +181,86 @@ def reproduction_section(tables: Tables) -> list[str]:
     return lines + markdown_table(tables.get("versions", []), ("table", "code", "quick")) + [""]
 
 
-def render(tables: Tables, pages, captions: dict[str, dict] | None = None) -> str:
-    """The whole report, from ``tables`` (:func:`mpm_fem.measure.tables.load_tables`), the study ``pages`` and
-    the figure ``captions`` of each study folder (``{study: {file: caption}}``)."""
+#: The two figures that carry the study, shown on the first screen when the report's folder has them.
+KEY_FIGURES = ("sod/convergence.png", "burgers/convergence.png")
+#: The claims the abstract reports, in this order, with what each says in words.
+ABSTRACT = (("C11", "Sod's shock tube"), ("C13", "viscous Burgers"), ("E1", "the error budget"),
+            ("E3", "MPM against fixed-mesh FEM on the same mesh"))
+
+
+def abstract(tables: Tables) -> list[str]:
+    """Three to five sentences formatted from the verdicts and their key numbers."""
+    found = {}
+    for c in CLAIMS:
+        found.setdefault(c.id, []).append((c, *c.verdict(tables)))
+    source = [v for cid, vs in found.items() if cid.startswith("C") for _, v, _ in vs]
+    counts = {v: source.count(v) for v in dict.fromkeys(source)}
+    lines = [f"We judge {len(source)} verdicts on the source's claims and "
+             f"{sum(len(vs) for cid, vs in found.items() if cid.startswith('E'))} on the extensions, each "
+             "computed from the tables below: " + ", ".join(f"{n} {v}" for v, n in counts.items()) + "."]
+    for cid, words in ABSTRACT:
+        for c, verdict, evidence in found.get(cid, []):
+            lines.append(f"On {words}{f' ({c.problem})' if c.problem else ''}, {c.id} is **{verdict}**: "
+                         f"{key_number(evidence, 2 * KEY_LENGTH)}.")
+    return [" ".join(lines), ""]
+
+
+def caveats(tables: Tables, current: str | None) -> list[str]:
+    """What a reader must know before the numbers: the tier, the study's settings that differ from the
+    source's, and whether the figures lag the code (``current``: the code version now, if known)."""
+    out = ["## Caveats", ""]
+    out.append("- These tables come from `mpm-fem reproduce --quick`: a subset of the meshes of each study."
+               if is_quick(tables) else "- These tables come from `mpm-fem reproduce --full`.")
+    written = code_version(tables)
+    if current is not None and current != written:
+        out.append(f"- **The figures lag the code**: the tables were written by code version {written}, the code "
+                   f"is now {current}; `mpm-fem reproduce --full` regenerates them.")
+    elif current is not None:
+        out.append(f"- The tables were written by the current code ({written}).")
+    setting = {r["key"]: r["value"] for r in tables.get("settings", []) if r["table"] == "sod/convergence"}
+    if "mpm.ppc" in setting:
+        out.append(f"- Sod's convergence study runs {setting['mpm.ppc']} particles per cell at CFL "
+                   f"{setting.get('mpm.cfl', '?')} (`sod/convergence.json`); the source prescribes 4-8 per cell and "
+                   "states no time step: the claims on Sod state their verdict per setting where the tables hold "
+                   "several.")
+    return out + [""]
+
+
+def render(tables: Tables, pages, captions: dict[str, dict] | None = None, current: str | None = None,
+           deep: Tables | None = None) -> str:
+    """The whole report, from ``tables`` (:func:`mpm_fem.measure.tables.load_tables`), the study ``pages``,
+    the figure ``captions`` of each study folder (``{study: {file: caption}}``), the code version now
+    (``current``) and the deep tier's tables (``deep``, ``None`` when there are none)."""
     captions = captions or {}
-    quick = is_quick(tables)
     head = [TITLE, "",
-            f"Rendered by `python -m mpm_fem.app.report` from the tables of code version {code_version(tables)}, "
-            + ("written by `mpm-fem reproduce --quick`: a subset of the meshes of each study." if quick
-               else "written by `mpm-fem reproduce --full`."),
+            f"Rendered by `python -m mpm_fem.app.report` from the tables of code version {code_version(tables)}. "
             "Source: L.-T. Tran and M. Berzins, Error Analysis for Material Point Method and a case study from Gas "
-            "Dynamics (slides). The claims, the source's tables and the corrections made to them are listed in "
-            "`docs/claims.md` of the repository.", "",
-            "## Summary", ""]
-    lines = head + summary(tables) + [""]
-    for page in pages:
-        if any(t.startswith(page.name + "/") for t in tables):
-            lines += page_section(page, tables, captions.get(page.name, {}))
-    return "\n".join(lines + reproduction_section(tables))
+            "Dynamics (slides; the claims, the source's tables and the corrections made to them: `docs/claims.md` "
+            "of the repository).", "", "## Abstract", "", *abstract(tables),
+            "## The source's claims", "", *summary(tables, kind="C"), "",
+            "## Extensions", "", *summary(tables, kind="E"), ""]
+    for key in KEY_FIGURES:
+        study, file = key.split("/")
+        if file in captions.get(study, {}):
+            head += figure(study, file, captions[study])
+    lines = head + caveats(tables, current)
+    shown = [page for page in pages if any(t.startswith(page.name + "/") for t in tables)]
+    for page in shown:
+        lines += page_section(page, tables, captions.get(page.name, {}))
+    lines += reproduction_section(tables) + deep_section(deep)
+    for page in shown:
+        lines += appendix_section(page, tables, captions.get(page.name, {}))
+    return "\n".join(lines)
+
+
+def deep_section(deep: Tables | None) -> list[str]:
+    """The deep tier's verdicts (``figures/deep/``), or a line saying it holds no tables."""
+    lines = ['<a id="deep"></a>', "", "## The deep tier", ""]
+    if not deep or not deep.get("versions"):
+        return lines + ["`deep/` holds no tables: `mpm-fem reproduce --deep` runs the finest meshes and the long "
+                        "sweeps into it, and this section then shows their verdicts.", ""]
+    return lines + [f"Verdicts on the deep tier's tables (code version {code_version(deep)}, "
+                    f"[deep/REPORT.md](deep/REPORT.md)):", "", *summary(deep, "deep/REPORT.md"), ""]
 
 
 # ----------------------------------------------------------------------------- the command
@@ -192,7 +277,9 @@ def write_report(out: Path, pages: list[Page] | None = None) -> Path:
     """Render ``<out>/REPORT.md`` from the tables and figure captions in ``out``; returns its path."""
     out = Path(out)
     pages = study_pages(out) if pages is None else pages
-    text = render(load_tables(out), pages, {p.name: captions_of(out / p.name) for p in pages})
+    deep = load_tables(out / "deep") if (out / "deep").is_dir() else None
+    text = render(load_tables(out), pages, {p.name: captions_of(out / p.name) for p in pages}, current_code(),
+                  deep)
     path = out / "REPORT.md"
     write_atomic(path, text + "\n")
     return path
