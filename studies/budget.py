@@ -1,7 +1,7 @@
 """Where the MPM error comes from: the error budget over every combination of the stages (E1), and
 the bases (E2).
 
-Caption. Sod's tube (16 particles per cell, CFL 0.05, von Neumann-Richtmyer viscosity 0.5 / 2.0,
+Sod's tube (16 particles per cell, CFL 0.05, von Neumann-Richtmyer viscosity 0.5 / 2.0,
 USL, lumped mass) and viscous Burgers (the rarefaction, eps = 0.045, 4 particles per cell, CFL
 0.5, calculated acceleration) are run for each mesh and basis (point-mass P1 "mpm", GIMP, the C1
 quadratic B-spline "bspline", and E5's closest remedy, the B-spline averaged over the particle
@@ -23,30 +23,16 @@ terms and Shapley values (:mod:`mpm_fem.measure.decomposition`) decompose ``v(al
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.00125 for every basis (four meshes give each basis's budget a trend, not only
-a change; h = 0.000625 was tried and taken out: no case of it finished in 33 min of a full run on 2
-cores); Burgers 0.04 ... 0.01. A Sod case is 16 runs, all on the fused step
-(:mod:`mpm_fem.fused.step`): the fourteen with an exact stage run its compiled particle passes around the
-numpy step's grid stage (the quadrature projection, the FE mass and the exact nodal values; the exact
-fields compiled, :mod:`mpm_fem.exact_stages.kernels`, the quadrature rows cached per grid, the cut pieces, the
-nodal sums and the FE mass entries compiled, :mod:`mpm_fem.exact_stages.grid_kernels`, bit for bit). Four
-exact-stage runs (every stage exact, the exact interpolation, projection, mass alone),
-CPU seconds on the shared 2-core machine, the numpy step -> the fused one: P1 at h = 0.0025 8.9 -> 5.8;
-GIMP at 0.005 8.3 -> 2.4; the particle-domain B-spline at 0.005 9.6 -> 3.4; then the compiled grid
-stage, the four runs with the exact mass: P1 at 0.0025 7.95 -> 3.90, the B-spline at 0.005 4.55 -> 2.22,
-the particle-domain B-spline 4.44 -> 2.07 (means of three alternating rounds). A halving costs about 4x
-(twice the particles, twice the steps). What each run cost is in ``runs.csv`` (``wall_s``).
+Meshes: Sod h = 0.01 ... 0.00125 for every basis (four meshes give each basis's budget a trend, not
+only a change; the deep tier adds P1 at h = 0.000625: :data:`DEEP`); Burgers 0.04 ... 0.01. A Sod case
+is 16 runs, all on the fused step (:mod:`mpm_fem.fused`): the fourteen with an exact stage run its
+compiled particle passes around the numpy step's grid stage (:mod:`mpm_fem.exact_stages`). What each
+run cost is in ``runs.csv`` (``wall_s``); ``docs/performance.md`` has the measured costs.
 Round-off: the subsets with the exact mass stage and the MPM projection (``v_i = v*_i + solve(MPM) -
-solve(exact)``) amplify it. At h = 0.005 a 1-ulp shift of every particle position grows to 5e-9 of the
-velocity in the numpy step with the exact mass (1.7e-13 with every stage MPM), and the fused step's
-uniform-grid arithmetic differs from the numpy step's by 2.6e-8 there (5.7e-14); at h = 0.0025 the
-particle density L1 of that run differs by 0.4% between the two. The budget's numbers carry that spread,
-and ``roundoff.csv`` measures it in every run: P1's Sod budget runs a second time on the numpy step
-(the reference arithmetic; its sixteen runs cost about 1.5x the fused ones), and each Shapley share
-is given from both with the change in percentage points.
-E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125, the Sod study's meshes but
-its two finest: each halving costs 4x; at 0.00125 the three bases took 2.8 / 8.9 / 7.0 s (P1 /
-GIMP / B-spline), so the two finest meshes add ~6 CPU-minutes.
+solve(exact)``) amplify it, so the budget's numbers carry a round-off spread, and ``roundoff.csv``
+measures it: P1's Sod budget runs a second time on the numpy step (the reference arithmetic), and
+each Shapley share is given from both with the change in percentage points.
+E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125.
 """
 
 from __future__ import annotations
