@@ -2,7 +2,7 @@
 
 :func:`steps` takes a block of the SSP-RK3 steps of :func:`baselines.fem_burgers.solve` in one
 compiled call, with the numpy step's operations in the same order (why compiled:
-``docs/perf-exact.md``):
+``docs/performance.md``):
 
     R_i      = sum over the cells with a = i of  -(v_b - v_a)(2 v_a + v_b)/6 + eps (v_b - v_a)/h_e
              + sum over the cells with b = i of  -(v_b - v_a)(v_a + 2 v_b)/6 - eps (v_b - v_a)/h_e

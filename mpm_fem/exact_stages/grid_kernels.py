@@ -4,7 +4,7 @@ The kernels of the exact grid stage (:class:`~mpm_fem.exact_stages.stage.ExactGr
 same sums as its numpy forms with the same floating-point operations in the same order, so they
 equal them bit for bit (tested: ``tests/test_grid_kernels.py``); the numpy forms
 (:mod:`mpm_fem.core.transfer`, :meth:`~mpm_fem.exact_stages.mass.FEMass.entries_numpy`) stay the
-readable reference. Why compiled: ``docs/perf-exact.md``.
+readable reference. Why compiled: ``docs/performance.md``.
 
     project     m_i = sum_q (w_q rho_q) S_qi,   P_i = sum_q ((w_q rho_q) v_q) S_qi,
                 F_i = - sum_q (w_q sigma_q) G_qi,

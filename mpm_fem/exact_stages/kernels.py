@@ -5,7 +5,7 @@
 these kernels. Each makes one pass over the points with the same floating-point operations in the
 same order as the numpy evaluation it replaces, so the two are equal bit for bit (tested:
 ``tests/test_exact_kernels.py``); the numpy versions stay the readable reference. Why compiled:
-``docs/perf-exact.md``.
+``docs/performance.md``.
 
     sample       Toro's sampling (section 4.5) at ``S = (x - x0)/t``: left of the contact the
                  left wave, right of it the mirror image of a left wave (``S -> -S``, ``u -> -u``).
