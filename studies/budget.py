@@ -304,5 +304,9 @@ def fields_figure(path: Path, problem: str, fields: dict) -> None:
                             + (", waves dotted" if problem == "sod" else ""))
 
 
+#: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`cost`, from the full
+#: tier's run on the 2-core machine (2026-11-25: 807 s wall on 2 workers for 2.9e9 units).
+PLAN, COST, SECONDS_PER_COST = plan, cost, 5.5e-7
+
 if __name__ == "__main__":
     sys.exit(script_main(NAME))

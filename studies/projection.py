@@ -289,5 +289,12 @@ def figures(folder: Path, t: dict, results: list) -> None:
                caption="Measured quadrature error against Hickernell's bound on every cell and node")
 
 
+#: The cost model of :mod:`mpm_fem.app.estimate`: a case is a fraction of a second (the full tier,
+#: 648 cases, took about 18 CPU-s on the 2-core machine on 2026-11-25).
+PLAN = lambda tier: {"cases": {k: c for k, c in enumerate(cases(StudyOptions(quick=tier == "quick")))}}  # noqa: E731
+COST = lambda case: 1.0  # noqa: E731
+SECONDS_PER_COST = 18.0 / 648
+run_case = case
+
 if __name__ == "__main__":
     sys.exit(script_main(NAME))

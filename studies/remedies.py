@@ -247,5 +247,9 @@ def _cost_figure(folder: Path, cost) -> None:
                "per mesh, for MPM with each remedy, fixed-mesh FEM and the FV reference")
 
 
+#: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`_cost`, from the full
+#: tier's run on the 2-core machine (2026-11-25: 803 s wall on 2 workers for 4.0e11 units).
+PLAN, COST, SECONDS_PER_COST = _plan, _cost, 4.1e-9
+
 if __name__ == "__main__":
     sys.exit(script_main(NAME))

@@ -61,3 +61,23 @@ def test_tiers_are_exclusive_on_the_command_line(capsys):
 
 def test_every_study_has_a_plan_per_tier():
     assert set(PLANS) | {"projection"} == set(STUDIES)
+
+
+def test_the_estimate_counts_the_cached_cases_and_grows_with_the_tier(tmp_path):
+    from mpm_fem.app.estimate import describe, estimate
+    from mpm_fem.app.sweep import case_key
+
+    full, deep = StudyOptions(out=tmp_path), StudyOptions(deep=True, out=tmp_path)
+    e_full, e_deep = estimate("budget", full), estimate("budget", deep)
+    assert e_full.cached == 0 and e_deep.cases > e_full.cases and e_deep.seconds > e_full.seconds > 0
+    assert e_full.wall(1) == e_full.seconds and e_full.wall(10**6) == e_full.longest
+    module = importlib.import_module("studies.budget")
+    case = next(iter(module.plan("full")["budget"].values()))
+    cache = full.cache_dir("budget")
+    cache.mkdir(parents=True)
+    (cache / f"{case_key(module.run_case, case)}.json").write_text("{}")
+    again = estimate("budget", full)
+    assert again.cached == 1 and again.seconds < e_full.seconds
+    line = describe({"budget": again, "other": None}, 2)
+    assert "budget: 49 of 50 cases to run" in line.replace(f"{again.cases - 1} of {again.cases}", "49 of 50")
+    assert "other: no cost model" in line

@@ -287,8 +287,13 @@ def write_report(out: Path, pages: list[Page] | None = None) -> Path:
 
 def reproduce(options) -> Path:
     """Run every study with ``options`` (:class:`mpm_fem.app.study.StudyOptions`), then write the report."""
+    from mpm_fem.app.estimate import describe, estimate
     from mpm_fem.app.study import STUDIES, run_study
+    from mpm_fem.app.sweep import default_jobs
 
+    if options.progress is not False:
+        workers = options.jobs or default_jobs()
+        print(describe({name: estimate(name, options) for name in STUDIES}, workers), file=sys.stderr, flush=True)
     for name in STUDIES:
         run_study(name, options)
     return write_report(options.out)

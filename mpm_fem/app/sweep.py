@@ -101,7 +101,7 @@ def _run_pool(fn, cases, todo, jobs: int, finish) -> None:
     pool.shutdown()
 
 
-def _default_jobs() -> int:
+def default_jobs() -> int:
     return max(1, min(os.cpu_count() or 1, 8))
 
 
@@ -117,7 +117,7 @@ def run_cases(
     """``[fn(case) for case in cases]``, in parallel, cached; results in the order of ``cases``."""
     if jobs is not None and jobs < 1:
         raise ValueError(f"jobs must be >= 1, got {jobs}")
-    jobs = jobs or _default_jobs()
+    jobs = jobs or default_jobs()
     cache = Path(cache_dir) if cache_dir is not None else None
     if cache is not None:
         cache.mkdir(parents=True, exist_ok=True)

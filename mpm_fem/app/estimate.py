@@ -1,0 +1,66 @@
+"""What a study costs before it runs: its cases, those already cached, and the CPU time of the rest.
+
+A study opts in by naming three things (module attributes of ``studies/<name>.py``):
+
+    PLAN(tier) -> {group: {label: case}}     the cases of a tier (the plan it sweeps)
+    COST(case) -> float                      its relative cost (particle-steps, or 1 per case)
+    SECONDS_PER_COST                         CPU seconds per unit of COST, measured on the project's
+                                             2-core machine (each study states its measurement)
+
+``CPU seconds = SECONDS_PER_COST * sum(COST(case))`` over the cases not in the cache. On ``J``
+workers the wall time is at least the total over ``J`` and at least the largest single case (the
+critical path): :meth:`Estimate.wall`. The estimate is a model fitted to one machine; the progress
+line of each sweep reports the real progress.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+
+from mpm_fem.app.sweep import case_key
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """``cases`` in the plan, ``cached`` of them done, ``seconds`` of CPU for the rest, ``longest`` case."""
+
+    cases: int
+    cached: int
+    seconds: float
+    longest: float
+
+    def wall(self, workers: int) -> float:
+        """Seconds on ``workers`` workers: the larger of the shared total and the longest case."""
+        return max(self.seconds / max(workers, 1), self.longest)
+
+
+def estimate(name: str, options) -> Estimate | None:
+    """The :class:`Estimate` of study ``name`` at ``options.tier`` with ``options``' cache; ``None`` if
+    the study does not state its cost model."""
+    module = importlib.import_module(f"studies.{name}")
+    plan, cost, rate = (getattr(module, a, None) for a in ("PLAN", "COST", "SECONDS_PER_COST"))
+    if plan is None or cost is None or rate is None:
+        return None
+    unique = {}
+    for group in plan(options.tier).values():
+        for case in group.values():
+            unique.setdefault(repr(sorted(case.items())), case)
+    cache = options.cache_dir(name)
+    todo = [c for c in unique.values() if not (cache / f"{case_key(module.run_case, c)}.json").exists()]
+    seconds = [rate * cost(c) for c in todo]
+    return Estimate(len(unique), len(unique) - len(todo), sum(seconds), max(seconds, default=0.0))
+
+
+def describe(estimates: dict[str, Estimate | None], workers: int) -> str:
+    """One line per study and a total: cases to run, CPU minutes, and the wall time on ``workers``."""
+    lines, total, longest = [], 0.0, 0.0
+    for name, e in estimates.items():
+        if e is None:
+            lines.append(f"  {name}: no cost model")
+            continue
+        lines.append(f"  {name}: {e.cases - e.cached} of {e.cases} cases to run, ~{e.seconds / 60:.1f} CPU-min")
+        total, longest = total + e.seconds, max(longest, e.longest)
+    wall = max(total / max(workers, 1), longest)
+    return "\n".join([f"estimated ~{total / 60:.1f} CPU-min, ~{wall / 60:.1f} min on {workers} worker(s) "
+                      "(the model of each study: mpm_fem.app.estimate)", *lines])
