@@ -16,10 +16,14 @@ Usage: ``python benchmarks/fem_cost.py [--T 0.05] [--finest 0.000625]``.
 from __future__ import annotations
 
 import argparse
+import datetime
+import os
+import platform
 import time
 
 from baselines import fem_burgers
 from baselines.exact.burgers import make_solution
+from mpm_fem.app.output import tee_markdown
 from mpm_fem.problems import burgers
 
 H = (0.005, 0.0025, 0.00125, 0.000625)
@@ -52,12 +56,21 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--T", type=float, default=0.05, help="final time of each timed run (default 0.05)")
     parser.add_argument("--finest", type=float, default=H[-1], help="the finest mesh (default 0.000625)")
+    parser.add_argument("--markdown", metavar="FILE", default=None,
+                        help="also write the tables into FILE's generated block (docs/performance.md)")
     args = parser.parse_args()
     if not 0 < args.T <= 0.5:
         parser.error(f"--T must lie in (0, 0.5], got {args.T}")
-    meshes = [h for h in H if h >= args.finest]
-    if not meshes:
+    if not [h for h in H if h >= args.finest]:
         parser.error(f"--finest must be at most {H[0]}, got {args.finest}")
+    today = datetime.date.today().isoformat()
+    header = f"Measured on {today} by `python benchmarks/fem_cost.py` ({platform.node()}, {os.cpu_count()} cores)."
+    with tee_markdown(args.markdown, "fem_cost", header):
+        _run(args)
+
+
+def _run(args) -> None:
+    meshes = [h for h in H if h >= args.finest]
     # compile first
     fem_step(H[0], "lumped", "fused", 0.01), fem_step(H[0], "consistent", "fused", 0.01), mpm_step(H[0], 0.01)
     print(f"viscous Burgers, rarefaction, eps = {EPS}, runs to T = {args.T}; CPU microseconds per step")

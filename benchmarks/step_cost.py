@@ -21,10 +21,14 @@ are the result. Usage: ``python benchmarks/step_cost.py [--max 1e7] [--repeat 3]
 from __future__ import annotations
 
 import argparse
+import datetime
+import os
+import platform
 import time
 
 import numpy as np
 
+from mpm_fem.app.output import tee_markdown
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.solve import Problem
@@ -126,7 +130,16 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max", type=float, default=1e7, help="largest particle count (default 1e7)")
     parser.add_argument("--repeat", type=int, default=3, help="timed steps per size; the best is kept")
+    parser.add_argument("--markdown", metavar="FILE", default=None,
+                        help="also write the tables into FILE's generated block (docs/performance.md)")
     args = parser.parse_args(argv)
+    today = datetime.date.today().isoformat()
+    header = f"Measured on {today} by `python benchmarks/step_cost.py` ({platform.node()}, {os.cpu_count()} cores)."
+    with tee_markdown(args.markdown, "step_cost", header):
+        _run(args)
+
+
+def _run(args) -> None:
     sizes = [int(10**k) for k in range(3, int(round(np.log10(args.max))) + 1)]
     bandwidth = triad_bandwidth()
     print(f"triad bandwidth (numpy a = b + s c, 24 B/element): {bandwidth / 1e9:.1f} GB/s\n")

@@ -23,3 +23,17 @@ def test_fem_cost_rejects_bad_arguments():
     proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fem_cost.py"), "--T", "0"],
                           capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert proc.returncode == 2 and "--T must lie in (0, 0.5]" in proc.stderr
+
+
+def test_a_generated_block_replaces_only_itself(tmp_path):
+    from mpm_fem.app.output import replace_block, tee_markdown
+
+    page = tmp_path / "page.md"
+    page.write_text("# Title\n\ntyped text\n")
+    replace_block(page, "bench", "| a |\n|---|\n| 1 |")
+    replace_block(page, "bench", "| a |\n|---|\n| 2 |")
+    text = page.read_text()
+    assert text.count("begin bench") == 1 and "| 2 |" in text and "| 1 |" not in text and "typed text" in text
+    with tee_markdown(page, "other", "Measured today."):
+        print("| b |")
+    assert "Measured today.\n\n| b |" in page.read_text() and "| 2 |" in page.read_text()

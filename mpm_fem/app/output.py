@@ -15,6 +15,7 @@ import os
 import platform
 import shutil
 import subprocess
+import sys
 import tempfile
 from contextlib import contextmanager
 from importlib import metadata
@@ -161,3 +162,43 @@ def particles_csv(particles: Particles, columns: dict[str, np.ndarray] | None = 
     np.savetxt(buffer, np.column_stack([np.asarray(v)[order] for v in columns.values()]), fmt="%.17g", delimiter=",",
                header=",".join(columns), comments="")
     return buffer.getvalue()
+
+
+def replace_block(path: str | os.PathLike, name: str, text: str) -> None:
+    """Put ``text`` between ``<!-- begin NAME ... -->`` and ``<!-- end NAME -->`` in the Markdown file
+    ``path`` (the block is appended when the file has none): generated content in a typed page."""
+    path = Path(path)
+    begin, end = f"<!-- begin {name}", f"<!-- end {name} -->"
+    page = path.read_text() if path.exists() else ""
+    block = f"{begin}: generated, do not edit -->\n{text.rstrip()}\n{end}"
+    if begin in page and end in page:
+        head, rest = page.split(begin, 1)
+        page = head + block + rest.split(end, 1)[1]
+    else:
+        page = page.rstrip() + "\n\n" + block + "\n"
+    write_atomic(path, page)
+
+
+@contextmanager
+def tee_markdown(path: str | os.PathLike | None, name: str, header: str):
+    """Print as usual; with a ``path``, also write what was printed, after ``header``, into its block
+    ``name`` (:func:`replace_block`) when the body ends without an error."""
+    if path is None:
+        yield
+        return
+    buffer, stdout = io.StringIO(), sys.stdout
+
+    class _Tee(io.TextIOBase):
+        def write(self, s: str) -> int:
+            buffer.write(s)
+            return stdout.write(s)
+
+        def flush(self) -> None:
+            stdout.flush()
+
+    sys.stdout = _Tee()
+    try:
+        yield
+    finally:
+        sys.stdout = stdout
+    replace_block(path, name, header + "\n\n" + buffer.getvalue())
