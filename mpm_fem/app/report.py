@@ -22,6 +22,7 @@ from mpm_fem.app.pages import PAGES, Page, View  # noqa: F401  (View: part of th
 from mpm_fem.app.plots import CAPTIONS
 from mpm_fem.measure.claims import CLAIMS, STATEMENTS, Claim, claims_of, select
 from mpm_fem.measure.tables import Tables, load_tables
+from mpm_fem.measure.version import code_version as current_code_version
 
 TITLE = "# mpm-fem: where does the error of MPM come from?"
 #: Views longer than this are cut, with a pointer to the whole CSV.
@@ -152,7 +153,9 @@ def render(tables: Tables, pages, captions: dict[str, dict] | None = None) -> st
     head = [TITLE, "",
             f"Rendered by `python -m mpm_fem.app.report` from the tables of code version {code_version(tables)}, "
             + ("written by `mpm-fem reproduce --quick`: a subset of the meshes of each study." if quick
-               else "written by `mpm-fem reproduce --full`."),
+               else "written by `mpm-fem reproduce --full`.")
+            + ("" if code_version(tables) == current_code_version()
+               else f" The current code is version {current_code_version()}: the figures lag it ([E4](#e4))."),
             "Source: L.-T. Tran and M. Berzins, Error Analysis for Material Point Method and a case study from Gas "
             "Dynamics (slides). The claims, the source's tables and the corrections made to them are listed in "
             "`docs/claims.md` of the repository.", "",
