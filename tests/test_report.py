@@ -12,6 +12,7 @@ import pytest
 from mpm_fem.app.report import Page, View, captions_of, cell, markdown_table, render, study_pages, write_report
 from mpm_fem.measure.claims import STATEMENTS
 from mpm_fem.measure.tables import load_tables
+from mpm_fem.measure.version import code_version as current_code_version
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"
 
@@ -30,6 +31,16 @@ def test_the_committed_report_is_the_rendering_of_the_committed_tables(committed
 def test_the_header_names_the_code_version_of_the_tables(committed):
     codes = {r["code"] for r in load_tables(FIGURES)["versions"]}
     assert any(f"code version {c}" in committed.splitlines()[2] for c in codes)
+
+
+def test_the_header_says_when_the_figures_lag_the_code():
+    """Tables of another code version than the current one: the header says the figures lag it (E4)."""
+    tables = load_tables(FIGURES)
+    lagging = {**tables, "versions": [{**r, "code": "0123456789ab"} for r in tables["versions"]]}
+    current = {**tables, "versions": [{**r, "code": current_code_version()} for r in tables["versions"]]}
+    head = render(lagging, []).splitlines()[2]
+    assert f"The current code is version {current_code_version()}: the figures lag it ([E4](#e4))." in head
+    assert "lag" not in render(current, []).splitlines()[2]
 
 
 def test_every_claim_is_in_the_summary(committed):

@@ -34,7 +34,8 @@ from mpm_fem.measure.claims.time import CROSSING_TOLERANCE, GLOBAL_ORDER, LOCAL_
 from mpm_fem.measure.claims.budget import (
     ROUNDOFF, SEPARATE, SEQUENCES, STEP_ORDER, SUBSETS, _roundoff_text, budget_findings, sequential, stage_findings)
 from mpm_fem.measure.claims.remedies import (
-    BURGERS_ORDER, FV_FACTOR, PLATEAU_ORDER, REMEDY_ERRORS, REMEDY_MEASURES, remedy_assessment, remedy_budget)
+    BURGERS_ORDER, FV_DRIFT, FV_FACTOR, ORDER_MARGIN, PLATEAU_CRITERION, REMEDY_ERRORS, REMEDY_MEASURES,
+    remedy_assessment, remedy_budget)
 # isort: on
 
 __all__ = [
@@ -48,6 +49,6 @@ __all__ = [
     "GLOBAL_ORDER", "LOCAL_ORDER", "CROSSING_TOLERANCE", "NO_JUMP",
     "SUBSETS", "STEP_ORDER", "SEPARATE", "SEQUENCES", "ROUNDOFF", "budget_findings", "stage_findings", "sequential",
     "_roundoff_text",
-    "REMEDY_ERRORS", "PLATEAU_ORDER", "FV_FACTOR", "BURGERS_ORDER", "REMEDY_MEASURES", "remedy_assessment",
-    "remedy_budget",
+    "REMEDY_ERRORS", "ORDER_MARGIN", "FV_DRIFT", "PLATEAU_CRITERION", "FV_FACTOR", "BURGERS_ORDER", "REMEDY_MEASURES",
+    "remedy_assessment", "remedy_budget",
 ]
