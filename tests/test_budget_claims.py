@@ -61,7 +61,7 @@ def test_e1_is_confirmed_when_the_stages_separate_and_the_attributions_agree():
     verdict, evidence = judge("E1 (burgers)", _e1(_two_bases(SEPARATE_TERMS)))
     assert verdict == "confirmed"
     assert evidence.startswith("the stages separate in 2 of 2 bases and norms at h = 0.02 (the interactions are "
-                               "0.05x |v(all MPM) - v(all exact)|; separate: at most 25%); a dominant stage in 2 of "
+                               "0.05x |v(all MPM) - v(all exact)|, at most 25% to separate); a dominant stage in 2 of "
                                "2: projection (mpm particles, gimp particles)")
     assert "interactions / |v(all MPM) - v(all exact)| from the coarsest mesh to the finest: mpm particles 0.05 -> " \
            "0.05" in evidence

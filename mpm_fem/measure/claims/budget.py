@@ -85,7 +85,7 @@ def _e1_text(found: dict) -> str:
     names = {k: f"{k[0]} {k[1]}" for k in finest}
     ratios = [f["interactions"] for _, f in finest.values()]
     head = (f"the stages separate in {len(sep)} of {n} bases and norms at h = {hs} (the interactions are "
-            f"{span(ratios, '.2g')}x |v(all MPM) - v(all exact)|; separate: at most {SEPARATE:.0%})")
+            f"{span(ratios, '.2g')}x |v(all MPM) - v(all exact)|, at most {SEPARATE:.0%} to separate)")
     by_stage = {}
     for k, s in dominant.items():
         by_stage.setdefault(s, []).append(names[k])
