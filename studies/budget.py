@@ -203,7 +203,7 @@ def run(options: StudyOptions) -> None:
     rows = subset_rows(ok)
     shapley, interactions = decomposition_rows(rows)
     reference = decomposition_rows(subset_rows({k: r for k, r in got["roundoff"].items() if r["ok"] and k in ok}))[0]
-    publish(folder, {"subsets": rows, schema.BUDGET_SHAPLEY: shapley, "interactions": interactions,
+    publish(folder, {schema.BUDGET_SUBSETS: rows, schema.BUDGET_SHAPLEY: shapley, "interactions": interactions,
                      "regions": region_rows(ok),
                      "runs": [{"problem": p, "h": h, "basis": b, **x}
                               for (p, h, b), r in got["budget"].items() for x in r["runs"]],

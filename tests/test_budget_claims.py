@@ -1,12 +1,15 @@
-"""The criteria of C1, C2, E1 and E2 follow their numbers: a table perturbed to fail and one
+"""The criteria of C1, C2, E1, E2 and C15 follow their numbers: a table perturbed to fail and one
 perturbed to pass give different verdicts. The time and budget tables are built here in the shape
 the studies write them (``studies/time.py``, ``studies/budget.py``), so the tests do not depend on
-which figures are committed; E2 mutates the committed ``budget/bases`` table."""
+which figures are committed; E2 and C15 mutate the committed tables."""
 
 from __future__ import annotations
 
+import pytest
 from claim_mutations import TABLES, assert_flips, judge, mutate
 
+from mpm_fem.measure.claims import SEQUENCES, STEP_ORDER, lumping_sign, sequential
+from mpm_fem.measure.decomposition import label, subsets
 from studies import budget as study
 
 STAGES = study.STAGES
@@ -23,35 +26,96 @@ def _shapley(shares: dict, problem: str = "burgers", norm: str = "particles") ->
     return rows
 
 
-DOMINATED = {(0.04, "mpm"): (0.55, 0.2, 0.15, 0.1), (0.02, "mpm"): (0.7, 0.1, 0.1, 0.1),
-             (0.04, "gimp"): (0.6, 0.3, 0.2, -0.1), (0.02, "gimp"): (0.8, 0.1, 0.2, -0.1)}
+# ---------------------------------------------------------------- E1: do the stages separate, which dominates
+
+def _subsets(groups: dict, problem: str = "burgers", floor: float = 0.0002) -> list[dict]:
+    """``budget/subsets`` rows from ``{(h, basis, norm): Moebius terms}``: the terms keyed by the
+    ``+``-joined stages (the all-exact error is ``floor``), v(S) the sum of the terms of the subsets of S."""
+    rows = []
+    for (h, basis, norm), terms in groups.items():
+        m = {frozenset(): floor, **{frozenset(k.split("+")): x for k, x in terms.items()}}
+        for S in subsets(STAGES):
+            rows.append({"problem": problem, "h": str(h), "basis": basis, "norm": norm, "mpm_stages": label(S),
+                         "error": repr(sum(x for T, x in m.items() if T <= S))})
+    return rows
 
 
-def test_e1_names_the_dominant_stage_and_whether_its_share_grows():
-    verdict, evidence = judge("E1 (burgers)", {"budget/shapley": _shapley(DOMINATED)})
+MAIN = {"projection": 0.006, "mass": 0.001, "interpolation": 0.002, "time": 0.0005}
+#: separate (the one interaction is 5% of the gap) and projection dominates by every attribution
+SEPARATE_TERMS = {**MAIN, "mass+projection": 0.0005}
+#: the projection alone adds more than all MPM does: the interactions compensate it, and making the
+#: projection exact first (forward order) removes less than making the interpolation exact
+TANGLED_TERMS = {**MAIN, "mass+projection": -0.0045, "interpolation+projection": -0.001}
+
+
+def _e1(groups: dict, problem: str = "burgers") -> dict:
+    return {"budget/subsets": _subsets(groups, problem)}
+
+
+def _two_bases(finest_gimp: dict, norm: str = "particles") -> dict:
+    return {(0.04, "mpm", norm): SEPARATE_TERMS, (0.02, "mpm", norm): SEPARATE_TERMS,
+            (0.04, "gimp", norm): SEPARATE_TERMS, (0.02, "gimp", norm): finest_gimp}
+
+
+def test_e1_is_confirmed_when_the_stages_separate_and_the_attributions_agree():
+    verdict, evidence = judge("E1 (burgers)", _e1(_two_bases(SEPARATE_TERMS)))
     assert verdict == "confirmed"
-    assert "mpm at h = 0.02: projection 70% (55% -> 70%, grows as h shrinks)" in evidence
-    assert "gimp at h = 0.02: projection 80% (60% -> 80%, grows as h shrinks); compensated by time -10%" in evidence
+    assert evidence.startswith("the stages separate in 2 of 2 bases and norms at h = 0.02 (the interactions are "
+                               "0.05x |v(all MPM) - v(all exact)|, at most 25% to separate); a dominant stage in 2 of "
+                               "2: projection (mpm particles, gimp particles)")
+    assert "interactions / |v(all MPM) - v(all exact)| from the coarsest mesh to the finest: mpm particles 0.05 -> " \
+           "0.05" in evidence
 
 
-def test_e1_is_partly_when_no_stage_reaches_half_and_names_the_two_largest():
-    shared = {**DOMINATED, (0.02, "gimp"): (0.4, 0.35, 0.2, 0.05)}
-    assert_flips("E1 (burgers)", {"budget/shapley": _shapley(shared)}, {"budget/shapley": _shapley(DOMINATED)})
-    verdict, evidence = judge("E1 (burgers)", {"budget/shapley": _shapley(shared)})
-    assert verdict == "partly" and "gimp at h = 0.02: shared: projection 40% and mass 35%" in evidence
+@pytest.mark.parametrize("interaction, separate", [(0.003, True), (0.0034, False)])
+def test_e1_separation_flips_at_a_quarter_of_the_gap(interaction, separate):
+    """One interaction of projection and interpolation: 0.003 is 24% of the gap, 0.0034 is 26%."""
+    terms = {**MAIN, "interpolation+projection": interaction}
+    verdict, evidence = judge("E1 (burgers)", _e1(_two_bases(terms)))
+    assert verdict == ("confirmed" if separate else "partly")
+    assert f"the stages separate in {2 if separate else 1} of 2" in evidence
 
 
-def test_e1_is_refuted_when_the_shares_do_not_add_up():
-    broken = {**DOMINATED, (0.04, "mpm"): (0.9, 0.2, 0.15, 0.1)}
-    verdict, evidence = judge("E1 (burgers)", {"budget/shapley": _shapley(broken)})
-    assert verdict == "refuted" and "do not add up" in evidence
+def test_e1_names_no_dominant_stage_when_the_attributions_disagree():
+    verdict, evidence = judge("E1 (burgers)", _e1(_two_bases(TANGLED_TERMS)))
+    assert verdict == "partly"
+    assert "a dominant stage in 1 of 2: projection (mpm particles)" in evidence
+    assert "the attributions disagree for gimp particles (Shapley projection, forward interpolation, backward " \
+           "projection)" in evidence
+    assert "e.g. mpm particles at h = 0.02: projection alone adds 0.006" in evidence
+
+
+def test_e1_is_refuted_when_no_stage_separates_or_dominates():
+    tangled = {key: TANGLED_TERMS for key in _two_bases(TANGLED_TERMS)}
+    assert_flips("E1 (burgers)", _e1(tangled), _e1(_two_bases(SEPARATE_TERMS)))
+    assert judge("E1 (burgers)", _e1(tangled))[0] == "refuted"
 
 
 def test_e1_sod_reads_both_norms_and_is_not_measured_without_its_table():
-    tables = {"budget/shapley": _shapley(DOMINATED, "sod") + _shapley(DOMINATED, "sod", "nodes")}
-    verdict, evidence = judge("E1 (sod)", tables)
-    assert verdict == "confirmed" and "nodes L1: mpm projection 70%, gimp projection 80%" in evidence
+    groups = {**_two_bases(SEPARATE_TERMS), **_two_bases(TANGLED_TERMS, "nodes")}
+    verdict, evidence = judge("E1 (sod)", _e1(groups, "sod"))
+    assert verdict == "partly" and "the stages separate in 3 of 4" in evidence
+    assert "the attributions disagree for gimp nodes" in evidence
     assert judge("E1 (sod)", {})[0] == "not measured"
+    incomplete = _e1(groups, "sod")["budget/subsets"][1:]  # the coarse mesh of mpm particles misses all exact
+    assert "from the coarsest mesh to the finest: mpm particles 0.05, gimp" in judge(
+        "E1 (sod)", {"budget/subsets": incomplete})[1]
+
+
+def test_the_sequential_replacements_add_up_to_the_gap_in_either_order():
+    v = {S: float(r["error"]) for S, r in zip(subsets(STAGES), _subsets({(0.02, "mpm", "particles"): TANGLED_TERMS}),
+                                              strict=True)}
+    for order in SEQUENCES.values():
+        removed = sequential(v, order)
+        assert abs(sum(removed.values()) - (v[frozenset(STAGES)] - v[frozenset()])) < 1e-15
+    assert STEP_ORDER == STAGES  # the claims' step order is the budget study's
+
+
+def test_e1_on_the_committed_sod_budget_says_the_stages_do_not_separate():
+    """The projection alone adds several times v(all MPM) on Sod: the interactions are not small."""
+    verdict, evidence = judge("E1 (sod)", TABLES)
+    assert evidence.startswith("the stages separate in 0 of ")
+    assert verdict in ("partly", "refuted")
 
 
 def _time_tables(global_order: float, local_order: float) -> dict:
@@ -102,31 +166,54 @@ def test_e2_follows_the_last_refinement_orders():
     assert judge("E2", p1_converges)[0] == "differs"
 
 
-# ---------------------------------------------------------------- C15: the budget's mass stage
+# ---------------------------------------------------------------- C15: the direct comparison, with its sign
 
-def _c15_tables(mass_share: float, problem: str = "sod") -> dict:
-    """The committed lumping table with every ratio passing, and a budget whose mass stage carries
-    ``mass_share`` at the finest mesh of one basis (0.3 elsewhere)."""
-    shares = {(0.01, "mpm"): (0.6, 0.3, 0.05, 0.05), (0.005, "mpm"): (0.6, 0.3, 0.05, 0.05),
-              (0.01, "gimp"): (0.6, 0.3, 0.05, 0.05), (0.005, "gimp"): (1 - mass_share - 0.1, mass_share, 0.05, 0.05)}
-    if problem == "sod":
-        tables = mutate(TABLES, "sod/mass", mpm_consistent_over_lumped_nodes=0.5, fem_consistent_over_lumped=0.5)
-    else:
-        tables = mutate(TABLES, "burgers/lumping", {"mass": "consistent"}, L2=1e-9)
-    return {**tables, "budget/shapley": _shapley(shares, problem)}
+@pytest.mark.parametrize("ratios, sign", [
+    ((0.5, 0.8), "source of error"), ((1.2, 2.0), "compensating"), ((0.95, 1.05), "neutral"),
+    ((0.5, 1.0), "mixed"), ((float("nan"),), "not measured")])
+def test_the_sign_of_lumping_per_method(ratios, sign):
+    assert lumping_sign(ratios) == sign
 
 
-def test_c15_reads_the_mass_stage_share_of_the_budget():
-    """A mass stage below 10% at the finest mesh of one basis is one case that fails (partly); 30%
-    passes, and so does -30% (the lumped solve compensating the other stages is a source too)."""
-    assert_flips("C15 (sod)", _c15_tables(0.05), _c15_tables(0.3))
-    assert judge("C15 (sod)", _c15_tables(-0.3))[0] == "confirmed"
-    verdict, evidence = judge("C15 (sod)", _c15_tables(0.05))
-    assert verdict == "partly"
-    assert "Shapley share of the mass stage at the finest budget mesh: mpm particles h = 0.005 30%, " \
-           "gimp particles h = 0.005 5%" in evidence
-    assert_flips("C15 (burgers)", _c15_tables(0.05, "burgers"), _c15_tables(0.3, "burgers"))
-    assert judge("C15 (sod)", {k: v for k, v in TABLES.items() if k != "budget/shapley"})[0] == "not measured"
+def _sod_mass(mpm: float, fem: float = 1.0) -> dict:
+    return mutate(TABLES, "sod/mass", mpm_consistent_over_lumped_nodes=mpm, mpm_consistent_over_lumped_particles=mpm,
+                  fem_consistent_over_lumped=fem)
+
+
+def test_c15_sod_is_judged_on_mpm_with_the_sign_of_lumping():
+    """Consistent clearly better in MPM: a source (confirmed); clearly worse: lumping compensates
+    (differs); within the band: neutral (refuted). The FEM beside does not enter the verdict."""
+    assert_flips("C15 (sod)", _sod_mass(1.5), _sod_mass(0.5))
+    assert judge("C15 (sod)", _sod_mass(1.5))[0] == "differs"
+    assert judge("C15 (sod)", _sod_mass(1.0, fem=0.5))[0] == "refuted"
+    assert judge("C15 (sod)", _sod_mass(0.5, fem=2.0))[0] == "confirmed"
+    one_mesh = mutate(_sod_mass(1.0), "sod/mass", {"h": 0.01}, mpm_consistent_over_lumped_nodes=0.5)
+    assert judge("C15 (sod)", one_mesh)[0] == "partly"
+    evidence = judge("C15 (sod)", _sod_mass(1.5))[1]
+    assert evidence.startswith("MPM nodes: compensating (consistent/lumped 1.50 at h = 0.00125..0.01)")
+    assert "beside, on the same meshes: FEM: neutral (consistent/lumped 1.00" in evidence
+
+
+def test_c15_burgers_follows_the_consistent_over_lumped_ratio_of_mpm():
+    mpm = {"method": "mpm_calculated"}, {"method": "mpm_exact"}
+    source = TABLES
+    for where in mpm:
+        source = mutate(source, "burgers/lumping", {**where, "mass": "consistent"}, L2=1e-9)
+    assert_flips("C15 (burgers)", TABLES, source)
+    assert judge("C15 (burgers)", TABLES)[0] == "differs"  # the committed MPM: consistent clearly worse
+    neutral = TABLES
+    for where in mpm:
+        lumped = {r["h"]: r["L2"] for r in TABLES["burgers/lumping"] if r["method"] == where["method"]
+                  and r["mass"] == "lumped"}
+        neutral = mutate(neutral, "burgers/lumping", {**where, "mass": "consistent"},
+                         L2=lambda r, lumped=lumped: lumped[r["h"]])
+    assert judge("C15 (burgers)", neutral)[0] == "refuted"
+
+
+def test_c15_needs_no_error_budget():
+    without = {k: v for k, v in TABLES.items() if k != "budget/shapley"}
+    assert judge("C15 (sod)", without)[0] != "not measured"
+    assert judge("C15 (burgers)", without)[0] != "not measured"
 
 
 # ---------------------------------------------------------------- E5: the budget of the closest remedy

@@ -1,16 +1,18 @@
-"""E5's criterion (mpm_fem.measure.claims, block "remedies: E5") on made-up tables: each part of the goal
-can fail it (mutation tests: one number moved across a threshold flips the verdict)."""
+"""E5's criterion (mpm_fem.measure.claims.remedies) on made-up tables: each part of the goal can fail
+it (mutation tests: one number moved across a threshold flips the verdict). On Sod a remedy is held to
+the finite-volume reference's own orders and error on the same meshes."""
 
 import pytest
 from claim_mutations import judge
 
+from mpm_fem.measure.claims import CONVERGING_ORDER, FLOOR_ORDER, FV_DRIFT, ORDER_MARGIN
 from mpm_fem.measure.claims import remedy_assessment as assess
 
 
 def verdict(tables):
     return judge("E5", {"remedies/errors": tables["errors"]})
 
-H = (0.01, 0.005, 0.0025, 0.00125)
+H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)
 
 
 def rows(problem, remedy, nodes, particles, fv=None):
@@ -91,3 +93,54 @@ def test_of_two_plateau_removers_the_one_nearer_the_fv_error_is_named():
     v, evidence = verdict(table(fv=fv, extra=rows("sod", "near", **far, fv=fv)
                                 + rows("burgers", "near", **GOOD_BURGERS)))
     assert v == "partly" and evidence.startswith("fix:")
+
+
+def _power(e0: float, orders: list[float]) -> list[float]:
+    """Errors from ``e0`` on the coarsest mesh of H, falling with the observed ``orders`` (halvings)."""
+    out = [e0]
+    for q in orders:
+        out.append(out[-1] / 2 ** q)
+    return out
+
+
+def test_the_margin_to_the_fv_order_is_the_studys_undecided_band():
+    assert ORDER_MARGIN == CONVERGING_ORDER - FLOOR_ORDER
+
+
+@pytest.mark.parametrize("gap, removes", [(-0.15, True), (-0.25, False)])
+def test_orders_are_judged_against_the_fv_references_own_on_the_same_meshes(gap, removes):
+    """FV converging at 0.75 (a contact limits every method): a remedy 0.15 below it on the last pair
+    still converges as the FV does; 0.25 below (more than the margin) it does not."""
+    fv = _power(0.008, [0.75] * 3)
+    sod = dict(nodes=_power(0.009, [0.75, 0.75, 0.75 + gap]), particles=_power(0.01, [0.75, 0.75, 0.75 + gap]))
+    s = assess(rows("sod", "fix", **sod, fv=fv))
+    assert s["removes_plateau"] is removes
+    assert abs(s["min_gap_fv_particles_L1"] - gap) < 1e-9
+    assert verdict(table(sod=sod, fv=fv))[0] == ("confirmed" if removes else "refuted")
+
+
+def test_an_order_below_the_floor_is_a_plateau_even_where_the_fv_is_slow():
+    fv = _power(0.008, [0.6] * 3)
+    sod = dict(nodes=_power(0.009, [0.6, 0.6, 0.45]), particles=_power(0.011, [0.6, 0.6, 0.45]))
+    assert 0.6 - 0.45 < ORDER_MARGIN and 0.45 < FLOOR_ORDER
+    assert not assess(rows("sod", "fix", **sod, fv=fv))["removes_plateau"]
+
+
+@pytest.mark.parametrize("gap, removes", [(-0.05, True), (-0.18, False)])
+def test_an_error_drifting_away_from_the_fv_error_is_a_plateau(gap, removes):
+    """Five halvings, each order within the margin of the FV's: at 0.18 below it the ratio to the FV
+    error grows by 2^0.9 = 1.87x from the coarsest mesh to the finest, beyond FV_DRIFT; at 0.05, 1.19x.
+    The remedy starts at half the FV error, so it stays within the goal's 1.5x on every mesh."""
+    fv = _power(0.008, [1.0] * 5)
+    sod = dict(nodes=_power(0.004, [1.0 + gap] * 5), particles=_power(0.004, [1.0 + gap] * 5))
+    s = assess(rows("sod", "fix", **sod, fv=fv))
+    assert (s["fv_drift_nodes_L1"] <= FV_DRIFT) is removes and s["removes_plateau"] is removes
+    assert s["max_fv_ratio_particles_L1"] < 1.5
+    assert verdict(table(sod=sod, fv=fv))[0] == ("confirmed" if removes else "refuted")
+
+
+@pytest.mark.parametrize("order, removes", [(0.75, True), (0.65, False)])
+def test_burgers_without_an_fv_reference_is_held_to_the_converging_order(order, removes):
+    burgers = rows("burgers", "fix", nodes=_power(4e-4, [order] * 2), particles=_power(5e-4, [order] * 2))
+    assert assess(burgers)["removes_plateau"] is removes
+    assert "max_fv_ratio_nodes_L1" in assess(burgers) and "fv_drift_nodes_L1" not in assess(burgers)

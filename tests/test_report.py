@@ -11,9 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from mpm_fem.app.report import Page, View, cell, markdown_table, write_report
+from mpm_fem.app.report import Page, View, cell, markdown_table, render, write_report
 from mpm_fem.measure.claims import STATEMENTS
 from mpm_fem.measure.tables import load_tables
+from mpm_fem.measure.version import code_version as current_code_version
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"
 
@@ -33,6 +34,18 @@ def test_the_committed_report_is_the_rendering_of_the_committed_tables(committed
 def test_the_header_names_the_code_version_of_the_tables(committed):
     codes = {r["code"] for r in load_tables(FIGURES)["versions"]}
     assert any(f"code version {c}" in committed.splitlines()[2] for c in codes)
+
+
+def test_the_first_screen_says_when_the_figures_lag_the_code():
+    """Tables of another code version than the current one: the caveats say the figures lag it (E4)."""
+    tables = load_tables(FIGURES)
+    now = current_code_version()
+    lagging = {**tables, "versions": [{**r, "code": "0123456789ab"} for r in tables["versions"]]}
+    current = {**tables, "versions": [{**r, "code": now} for r in tables["versions"]]}
+    first = "\n".join(render(lagging, [], current=now).splitlines()[:60])
+    lag = f"**The figures lag the code**: the tables were written by code version 0123456789ab, the code is now {now}"
+    assert lag in first
+    assert "lag" not in render(current, [], current=now).split("## Caveats")[1].split("<a id=")[0]
 
 
 def test_every_claim_is_in_the_summary(committed):

@@ -22,9 +22,9 @@ from pathlib import Path
 from mpm_fem.app.output import write_atomic
 from mpm_fem.app.pages import PAGES, Page, View  # noqa: F401  (View: part of this module's interface)
 from mpm_fem.app.plots import CAPTIONS
-from mpm_fem.app.sweep import code_version as current_code
 from mpm_fem.measure.claims import CLAIMS, STATEMENTS, Claim, claims_of, select
 from mpm_fem.measure.tables import Tables, load_tables
+from mpm_fem.measure.version import code_version as current_code
 
 TITLE = "# mpm-fem: where does the error of MPM come from?"
 #: Views longer than this are cut, with a pointer to the whole CSV.

@@ -2,10 +2,11 @@
 
 ``run_cases(fn, cases)`` calls the module-level function ``fn(case) -> dict`` on every case (a
 JSON-able dict of settings). Results are cached under ``cache_dir`` by a key made of ``fn``'s
-qualified name, the case, and a hash of the source code of ``mpm_fem``, ``baselines`` and ``studies``: a
-finished case is never recomputed while the code is unchanged, and a change to the code
-recomputes everything. Each result is written atomically (temporary file + rename), so a sweep that
-is interrupted resumes where it stopped and never reads a half-written result.
+qualified name, the case, and the version of the code that computes numbers
+(:func:`mpm_fem.measure.version.code_version`, re-exported here): a finished case is never
+recomputed while that code is unchanged, and a change to it recomputes everything. Each result is
+written atomically (temporary file + rename), so a sweep that is interrupted resumes where it
+stopped and never reads a half-written result.
 
 Parallelism: ``jobs`` worker processes (``concurrent.futures``), or an existing Dask cluster when
 ``scheduler="tcp://HOST:PORT"`` is given (``dask.distributed``, the optional extra ``[dask]``).
@@ -27,27 +28,15 @@ import sys
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from functools import lru_cache
 from pathlib import Path
 from typing import Callable
 
 from tqdm.auto import tqdm
 
 from mpm_fem.app.output import write_json
+from mpm_fem.measure.version import code_version
 
 CaseFn = Callable[[dict], dict]
-
-
-@lru_cache(maxsize=1)
-def code_version() -> str:
-    """A hash of every ``.py`` file of the packages ``mpm_fem``, ``baselines`` and ``studies``."""
-    root = Path(__file__).resolve().parents[2]
-    digest = hashlib.sha256()
-    for package in ("mpm_fem", "baselines", "studies"):
-        for path in sorted((root / package).rglob("*.py")):
-            digest.update(str(path.relative_to(root)).encode())
-            digest.update(path.read_bytes())
-    return digest.hexdigest()[:12]
 
 
 def case_key(fn: CaseFn, case: dict) -> str:

@@ -123,8 +123,11 @@ TIME_LOCAL_ERROR = Table("time/local_error", ("problem", "basis", "quantity", "d
 TIME_CROSSING_SUMMARY = Table("time/crossing_summary", (
     "basis", "acceleration", "crossings", "median_ratio", "max_ratio_error", "max_abs_ratio", "median_abs_measured"))
 
-# ----------------------------------------------------------------------------- budget (E1, E2; C15, E5)
+# ----------------------------------------------------------------------------- budget (E1, E2; E5)
 
+#: v(S), the error with the stages of ``mpm_stages`` (``+``-joined, ``none`` for the empty set) in
+#: MPM form and the others exact: the raw measurements of the budget, which E1 reads.
+BUDGET_SUBSETS = Table("budget/subsets", ("problem", "h", "basis", "norm", "mpm_stages", "error"))
 BUDGET_SHAPLEY = Table("budget/shapley", (
     "problem", "h", "basis", "norm", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error"))
 BUDGET_ROUNDOFF = Table("budget/roundoff", (
@@ -153,7 +156,7 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     SOD_CONVERGENCE, SOD_REGIONS, SOD_EXTREMA, SOD_PPC, SOD_MASS,
     BURGERS_ORDERS, BURGERS_PPC, BURGERS_LUMPING,
     TIME_ORDER, TIME_LOCAL_ERROR, TIME_CROSSING_SUMMARY,
-    BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,
+    BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,
     REMEDIES_ERRORS)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}

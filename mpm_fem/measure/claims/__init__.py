@@ -24,28 +24,31 @@ from mpm_fem.measure.claims.rows import count_verdict, num, saturation, select, 
 # the per-study modules, in the order their claims are registered (CLAIMS keeps that order)
 # isort: off
 from mpm_fem.measure.claims.projection import BAND_TOLERANCE, JUDGED_LAYOUTS, ORDERS
-from mpm_fem.measure.claims.shared import LUMPING_GAIN, MASS_SHARE, SATURATION, mass_shares
+from mpm_fem.measure.claims.shared import LUMPING_BAND, SATURATION, lumping_sign
 from mpm_fem.measure.claims.sod import (
     CONVERGENCE, CONVERGING_ORDER, EXTREMA_RATIO, FLOOR_MESHES, FLOOR_ORDER, FLOOR_STEPS, SIDE_BY_SIDE, WAVE_REGIONS,
     WAVE_SHARE)
 from mpm_fem.measure.claims import reproduce  # noqa: F401  (registers E4)
 from mpm_fem.measure.claims.burgers import BURGERS_SHOWN, C13_METHODS, FIRST_ORDER
 from mpm_fem.measure.claims.time import CROSSING_TOLERANCE, GLOBAL_ORDER, LOCAL_ORDER, NO_JUMP
-from mpm_fem.measure.claims.budget import CLOSURE, DOMINANT, ROUNDOFF, SHAPLEY, _roundoff_text, budget_verdicts
+from mpm_fem.measure.claims.budget import (
+    ROUNDOFF, SEPARATE, SEQUENCES, STEP_ORDER, SUBSETS, _roundoff_text, budget_findings, sequential, stage_findings)
 from mpm_fem.measure.claims.remedies import (
-    BURGERS_ORDER, FV_FACTOR, PLATEAU_ORDER, REMEDY_ERRORS, REMEDY_MEASURES, remedy_assessment, remedy_budget)
+    BURGERS_ORDER, FV_DRIFT, FV_FACTOR, ORDER_MARGIN, PLATEAU_CRITERION, REMEDY_ERRORS, REMEDY_MEASURES,
+    remedy_assessment, remedy_budget)
 # isort: on
 
 __all__ = [
     "VERDICTS", "STATEMENTS", "Tables", "Criterion", "Claim", "CLAIMS", "claim", "claims_of",
     "num", "select", "span", "count_verdict", "saturation", "successive_orders",
     "BAND_TOLERANCE", "JUDGED_LAYOUTS", "ORDERS",
-    "SATURATION", "LUMPING_GAIN", "MASS_SHARE", "mass_shares",
+    "SATURATION", "LUMPING_BAND", "lumping_sign",
     "CONVERGENCE", "FLOOR_ORDER", "CONVERGING_ORDER", "FLOOR_MESHES", "FLOOR_STEPS", "WAVE_REGIONS", "WAVE_SHARE",
     "EXTREMA_RATIO", "SIDE_BY_SIDE",
     "BURGERS_SHOWN", "FIRST_ORDER", "C13_METHODS",
     "GLOBAL_ORDER", "LOCAL_ORDER", "CROSSING_TOLERANCE", "NO_JUMP",
-    "DOMINANT", "CLOSURE", "SHAPLEY", "ROUNDOFF", "budget_verdicts", "_roundoff_text",
-    "REMEDY_ERRORS", "PLATEAU_ORDER", "FV_FACTOR", "BURGERS_ORDER", "REMEDY_MEASURES", "remedy_assessment",
-    "remedy_budget",
+    "SUBSETS", "STEP_ORDER", "SEPARATE", "SEQUENCES", "ROUNDOFF", "budget_findings", "stage_findings", "sequential",
+    "_roundoff_text",
+    "REMEDY_ERRORS", "ORDER_MARGIN", "FV_DRIFT", "PLATEAU_CRITERION", "FV_FACTOR", "BURGERS_ORDER", "REMEDY_MEASURES",
+    "remedy_assessment", "remedy_budget",
 ]

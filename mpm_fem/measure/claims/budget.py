@@ -1,75 +1,123 @@
 """The budget study's claims: E1 (the error budget over every combination of the stages, on Sod and
-on Burgers) and E2 (the bases), from ``budget/shapley``, ``budget/roundoff`` and ``budget/bases``."""
+on Burgers: do the stages separate, and which one dominates) from the raw measurements
+``budget/subsets`` (with ``budget/roundoff`` beside), and E2 (the bases) from ``budget/bases``."""
 
 from __future__ import annotations
 
 import math
 
 from mpm_fem.measure.claims.base import Criterion, Tables, claim
-from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select
-from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF, BUDGET_SHAPLEY
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
+from mpm_fem.measure.decomposition import decompose
+from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF, BUDGET_SUBSETS
 
-#: E1: a stage dominates when its Shapley share of v(all MPM) - v(all exact) is at least DOMINANT;
-#: the shares close when they add up to one within CLOSURE (the CSV keeps six digits).
-DOMINANT, CLOSURE = 0.5, 1e-4
+SUBSETS = BUDGET_SUBSETS.name
+#: E1: the stages in the order the step runs them (projection to the grid, the FE solve with the
+#: lumped mass, the interpolation back to the particles, the time update); the budget's stages.
+STEP_ORDER = ("projection", "mass", "interpolation", "time")
+#: E1 (a): the stages separate when their interactions (the Moebius terms of two stages or more), in
+#: total magnitude, are at most SEPARATE of |v(all MPM) - v(all exact)|.
+SEPARATE = 0.25
+#: E1 (b): the attributions that must name the same largest stage for it to dominate: the Shapley
+#: value, and the error removed by each stage when the stages are made exact one after another from
+#: all MPM, in the step's order and in its reverse.
+SEQUENCES = {"forward": STEP_ORDER, "backward": STEP_ORDER[::-1]}
 # E2: a basis keeps converging with a last-refinement order of the particle density L1 above C11's
 # CONVERGING_ORDER, and P1 has levelled off below C11's FLOOR_ORDER.
-SHAPLEY = BUDGET_SHAPLEY.name
 
 
-def _trend(shares: list[float]) -> str:
-    steps = [b - a for a, b in zip(shares, shares[1:], strict=False)]
-    if not steps:
-        return "one mesh"
-    return "grows as h shrinks" if all(d > 0 for d in steps) else "falls as h shrinks" if all(d < 0 for d in steps) \
-        else "varies with h"
+def _subset(label: str) -> frozenset:
+    return frozenset() if label == "none" else frozenset(label.split("+"))
 
 
-def budget_verdicts(rows: list[dict], norm: str) -> tuple[dict, bool]:
-    """Per basis, at the finest mesh: the stages ranked by Shapley share, the dominant one (the
-    largest, when it reaches DOMINANT), the shares of the largest from the coarsest mesh to the
-    finest; and whether the shares of every mesh add up to one."""
-    out, closes = {}, True
-    for basis in dict.fromkeys(r["basis"] for r in rows):
+def sequential(v: dict, order: tuple) -> dict:
+    """The error each stage removes when the stages are made exact one after another in ``order``,
+    starting from all MPM: ``v(B) - v(B - {s})``, ``B`` the stages still in MPM form before ``s``;
+    they add up to v(all MPM) - v(all exact) in any order."""
+    out, still = {}, frozenset(order)
+    for s in order:
+        out[s] = v[still] - v[still - {s}]
+        still = still - {s}
+    return out
+
+
+def stage_findings(rows: list[dict]) -> dict | None:
+    """E1's two questions on the ``budget/subsets`` rows of one (problem, h, basis, norm): the
+    interactions' total magnitude over |v(all MPM) - v(all exact)| (``interactions``), whether the
+    stages separate, the largest stage by each attribution (``tops``: Shapley, forward, backward),
+    the dominant stage when they agree (else None), the largest main effect (``alone``: stage,
+    m({s})) and the end points; None when a subset of STEP_ORDER is missing."""
+    v = {_subset(r["mpm_stages"]): num(r, "error") for r in rows}
+    try:
+        d = decompose(v, STEP_ORDER)
+    except ValueError:
+        return None
+    inter = sum(abs(m) for m in d.interactions().values())
+    ratio = inter / abs(d.gap) if d.gap else math.inf
+    tops = {"Shapley": max(STEP_ORDER, key=lambda s: d.shapley[s])}
+    for name, order in SEQUENCES.items():
+        removed = sequential(v, order)
+        tops[name] = max(order, key=lambda s: removed[s])
+    alone = max(STEP_ORDER, key=lambda s: abs(d.moebius[frozenset({s})]))
+    return {"interactions": ratio, "separate": ratio <= SEPARATE, "tops": tops,
+            "dominant": tops["Shapley"] if len(set(tops.values())) == 1 else None,
+            "alone": (alone, d.moebius[frozenset({alone})]), "mpm": d.total, "exact": d.floor}
+
+
+def budget_findings(rows: list[dict]) -> dict:
+    """:func:`stage_findings` of every mesh, per ``(basis, norm)`` of one problem's
+    ``budget/subsets`` rows: ``{(basis, norm): [(h, findings), ...]}``, coarsest mesh first."""
+    out = {}
+    for basis, norm in dict.fromkeys((r["basis"], r["norm"]) for r in rows):
         sub = select(rows, basis=basis, norm=norm)
         hs = sorted({num(r, "h") for r in sub}, reverse=True)
-        share = {h: {r["stage"]: num(r, "share") for r in sub if num(r, "h") == h} for h in hs}
-        closes &= all(abs(sum(s.values()) - 1) <= CLOSURE for s in share.values())
-        ranked = sorted(share[hs[-1]].items(), key=lambda kv: -kv[1])
-        out[basis] = {"h": hs[-1], "ranked": ranked, "dominant": ranked[0][0] if ranked[0][1] >= DOMINANT else None,
-                      "shares": [share[h].get(ranked[0][0], math.nan) for h in hs]}
-    return out, closes
+        found = [(h, stage_findings([r for r in sub if num(r, "h") == h])) for h in hs]
+        out[(basis, norm)] = [(h, f) for h, f in found if f is not None]
+    return {k: v for k, v in out.items() if v}
 
 
-def _e1_text(basis: str, f: dict) -> str:
-    """``mpm at h = 0.0025: projection 326% (136% -> 326%, grows as h shrinks); compensated by mass -180%``."""
-    (top, v), second = f["ranked"][0], f["ranked"][1]
-    head = (f"{top} {v:.0%}" if f["dominant"] else f"shared: {top} {v:.0%} and {second[0]} {second[1]:.0%}")
-    also = [f"{s} {x:.0%}" for s, x in f["ranked"][1:] if x >= DOMINANT]
-    low = f["ranked"][-1]
-    return (f"{basis} at h = {f['h']:g}: {head} ({' -> '.join(f'{x:.0%}' for x in f['shares'])}, {_trend(f['shares'])})"
-            + (f", also above half {', '.join(also)}" if also and f["dominant"] else "")
-            + (f"; compensated by {low[0]} {low[1]:.0%}" if low[1] < 0 else ""))
+def _e1_text(found: dict) -> str:
+    """E1's evidence from :func:`budget_findings` (judged at the finest mesh of each basis and norm)."""
+    finest = {k: series[-1] for k, series in found.items()}
+    n, sep = len(finest), [k for k, (_, f) in finest.items() if f["separate"]]
+    dominant = {k: f["dominant"] for k, (_, f) in finest.items() if f["dominant"]}
+    hs = span([h for h, _ in finest.values()], "g")
+    names = {k: f"{k[0]} {k[1]}" for k in finest}
+    ratios = [f["interactions"] for _, f in finest.values()]
+    head = (f"the stages separate in {len(sep)} of {n} bases and norms at h = {hs} (the interactions are "
+            f"{span(ratios, '.2g')}x |v(all MPM) - v(all exact)|, at most {SEPARATE:.0%} to separate)")
+    by_stage = {}
+    for k, s in dominant.items():
+        by_stage.setdefault(s, []).append(names[k])
+    head += (f"; a dominant stage in {len(dominant)} of {n}: "
+             + ("; ".join(f"{s} ({', '.join(ks)})" for s, ks in by_stage.items()) if dominant else "none"))
+    undecided = [f"{names[k]} (" + ", ".join(f"{a} {s}" for a, s in f["tops"].items()) + ")"
+                 for k, (_, f) in finest.items() if not f["dominant"]]
+    if undecided:
+        head += "; the attributions disagree for " + ", ".join(undecided)
+    (k0, (h0, f0)) = next(iter(finest.items()))
+    head += (f"; e.g. {names[k0]} at h = {h0:g}: {f0['alone'][0]} alone adds {f0['alone'][1]:.3g} against "
+             f"v(all MPM) = {f0['mpm']:.3g} and v(all exact) = {f0['exact']:.3g}")
+    trend = ", ".join(f"{names[k]} " + " -> ".join(f"{f['interactions']:.2g}" for _, f in series)
+                      for k, series in found.items())
+    return head + f"; interactions / |v(all MPM) - v(all exact)| from the coarsest mesh to the finest: {trend}"
 
 
 def _e1(problem: str) -> Criterion:
     def criterion(t: Tables) -> tuple[str, str]:
-        """The sixteen combinations of the four stages in MPM or exact form give each stage's Shapley
-        value: its main effect plus an equal share of every interaction it is part of. A negative value
-        says that the stage's MPM form compensates the others on average."""
-        rows = select(t[SHAPLEY], problem=problem)
-        norms = list(dict.fromkeys(r["norm"] for r in rows))
-        found, closes = budget_verdicts(rows, norms[0])
-        parts = [_e1_text(basis, f) for basis, f in found.items()]
-        for norm in norms[1:]:
-            other, ok = budget_verdicts(rows, norm)
-            closes &= ok
-            parts.append(f"{norm} L1: " + ", ".join(f"{b} {f['ranked'][0][0]} {f['ranked'][0][1]:.0%}"
-                                                    for b, f in other.items()))
-        dominated = sum(f["dominant"] is not None for f in found.values())
-        verdict = ("refuted" if not closes else "confirmed" if dominated == len(found) else "partly")
-        return verdict, f"{norms[0]} L1, largest Shapley share: " + "; ".join(parts) + (
-            "" if closes else "; the shares do not add up to one") + _roundoff_text(t, problem)
+        """The sixteen combinations of the four stages in MPM or exact form are the raw measurements.
+        The stages separate when the error of every combination is close to the all-exact error plus
+        the errors each stage adds alone: the Moebius interactions, which measure the departure from
+        that sum, are small beside the gap between all MPM and all exact. A stage dominates when the
+        Shapley value and the errors removed by making the stages exact one after another, in the
+        step's order and in its reverse, name it as the largest; where the interactions are large these
+        attributions can disagree, and then no stage is named."""
+        found = budget_findings(select(t[SUBSETS], problem=problem))
+        if not found:
+            return "not measured", f"no complete set of the {2 ** len(STEP_ORDER)} combinations of {STEP_ORDER}"
+        finest = [series[-1][1] for series in found.values()]
+        hits = sum(f["separate"] for f in finest) + sum(f["dominant"] is not None for f in finest)
+        return count_verdict(hits, 2 * len(finest)), _e1_text(found) + _roundoff_text(t, problem)
     return criterion
 
 
@@ -91,12 +139,15 @@ def _roundoff_text(t: Tables, problem: str) -> str:
             + " / ".join(f"{h:g}" for h in hs))
 
 
-_E1_RULE = (f"the Shapley shares of every mesh add up to one (within {CLOSURE:g}) and at the finest mesh one stage "
-            f"carries at least {DOMINANT:.0%} of v(all MPM) - v(all exact) for every basis -> confirmed; for some "
-            "bases the error is shared -> partly; shares that do not add up -> refuted")
+_E1_RULE = (f"at the finest mesh of every basis and norm, (a) the interactions of the stages (the Moebius terms of two "
+            f"stages or more), in total magnitude, are at most {SEPARATE:.0%} of |v(all MPM) - v(all exact)| (the "
+            "stages separate) and (b) the Shapley value and the sequential replacement (the stages made exact one "
+            f"after another from all MPM, in the step's order {' -> '.join(STEP_ORDER)} and in its reverse) name the "
+            "same largest stage (it dominates) -> confirmed; some of these -> partly; none -> refuted. Read from "
+            "budget/subsets, the value of every combination")
 for _problem in ("sod", "burgers"):
     claim("E1", source="the four error sources of the slides (projection, FE + mass lumping, interpolation, time)",
-          tables=(SHAPLEY,), study="budget", problem=_problem, thresholds=_E1_RULE)(_e1(_problem))
+          tables=(SUBSETS,), study="budget", problem=_problem, thresholds=_E1_RULE)(_e1(_problem))
 
 
 @claim("E2", source="whether a smooth basis removes the stagnation of C11", tables=(BUDGET_BASES.name,), study="budget",

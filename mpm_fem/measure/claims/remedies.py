@@ -6,34 +6,66 @@ from __future__ import annotations
 import math
 
 from mpm_fem.measure.claims.base import Tables, claim
-from mpm_fem.measure.claims.rows import num, select, successive_orders
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
 from mpm_fem.measure.schema import BUDGET_SHAPLEY, REMEDIES_ERRORS, SETTINGS
 from mpm_fem.measure.tables import setting
 
 REMEDY_ERRORS = REMEDIES_ERRORS.name
-PLATEAU_ORDER = 0.8  # a remedy removes the plateau: every successive order >= this, nodes and particles
-FV_FACTOR = 1.5  # goal on Sod: within this factor of the finite-volume error at every h
-BURGERS_ORDER = 1.0  # goal on Burgers (4 per cell): fitted order >= this, nodes and particles
+#: E5 on Sod, against the finite-volume reference on the same meshes: a remedy's observed order between
+#: two successive meshes is as good as the FV's when it is at least the FV's order there minus
+#: ORDER_MARGIN, the width of the band the study leaves undecided between a floor and convergence
+#: (rows.py), and not below FLOOR_ORDER.
+ORDER_MARGIN = CONVERGING_ORDER - FLOOR_ORDER
+#: E5 on Sod: the error stays within a constant factor of the FV's when its ratio to the FV error at the
+#: finest mesh is at most FV_DRIFT times the ratio at the coarsest.
+FV_DRIFT = 1.5
+#: The thresholds of :func:`remedy_assessment`'s ``removes_plateau``, as the remedies study records them.
+PLATEAU_CRITERION = {"order_margin_to_fv": ORDER_MARGIN, "floor_order": FLOOR_ORDER, "fv_drift": FV_DRIFT,
+                     "converging_order_without_fv": CONVERGING_ORDER}
+FV_FACTOR = 1.5  # the goal on Sod: within this factor of the finite-volume error at every h
+BURGERS_ORDER = 1.0  # the goal on Burgers (4 per cell): fitted order >= this, nodes and particles
 REMEDY_MEASURES = ("nodes_L1", "particles_L1")
 
 
+def _fitted(rows: list[dict], key: str) -> float:
+    pts = [(math.log(num(r, "h")), math.log(num(r, key))) for r in rows if num(r, key) > 0]
+    if len(pts) < 2:
+        return math.nan
+    mx, my = sum(p[0] for p in pts) / len(pts), sum(p[1] for p in pts) / len(pts)
+    return sum((x - mx) * (y - my) for x, y in pts) / sum((x - mx) ** 2 for x, _ in pts)
+
+
 def remedy_assessment(rows: list[dict]) -> dict:
-    """What E5 asks of one remedy on one problem (rows of one series): per measure the lowest
-    successive order, the least-squares order and the largest ratio to ``fv_L1`` (when present)."""
+    """What E5 asks of one remedy on one problem (rows of one series, any order). Per measure: the
+    lowest successive order, the least-squares order and, where every row carries the FV reference's
+    error ``fv_L1`` (Sod), the largest ratio to it, the ratio at the finest mesh over that at the
+    coarsest (``fv_drift``) and the lowest difference between the remedy's order and the FV's on the
+    same pair of meshes (``min_gap_fv``). ``removes_plateau``, over both measures: with the FV
+    reference, every successive order as good as the FV's (at least the FV's minus ORDER_MARGIN, and
+    at least FLOOR_ORDER) and ``fv_drift`` at most FV_DRIFT; without it (Burgers), every successive
+    order at least CONVERGING_ORDER. A failed run (no error) fails every condition it enters."""
     rows = sorted(rows, key=lambda r: -num(r, "h"))
-    out = {}
+    with_fv = bool(rows) and all(num(r, "fv_L1") > 0 for r in rows)
+    fv_orders = successive_orders(rows, "fv_L1") if with_fv else []
+    out, removes = {}, len(rows) >= 2
     for m in REMEDY_MEASURES:
         o = successive_orders(rows, m)
-        out[f"min_order_{m}"] = min(o) if o and all(math.isfinite(x) for x in o) else math.nan
-        pts = [(math.log(num(r, "h")), math.log(num(r, m))) for r in rows if num(r, m) > 0]
-        if len(pts) >= 2:
-            mx, my = sum(p[0] for p in pts) / len(pts), sum(p[1] for p in pts) / len(pts)
-            out[f"fitted_order_{m}"] = (sum((x - mx) * (y - my) for x, y in pts) / sum((x - mx) ** 2 for x, _ in pts))
+        finite = bool(o) and all(math.isfinite(x) for x in o)
+        out[f"min_order_{m}"] = min(o) if finite else math.nan
+        out[f"fitted_order_{m}"] = _fitted(rows, m)
+        if with_fv:
+            ratios = [num(r, m) / num(r, "fv_L1") for r in rows]
+            gaps = [a - b for a, b in zip(o, fv_orders, strict=True)]
+            out[f"max_fv_ratio_{m}"] = max(ratios) if all(math.isfinite(x) for x in ratios) else math.nan
+            out[f"fv_drift_{m}"] = ratios[-1] / ratios[0]
+            out[f"min_gap_fv_{m}"] = min(gaps) if finite else math.nan
+            removes &= finite and all(x >= max(FLOOR_ORDER, f - ORDER_MARGIN)
+                                      for x, f in zip(o, fv_orders, strict=True))
+            removes &= out[f"fv_drift_{m}"] <= FV_DRIFT
         else:
-            out[f"fitted_order_{m}"] = math.nan
-        ratios = [num(r, m) / num(r, "fv_L1") for r in rows if num(r, "fv_L1") > 0]
-        out[f"max_fv_ratio_{m}"] = max(ratios) if len(ratios) == len(rows) and rows else math.nan
-    out["removes_plateau"] = all(out[f"min_order_{m}"] >= PLATEAU_ORDER for m in REMEDY_MEASURES)
+            out[f"max_fv_ratio_{m}"] = math.nan
+            removes &= finite and all(x >= CONVERGING_ORDER for x in o)
+    out["removes_plateau"] = bool(removes)
     return out
 
 
@@ -70,20 +102,27 @@ def _series(rows: list[dict], problem: str) -> dict[str, list[dict]]:
                     "every mesh, over nodes and over particles, within 1.5x of the FV error at every h, and that "
                     "converges at first order or better on Burgers with 4 particles per cell",
        tables=(REMEDY_ERRORS,), study="remedies",
-       thresholds=f"a remedy removes the plateau when its observed orders over nodes and over particles stay >= "
-                  f"{PLATEAU_ORDER} between every pair of successive meshes (on Sod: run on every mesh of the "
-                  f"table); a remedy that removes it on Sod, stays within {FV_FACTOR}x of the FV error at every h "
-                  f"(nodes and particles) and on Burgers removes it with fitted orders >= {BURGERS_ORDER} -> "
-                  "confirmed (named); one that only removes the Sod plateau -> partly; none -> refuted. The remedy "
-                  "named meets most of the three conditions and, among those, has the smallest largest FV ratio. "
-                  "Wall time enters no verdict. The evidence adds which stage carries the largest Shapley "
-                  "share of the named remedy's remaining error, from the error budget of its basis at its finest "
-                  "mesh (budget/shapley, when the budget was run)")
+       thresholds=f"on Sod (run on every mesh of the table) a remedy removes the plateau when, over nodes and over "
+                  f"particles, its observed order between every pair of successive meshes is as good as the "
+                  f"finite-volume reference's on the same pair (at least the FV's minus {ORDER_MARGIN:.2g}, the "
+                  f"study's band between the floor {FLOOR_ORDER} and convergence {CONVERGING_ORDER}, and at least "
+                  f"{FLOOR_ORDER}) and its error stays within a constant factor of the FV's (its ratio to the FV "
+                  f"error at the finest mesh at most {FV_DRIFT}x that at the coarsest); on Burgers, which has no FV "
+                  f"reference, when every successive order is at least {CONVERGING_ORDER}. A remedy that removes "
+                  f"it on Sod, stays within {FV_FACTOR}x of the FV error at every h (nodes and particles) and on "
+                  f"Burgers removes it with fitted orders >= {BURGERS_ORDER} -> confirmed (named); one that only "
+                  "removes the Sod plateau -> partly; none -> refuted. The remedy named meets most of the three "
+                  "conditions and, among those, has the smallest largest FV ratio. Wall time enters no verdict. The "
+                  "evidence adds which stage carries the largest Shapley share of the named remedy's remaining "
+                  "error, from the error budget of its basis at its finest mesh (budget/shapley, when the budget "
+                  "was run)")
 def _e5(t: Tables) -> tuple[str, str]:
     """The remedies attack the error sources the budget found: the particle-domain B-spline the force
     quadrature and the jump of the basis gradient at node crossings, the Taylor reconstruction the force
     quadrature, the volume reset the volume drift, the PIC/FLIP blend and XPIC(m) the noise carried by the
-    particle velocities (XPIC filters FLIP's null-space noise without PIC's diffusion)."""
+    particle velocities (XPIC filters FLIP's null-space noise without PIC's diffusion). The contact
+    discontinuity of Sod's tube limits the L1 order of every method, the finite-volume reference's too, so
+    a remedy is held to the FV reference's own orders on the same meshes, not to first order."""
     rows = t[REMEDY_ERRORS]
     sod = {k: v for k, v in _series(rows, "sod").items() if len(v) >= 2}
     burgers = _series(rows, "burgers")
@@ -102,10 +141,15 @@ def _e5(t: Tables) -> tuple[str, str]:
                        name, s, fv, b, b_ok))
     scored.sort(key=lambda x: x[0], reverse=True)
     _, name, s, fv, b, b_ok = scored[0]
-    own = [num(r, "h") for r in sod[name]]
-    text = (f"{name}: lowest Sod order {s['min_order_nodes_L1']:.2f} (nodes) / {s['min_order_particles_L1']:.2f} "
-            f"(particles) over h = {max(own):g}..{min(own):g}, at most {s['max_fv_ratio_nodes_L1']:.2f}x / "
-            f"{s['max_fv_ratio_particles_L1']:.2f}x the FV error")
+    own = sorted(sod[name], key=lambda r: -num(r, "h"))
+    fv_orders = successive_orders(own, "fv_L1")
+    g = {f"{k}_{m}": s.get(f"{k}_{m}", math.nan) for k in ("min_gap_fv", "fv_drift") for m in REMEDY_MEASURES}
+    text = (f"{name}: Sod order minus the FV reference's on the same meshes at least "
+            f"{g['min_gap_fv_nodes_L1']:+.2f} (nodes) / {g['min_gap_fv_particles_L1']:+.2f} (particles), lowest "
+            f"orders {s['min_order_nodes_L1']:.2f} / {s['min_order_particles_L1']:.2f} against the FV's "
+            f"{span(fv_orders)}, over h = {num(own[0], 'h'):g}..{num(own[-1], 'h'):g}; at most "
+            f"{s['max_fv_ratio_nodes_L1']:.2f}x / {s['max_fv_ratio_particles_L1']:.2f}x the FV error, the ratio at "
+            f"the finest mesh {g['fv_drift_nodes_L1']:.2f}x / {g['fv_drift_particles_L1']:.2f}x that at the coarsest")
     text += (f"; Burgers (4 per cell) fitted orders {b['fitted_order_nodes_L1']:.2f} / "
              f"{b['fitted_order_particles_L1']:.2f}, "
              f"lowest successive {min(b['min_order_nodes_L1'], b['min_order_particles_L1']):.2f}"
@@ -117,4 +161,4 @@ def _e5(t: Tables) -> tuple[str, str]:
         return "confirmed", "meets the goal: " + text
     if removers:
         return "partly", text + f"; the Sod plateau is removed by {', '.join(removers)}"
-    return "refuted", f"closest: {text}; no remedy keeps the order >= {PLATEAU_ORDER} on every Sod mesh"
+    return "refuted", f"closest: {text}; no remedy converges as the FV reference does on every Sod mesh"

@@ -1,25 +1,38 @@
 """E4: one command regenerates every table from one code version, judged from the ``versions`` table
-(:func:`mpm_fem.measure.tables.load_tables`) against the tables every registered claim reads."""
+(:func:`mpm_fem.measure.tables.load_tables`) against the version of the code judging them
+(:func:`mpm_fem.measure.version.code_version`) and the tables every registered claim reads."""
 
 from __future__ import annotations
 
+from mpm_fem.measure import version
 from mpm_fem.measure.claims.base import CLAIMS, Tables, claim
 from mpm_fem.measure.schema import BUILT, VERSIONS
 
 
+def lag_text(stamp: str, current: str) -> str:
+    """The first clause of E4's evidence when the tables' code ``stamp`` is not the ``current`` code's."""
+    return f"the figures lag the code: tables from code {stamp}, the current code is {current}"
+
+
 @claim("E4", source="`mpm-fem reproduce` regenerates every table and this report", tables=(VERSIONS.name,),
        study="reproduce",
-       thresholds="every table carries the code version named in the header, and every table a claim reads "
-                  "exists -> confirmed; a table from another code version -> refuted; a table missing -> partly")
+       thresholds="every table carries one code version, the version of the code that judges them (a hash of the "
+                  "syntax trees, docstrings aside, of the code that computes numbers: mpm_fem, baselines and "
+                  "studies but the report, its pages and the plots; mpm_fem/measure/version.py), and every table a "
+                  "claim reads exists -> confirmed; one version that is not the current code's (the figures lag "
+                  "the code) or a table missing -> partly; tables from several code versions -> refuted")
 def _e4(t: Tables) -> tuple[str, str]:
+    """The stamp of each table is the version of the code that wrote it, computed as the sweeps compute
+    the key of their case cache; a change to a docstring, a comment, the report or the plots leaves it."""
     rows = t[VERSIONS.name]
     codes = [r["code"] for r in rows]
     main = max(set(codes), key=codes.count)
+    current = version.code_version()
     other = [r["table"] for r in rows if r["code"] != main]
     needed = {name for c in CLAIMS for name in c.tables if name not in BUILT}
     missing = sorted(needed - {r["table"] for r in rows})
-    verdict = "refuted" if other else ("partly" if missing else "confirmed")
-    return verdict, (f"{len(rows) - len(other)} of {len(rows)} tables from code {main}"
-                     + (f"; other versions: {', '.join(other)}" if other else "")
+    verdict = "refuted" if other else ("partly" if missing or main != current else "confirmed")
+    head = (f"{len(rows) - len(other)} of {len(rows)} tables from code {main}, the current code"
+            if main == current else lag_text(main, current) + f" ({len(rows) - len(other)} of {len(rows)} tables)")
+    return verdict, (head + (f"; other versions: {', '.join(other)}" if other else "")
                      + (f"; missing: {', '.join(missing)}" if missing else ""))
-

@@ -1,18 +1,19 @@
 """What the Sod and the Burgers claims share: the criteria of C3 (particles per cell) and C15 (mass
-lumping), each judged per problem (``sod/ppc``, ``burgers/ppc``; ``sod/mass``, ``burgers/lumping`` and
-the budget's ``budget/shapley``)."""
+lumping), each judged per problem (``sod/ppc``, ``burgers/ppc``; ``sod/mass``, ``burgers/lumping``)."""
 
 from __future__ import annotations
 
-from mpm_fem.measure.claims.rows import count_verdict, num, saturation, select
+import math
+
+from mpm_fem.measure.claims.rows import count_verdict, saturation, span
 from mpm_fem.measure.source import OPTIMAL_PPC
 
 #: C3: the fewest particles per cell within SATURATION of the smallest error.
 SATURATION = 0.05
-#: C15: lumping is an error source where the consistent mass lowers the error below LUMPING_GAIN x lumped;
-#: the budget's mass stage (FE + mass lumping) is one where its Shapley share of v(all MPM) - v(all exact),
-#: in magnitude, reaches MASS_SHARE at the finest mesh of a basis (either sign: adding or compensating).
-LUMPING_GAIN, MASS_SHARE = 0.9, 0.1
+#: C15: the error with the consistent mass over the error with the lumped mass, all else equal, of one
+#: method on one mesh: lumping is a source of error where the consistent mass is clearly better (ratio
+#: below LUMPING_BAND), compensating where it is clearly worse (above 1 / LUMPING_BAND), neutral between.
+LUMPING_BAND = 0.9
 
 
 def ppc_claim(groups: dict[str, list[dict]], keys: tuple[str, ...]) -> tuple[str, str]:
@@ -29,29 +30,41 @@ PPC_RULE = (f"the fewest particles per cell within {SATURATION:.0%} of the small
             "on none -> differs")
 
 
-def mass_shares(rows: list[dict]) -> dict[str, float]:
-    """The budget's Shapley share of the mass stage at the finest mesh of each basis and norm
-    (``budget/shapley`` rows of one problem), keyed ``"<basis> <norm> h = <h>"``."""
-    out = {}
-    for basis, norm in dict.fromkeys((r["basis"], r["norm"]) for r in rows):
-        sub = select(rows, basis=basis, norm=norm, stage="mass")
-        finest = min(sub, key=lambda r: num(r, "h"))
-        out[f"{basis} {norm} h = {finest['h']}"] = num(finest, "share")
-    return out
+def lumping_sign(ratios) -> str:
+    """What lumping does in one method, from its consistent/lumped ratios on every mesh: ``source of
+    error`` (every ratio below LUMPING_BAND), ``compensating`` (every ratio above 1 / LUMPING_BAND),
+    ``neutral`` (every ratio between), ``mixed`` (the meshes disagree); ``not measured`` without a ratio."""
+    r = [x for x in ratios if math.isfinite(x)]
+    if not r:
+        return "not measured"
+    signs = {"source of error" if x < LUMPING_BAND else "compensating" if x > 1 / LUMPING_BAND else "neutral"
+             for x in r}
+    return signs.pop() if len(signs) == 1 else "mixed"
 
 
-def lumping_claim(ratios: dict[str, float], shares: dict[str, float]) -> tuple[str, str]:
-    """C15 on one problem: every consistent/lumped ratio below LUMPING_GAIN and every mass-stage share
-    at least MASS_SHARE in magnitude count as cases that hold."""
-    hits = sum(v < LUMPING_GAIN for v in ratios.values()) + sum(abs(v) >= MASS_SHARE for v in shares.values())
-    return count_verdict(hits, len(ratios) + len(shares), "differs"), (
-        "consistent/lumped error: " + ", ".join(f"{k} {v:.2f}" for k, v in ratios.items())
-        + "; Shapley share of the mass stage at the finest budget mesh: "
-        + (", ".join(f"{k} {v:.0%}" for k, v in shares.items()) or "-"))
+def lumping_claim(ratios: dict[str, dict[str, float]], judged: tuple[str, ...]) -> tuple[str, str]:
+    """C15 on one problem from ``ratios`` (``{method: {h: consistent / lumped error}}``): each (method
+    of ``judged``, mesh) whose ratio is below LUMPING_BAND is a case that holds; the other methods
+    (the fixed-mesh FEM) are shown beside. With no case holding, ``differs`` when lumping compensates
+    on some judged case, ``refuted`` when it is neutral on all."""
+    cases = [x for m in judged for x in ratios.get(m, {}).values() if math.isfinite(x)]
+    hits = sum(x < LUMPING_BAND for x in cases)
+    verdict = count_verdict(hits, len(cases), "differs" if any(x > 1 / LUMPING_BAND for x in cases) else "refuted")
+
+    def text(m: str) -> str:
+        r = ratios[m]
+        return (f"{m}: {lumping_sign(r.values())} (consistent/lumped {span(r.values())} at h = "
+                f"{span([float(h) for h in r], 'g')})")
+
+    beside = [m for m in ratios if m not in judged]
+    return verdict, ("; ".join(text(m) for m in judged if m in ratios)
+                     + (f"; beside, on the same meshes: {'; '.join(text(m) for m in beside)}" if beside else "")
+                     + f"; source of error below {LUMPING_BAND:g}, compensating above {1 / LUMPING_BAND:.3g}")
 
 
-LUMPING_RULE = (f"the consistent mass lowers the error below {LUMPING_GAIN} x the lumped one for every method and "
-                f"mesh, and the error budget's mass stage (FE + mass lumping) carries a Shapley share of at least "
-                f"{MASS_SHARE:.0%} (in magnitude: adding to the error or compensating the other stages) of v(all MPM) "
-                "- v(all exact) at the finest mesh of every basis and norm -> confirmed; some of these -> partly; "
-                "none -> differs")
+LUMPING_RULE = (f"the error with the consistent mass over that with the lumped mass, all else equal, on every mesh: "
+                f"lumping is a source of error where the ratio is below {LUMPING_BAND:g} (the consistent mass is "
+                f"clearly better), compensating where it is above {1 / LUMPING_BAND:.3g} (clearly worse), neutral "
+                "between. Judged on MPM, the source's method (the fixed-mesh FEM shown beside): a source on every "
+                "mesh -> confirmed, on some -> partly; on none, compensating on some -> differs; neutral on every "
+                "mesh -> refuted")
