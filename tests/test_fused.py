@@ -326,7 +326,7 @@ def test_particle_domain_bspline_row_is_the_formula_float_for_float():
     pieces that do not vanish (``_bspline_pieces``): the same floats as the formula of
     ``mpm_fem.core.shape`` (``_bspline_integral``, ``_quadratic_bspline``) at every node of the row, on
     domain ends placed at random, on nodes, half-way between nodes and at the grid's ends."""
-    from mpm_fem.fused.step import _bspline_domain_row
+    from mpm_fem.fused.basis import _bspline_domain_row
     from mpm_fem.core.shape import _bspline_integral, _quadratic_bspline
 
     nodes = np.linspace(0.0, 1.0, 41)
@@ -358,7 +358,7 @@ def test_the_five_column_bspline_row_is_the_column_rows_float_for_float():
     three pieces placed by selects, ``_five``) gives ``_domain_column``'s floats at every column, for
     domains within two cells placed at random, on nodes and at the grid's ends; ``_five`` is
     ``_piece`` at every start it is used for."""
-    from mpm_fem.fused.step import _bspline_domain_five, _domain, _domain_column, _five, _piece
+    from mpm_fem.fused.basis import _bspline_domain_five, _domain, _domain_column, _five, _piece
 
     for d in range(3):
         assert _five(d, 7.0, 1.0, 2.0, 3.0) == tuple(_piece(k - d, 7.0, 1.0, 2.0, 3.0) for k in range(5))

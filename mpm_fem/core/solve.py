@@ -20,7 +20,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from mpm_fem.exact_stages import ExactFields
-from mpm_fem.fused.step import FusedStep, all_finite, check_kernel, supported
+from mpm_fem.fused import FusedStep, all_finite, check_kernel, supported
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles, PositivityError
 from mpm_fem.core.shape import basis_integrals, make_shape
