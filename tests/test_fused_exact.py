@@ -10,17 +10,17 @@ uniform grid the uniform-grid arithmetic agrees to ``TOLERANCE`` (tests/test_fus
 
 import numpy as np
 import pytest
+from test_fused import TOLERANCE, _assert_same, _drifting_grid, _worst
 
 from mpm_fem.core import solve
-from mpm_fem.problems.sod import RiemannFields
-from mpm_fem.fused.step import FusedStep, supported
 from mpm_fem.core.grid import grid_from_nodes, uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import make_particles, seed_positions
 from mpm_fem.core.solve import Problem, run
 from mpm_fem.core.step import Stages, Walls
-from test_fused import TOLERANCE, _assert_same, _drifting_grid, _worst
+from mpm_fem.fused.step import FusedStep, supported
+from mpm_fem.problems.sod import RiemannFields
 
 #: the seven subsets with an exact stage: which of projection, mass, interpolation are exact
 SUBSETS = [dict(projection=p, mass=m, interpolation=i)
@@ -60,7 +60,8 @@ def _stretched():
 
 
 @pytest.mark.parametrize("basis", [
-    "mpm", "bspline_gimp", pytest.param("gimp", marks=pytest.mark.slow), pytest.param("bspline", marks=pytest.mark.slow)])
+    "mpm", "bspline_gimp", pytest.param("gimp", marks=pytest.mark.slow),
+    pytest.param("bspline", marks=pytest.mark.slow)])
 @pytest.mark.parametrize("subset", SUBSETS, ids=IDS)
 def test_exact_stages_compiled_equal_the_numpy_step_bit_for_bit(basis, subset):
     """Off a uniform grid the compiled exact stages are the numpy step's operations in its order:

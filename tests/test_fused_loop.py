@@ -8,15 +8,18 @@ grid every basis takes uniform-grid arithmetic: it equals the numpy step to ``TO
 import numpy as np
 import pytest
 
+import mpm_fem.fused.codes as fused_codes
+import mpm_fem.fused.compiler as fused_compiler
+import mpm_fem.fused.loop as fused_loop
 import mpm_fem.fused.step as fused_module
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
-from mpm_fem.core.particles import make_particles, seed_positions
 from mpm_fem.core.models.euler import IdealGas
-from mpm_fem.problems import burgers
-from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
+from mpm_fem.core.particles import make_particles, seed_positions
 from mpm_fem.core.solve import Problem, run
 from mpm_fem.core.step import Stages, Walls
+from mpm_fem.problems import burgers
+from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 TOLERANCE = 1e-12  # as tests/test_fused.py: max_p |u_fused - u_numpy| <= TOLERANCE max_p |u_numpy|, each field
@@ -84,7 +87,7 @@ def test_burgers_between_walls_with_the_viscous_limit_equals_the_numpy_step(sche
     loops = [run(problem, grid, particles, stages, progress=False, kernel="fused") for problem, stages in cases]
     assert sum(loop_steps) > 0
     one_at_a_time()
-    for (problem, stages), reference, fused in zip(cases, numpy_runs, loops):
+    for (problem, stages), reference, fused in zip(cases, numpy_runs, loops, strict=False):
         _assert_close(reference, fused)
         _assert_same(run(problem, grid, particles, stages, progress=False, kernel="fused"), fused)
 
@@ -160,13 +163,14 @@ def test_the_reservoir_is_quiet_exactly_where_it_returns_the_particles_unchanged
     s = 0.025
     inner = np.linspace(0.5 * s, 1.0 - 0.5 * s, 40)
     cases = {"inner": inner, "on both ends": np.r_[0.0, inner, 1.0], "left of a": np.r_[-1e-17, inner],
-             "right of b": np.r_[inner, np.nextafter(1.0, 2.0)], "gap below s": inner[1:] - inner[1] + np.nextafter(s, 0.0),
+             "right of b": np.r_[inner, np.nextafter(1.0, 2.0)],
+             "gap below s": inner[1:] - inner[1] + np.nextafter(s, 0.0),
              "gap of s": inner[1:] - inner[1] + s}
     verdicts = {}
     for name, x in cases.items():
         particles = make_particles(x, s, 1.0, np.zeros_like(x))
         unchanged = reservoir(particles, grid, 0.0) is particles
-        assert fused_module._reservoir_quiet(x, window) == unchanged, name
+        assert fused_loop._reservoir_quiet(x, window) == unchanged, name
         verdicts[name] = unchanged
     assert verdicts == {"inner": True, "on both ends": True, "left of a": False, "right of b": False,
                         "gap below s": True, "gap of s": False}
@@ -184,7 +188,7 @@ def test_a_loop_variant_carries_only_the_passes_its_run_takes(scheme, remedy, ru
     others are ``None`` in the variant's scope, so a branch that still called one would not compile).
     Reads the variant the run itself asked for."""
     asked = []
-    get = fused_module._Passes.get
+    get = fused_compiler._Passes.get
 
     def recording(self, fn, **constants):
         made = get(self, fn, **constants)
@@ -199,7 +203,7 @@ def test_a_loop_variant_carries_only_the_passes_its_run_takes(scheme, remedy, ru
         steppers.append(self)
         return advance(self, *args, **kwargs)
 
-    monkeypatch.setattr(fused_module._Passes, "get", recording)
+    monkeypatch.setattr(fused_compiler._Passes, "get", recording)
     monkeypatch.setattr(fused_module.FusedStep, "advance", keeping)
     result = simulate(SodSettings(h=0.05, ppc=4, T=0.02, scheme=scheme, **remedy), progress=False)
     assert result.steps > 1 and sum(loop_steps) > 0 and asked  # the loop took the steps
@@ -214,6 +218,6 @@ def test_a_loop_variant_carries_only_the_passes_its_run_takes(scheme, remedy, ru
         names = ("PROJECT", "MOVE", "UPDATE", "FINISH", "VISCOUS", "GAS_FORCE", "VOLUME", "XPIC", "TAYLOR")
         assert {name for name in names if scope[name] is not None} == runs
         assert (constants["SCHEME"], constants["XPIC_ON"], constants["VOLUME_ON"], constants["TAYLOR_ON"]) == (
-            fused_module._SCHEME_CODE[scheme], int("xpic" in remedy), int("volume" in remedy),
+            fused_codes.SCHEME_CODE[scheme], int("xpic" in remedy), int("volume" in remedy),
             int("reconstruct" in remedy))
         assert all(scope[name] == value for name, value in constants.items())

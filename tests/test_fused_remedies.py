@@ -8,15 +8,15 @@ every basis."""
 import numpy as np
 import pytest
 
-from mpm_fem.fused.step import FusedStep, supported
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import make_particles, seed_positions
-from mpm_fem.problems.burgers import Reservoir
-from mpm_fem.problems.sod import SodSettings, simulate
 from mpm_fem.core.solve import Problem, run
 from mpm_fem.core.step import Dirichlet, Stages, Walls, explicit_step
+from mpm_fem.fused.step import FusedStep, supported
+from mpm_fem.problems.burgers import Reservoir
+from mpm_fem.problems.sod import SodSettings, simulate
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 GRID = uniform_grid(0.0, 1.0, 0.1)

@@ -25,7 +25,7 @@ from mpm_fem.core.shape import basis_integrals, make_shape
 from mpm_fem.core.step import Boundary, GridState, Model, Stages, explicit_step
 from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_mass, nodal_momentum
 from mpm_fem.exact_stages import ExactFields
-from mpm_fem.fused.step import FusedStep, all_finite, check_kernel, supported
+from mpm_fem.fused import FusedStep, all_finite, check_kernel, supported
 
 LOOP_WORK = 4_000_000  # particle-steps per compiled loop of the fused step (about 0.1 s)
 Observer = Callable[[int, float, Particles, Particles, GridState], None]

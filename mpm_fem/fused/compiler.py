@@ -1,0 +1,134 @@
+"""The variant compiler: each pass and the loop compiled once per basis, model, width, ... .
+
+A pass is written once, reading a few module globals in capitals; a variant is the same code with
+those globals replaced by constants (:func:`_compile`), so that numba prunes the branches of the
+other bases, models, schemes and remedies before it compiles. Every replacement is named here:
+
+    global        replaced with                                             in the variants of
+    BASIS         the basis code (codes.POINT, GIMP, BSPLINE, BSPLINE_GIMP)  every pass but _update_exact; the loop
+    MODEL         the model code (codes.GAS, BURGERS)                       _update, _move, _finish, _taylor_force,
+                                                                            _volume_reset, _update_exact; the loop
+    WIDTH         K, the nodes per particle (a row's length)                _project, _scatter_pass, _update, _move,
+                                                                            _finish, _taylor_force, _move_exact;
+                                                                            the loop
+    WEIGHT        codes.PRESSURE, VISCOUS_STRESS or MOMENTUM                _scatter_pass
+    ROW           basis._stored_row for the particle-domain bases (pass     every variant with BASIS
+                  1's rows read back), basis._recomputed_row for the point
+                  bases (recomputed: the same numbers, and cheaper)
+    DOMAIN        codes.DOMAIN_OF[BASIS]: the particle-domain basis the     every variant with BASIS
+                  volume reset averages over
+    SCHEME        codes.USL, USF or MUSL                                    the loop
+    XPIC_ON,      0 or 1: whether the loop runs XPIC, the grid volume       the loop
+    VOLUME_ON,    reset, the Taylor force
+    TAYLOR_ON
+    PROJECT, MOVE, UPDATE, FINISH, VISCOUS, GAS_FORCE, XPIC, VOLUME, TAYLOR
+                  the loop's passes: variants of the same BASIS, MODEL and  the loop
+                  WIDTH (:meth:`_Passes._loop_passes`), ``None`` where its
+                  run takes none (the branch calling it is pruned)
+
+``CONSTANTS`` lists the constants each function's variants take, and :func:`_compile` refuses a
+variant that would leave a global it reads unreplaced: the modules define these names only as
+``None`` placeholders. Each variant is named by its constants and a digest of the package's sources
+(:data:`SOURCES`), which keeps numba's on-disk caches apart: numba checks only the stamp of the
+variant's own file, not of the files whose helpers it inlines.
+"""
+
+import hashlib
+import inspect
+import types
+from pathlib import Path
+
+from numba import njit
+
+from mpm_fem.exact_stages.grid_kernels import locate
+from mpm_fem.fused.basis import _recomputed_row, _stored_row
+from mpm_fem.fused.codes import BURGERS, DOMAIN_BASES, DOMAIN_OF, GAS, MOMENTUM, MUSL, PRESSURE, USF, VISCOUS_STRESS
+from mpm_fem.fused.loop import _advance
+from mpm_fem.fused.passes import _finish, _move, _move_exact, _scatter_pass, _update, _update_exact
+from mpm_fem.fused.project import _project
+from mpm_fem.fused.remedies import _taylor_force, _volume_reset
+
+LOOP_PASSES = ("PROJECT", "MOVE", "UPDATE", "FINISH", "VISCOUS", "GAS_FORCE", "XPIC", "VOLUME", "TAYLOR")
+REPLACED = frozenset(("BASIS", "MODEL", "WIDTH", "WEIGHT", "ROW", "DOMAIN", "SCHEME", "XPIC_ON", "VOLUME_ON",
+                      "TAYLOR_ON") + LOOP_PASSES)
+_SHAPE = ("BASIS", "WIDTH")
+_MODEL = ("BASIS", "MODEL", "WIDTH")
+CONSTANTS = {  # the constants of each function's variants (the keywords of _Passes.get)
+    _project: _SHAPE,
+    _scatter_pass: _SHAPE + ("WEIGHT",),
+    _update: _MODEL,
+    _move: _MODEL,
+    _finish: _MODEL,
+    _taylor_force: _MODEL,
+    _volume_reset: ("BASIS", "MODEL"),
+    _move_exact: _SHAPE,
+    _update_exact: ("MODEL",),
+    _advance: _MODEL + ("SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON"),
+}
+# the files whose code a variant compiles (inlined helpers included): this package and the located cell
+SOURCES = sorted(Path(__file__).parent.glob("*.py")) + [Path(inspect.getsourcefile(locate.py_func))]
+DIGEST = hashlib.sha1(b"".join(path.read_bytes() for path in SOURCES)).hexdigest()[:8]
+
+
+def _basis_globals(constants):
+    """``ROW`` and ``DOMAIN`` of a variant with ``BASIS`` (none without)."""
+    if "BASIS" not in constants:
+        return {}
+    basis = constants["BASIS"]
+    return dict(ROW=_stored_row if basis in DOMAIN_BASES else _recomputed_row, DOMAIN=DOMAIN_OF[basis])
+
+
+def _compile(fn, parallel, passes=None, **constants):
+    """``fn`` compiled serial or parallel with ``constants``, the globals derived from them
+    (:func:`_basis_globals`) and ``passes`` (the loop's) as compile-time globals. Raises
+    ``ValueError`` if ``fn`` reads a replaceable global its variant does not replace."""
+    replaced = dict(constants, **_basis_globals(constants), **(passes or {}))
+    unset = REPLACED.intersection(fn.__code__.co_names).difference(replaced)
+    if unset:
+        raise ValueError(f"{fn.__name__} reads {', '.join(sorted(unset))}, which its variant does not replace")
+    suffix = "".join(f"_{k.lower()}{v}" for k, v in constants.items()) + ("_parallel" if parallel else "")
+    variant = types.FunctionType(fn.__code__, dict(fn.__globals__, **replaced), f"{fn.__name__}{suffix}_{DIGEST}",
+                                 fn.__defaults__)
+    variant.__qualname__ = variant.__name__
+    return njit(cache=True, parallel=parallel)(variant)
+
+
+class _Passes:
+    """The compiled variants of one kind of thread use (serial or parallel passes), made on first
+    use and kept: ``get(fn, **constants)`` with the constants ``CONSTANTS[fn]`` names."""
+
+    def __init__(self, parallel: bool):
+        self.parallel = parallel
+        self._made = {}
+
+    def get(self, fn, **constants):
+        key = (fn.__name__, tuple(sorted(constants.items())))
+        if key not in self._made:
+            if set(constants) != set(CONSTANTS[fn]):
+                raise ValueError(f"{fn.__name__}'s variants take {', '.join(CONSTANTS[fn])}, "
+                                 f"not {', '.join(constants)}")
+            passes = None
+            if fn is _advance:  # the loop calls this variant's passes, compiled into it; the loop itself is
+                passes = self._loop_passes(**constants)  # serial, its passes parallel or not
+                constants = dict(constants, THREADED=int(self.parallel))  # a name per variant
+            self._made[key] = _compile(fn, False if fn is _advance else self.parallel, passes, **constants)
+        return self._made[key]
+
+    def _loop_passes(self, BASIS, MODEL, WIDTH, SCHEME, XPIC_ON, VOLUME_ON, TAYLOR_ON):
+        """The passes the loop variant with these constants calls: pass 1 and 2 always, USF's update,
+        MUSL's last pass, Burgers' viscous force and each remedy's passes only where they run, so a
+        plain run compiles none of the remedies."""
+        shape = dict(BASIS=BASIS, WIDTH=WIDTH)
+        model = dict(shape, MODEL=MODEL)
+        scatter = lambda weight: self.get(_scatter_pass, **shape, WEIGHT=weight)  # noqa: E731
+        return dict(PROJECT=self.get(_project, **shape), MOVE=self.get(_move, **model),
+                    UPDATE=self.get(_update, **model) if SCHEME == USF else None,
+                    FINISH=self.get(_finish, **model) if SCHEME == MUSL else None,
+                    VISCOUS=scatter(VISCOUS_STRESS) if MODEL == BURGERS else None,
+                    GAS_FORCE=scatter(PRESSURE) if VOLUME_ON and MODEL == GAS else None,
+                    VOLUME=self.get(_volume_reset, BASIS=BASIS, MODEL=MODEL) if VOLUME_ON else None,
+                    XPIC=scatter(MOMENTUM) if XPIC_ON else None,
+                    TAYLOR=self.get(_taylor_force, **model) if TAYLOR_ON else None)
+
+
+PASSES = {parallel: _Passes(parallel) for parallel in (False, True)}  # the variants, by whether they thread

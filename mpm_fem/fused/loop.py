@@ -1,0 +1,326 @@
+"""The compiled loop (:func:`_advance`): many steps of the fused step in one call.
+
+Between walls or Dirichlet ends with the lumped mass, a run takes its steps here: per step the time
+step of :func:`mpm_fem.core.solve.run`, pass 1, the grid stage (``v_i = P_i / m_i``, ``a_i = F_i /
+m_i``, the end conditions), the remedies' passes and pass 2, in the order and with the operations
+of the per-step path :meth:`mpm_fem.fused.step.FusedStep.step`, so the same numbers bit for bit.
+The Dirichlet data and an exact acceleration come from the problem's own Python objects, called in
+object mode once per step (the same floats). The loop's arguments travel in a few named structures
+(:class:`Geometry`, :class:`Conditions`, :class:`Clock`, :class:`Scratch`, :class:`Remedies`). The
+scheme, the remedies that run and the passes it calls are compile-time globals of each variant
+(:mod:`mpm_fem.fused.compiler`): the branches not taken are pruned and their passes never compile.
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, objmode
+
+from mpm_fem.fused.codes import (
+    BSPLINE_GIMP,
+    GA,
+    GAS,
+    GF,
+    GIMP,
+    GM,
+    GP,
+    GPMUSL,
+    GPX,
+    GTARGET,
+    GTERM,
+    GV,
+    GVN,
+    GVSTAR,
+    IE,
+    IEPS,
+    IM,
+    IP,
+    IRHO,
+    IV,
+    IVOL,
+    IX,
+    MUSL,
+    USF,
+    USL,
+)
+from mpm_fem.fused.sums import _divide_by_lumped
+
+# placeholders: each variant has its own (mpm_fem.fused.compiler)
+BASIS = MODEL = WIDTH = SCHEME = XPIC_ON = VOLUME_ON = TAYLOR_ON = None
+PROJECT = MOVE = UPDATE = FINISH = VISCOUS = GAS_FORCE = XPIC = VOLUME = TAYLOR = None
+
+class Geometry(NamedTuple):
+    """The grid as every pass reads it."""
+
+    nodes: np.ndarray  # x_i
+    h: np.ndarray  # rows: the cell sizes h_c and 1 / h_c
+    inv_spacing: float  # 1/h on a grid uniform to round-off, else 0 (the node arithmetic)
+
+
+class Conditions(NamedTuple):
+    """The problem's conditions at the ends and on the particles."""
+
+    ends: np.ndarray  # the end nodes: walls (zero velocity and acceleration) or Dirichlet ends
+    dirichlet: bool  # the ends take the boundary's data g(t)
+    window: np.ndarray  # the reservoir's (a, b, spacing); empty: no particle boundary
+    exact: bool  # the problem's exact nodal acceleration in place of F_i / m_i, and no viscous force
+
+
+class Clock(NamedTuple):
+    """The run's time control (:func:`mpm_fem.core.solve.run`'s time step)."""
+
+    t: float
+    T: float  # the final time
+    speed: float  # the previous step's max_p (c_p + |v_p|) (gas) or max_p |v_p| (Burgers)
+    fixed_dt: float  # > 0: the problem's own time step
+    cfl: float
+    h_min: float  # the smallest cell
+    refine: float  # the time step is dt / refine
+    viscous_limit: bool  # Burgers' bound dt <= cfl h^2 / (2 eps)
+    steps: int  # the steps the run has taken
+    max_steps: int
+    budget: int  # the steps this call may take
+
+
+class Scratch(NamedTuple):
+    """The arrays the loop writes (the per-chunk ones have a row per chunk)."""
+
+    cell: np.ndarray  # the particles' cells
+    rows: np.ndarray  # the stored rows (the particle-domain bases'): node indices, S_ip, G_ip
+    S: np.ndarray
+    G: np.ndarray
+    grid: np.ndarray  # nodal rows codes.GM .. GPMUSL, then XPIC's GPX .. GTARGET, the volume reset's V_i, ratio
+    flags: np.ndarray  # pass 1's and pass 2's first bad particles, per chunk
+    upd: np.ndarray  # USF's update's and the volume reset's
+    values: np.ndarray  # the values at those particles
+    speeds: np.ndarray  # pass 2's max speed per chunk
+    reset: np.ndarray  # reset[0] = (V, rho, p): the volume reset's state
+    sums: np.ndarray  # the Taylor fit's five sums per cell
+
+
+class Remedies(NamedTuple):
+    """The remedies' data (an off remedy: 0 or empty arrays)."""
+
+    xpic: int  # XPIC's order m (0: off)
+    volume_width: int  # the width of the volume reset's domain rows (0: off)
+    integrals: np.ndarray  # int S_i, the volume reset's
+    points: np.ndarray  # the Taylor force's quadrature: the points' nodes,
+    G_q: np.ndarray  # S_i' there,
+    weights: np.ndarray  # their weights
+    offsets: np.ndarray  # and xi_g - 1/2
+
+
+@njit(cache=True, inline="always")
+def _pymin(a, b):
+    """Python's ``min(a, b)``: ``b`` only if ``b < a`` (NaN and ties as in :func:`mpm_fem.core.solve.run`)."""
+    return b if b < a else a
+
+
+@njit(cache=True, inline="always")
+def _lumped_walls(rhs, m_i, ends, out):
+    """``out = rhs / m_i`` where ``m_i > 0``, else 0 (:func:`~mpm_fem.core.transfer.divide_by_lumped`),
+    then 0 at the wall nodes ``ends`` (:class:`~mpm_fem.core.step.Walls`)."""
+    _divide_by_lumped(rhs, m_i, out)
+    for i in ends:
+        out[i] = 0.0
+
+
+_LOOP_CALLS = []  # (boundary, grid, exact acceleration) of the running loop, for its object-mode calls
+
+
+def _end_values(t):
+    """The Dirichlet data ``g(x_b, t)`` at the end nodes, from the running loop's boundary object
+    (:meth:`~mpm_fem.core.step.Dirichlet.end_values`: the same call, the same floats, the same cache as
+    the per-step path). Called from the compiled loop in object mode, once per step."""
+    boundary, grid, _ = _LOOP_CALLS[-1]
+    return np.ascontiguousarray(boundary.end_values(grid, t), dtype=float)
+
+
+def _exact_acceleration(t):
+    """The problem's exact nodal acceleration ``a*(x_i, t)``, the call the per-step path makes
+    (the same floats); from the compiled loop in object mode, once per step."""
+    _, grid, exact_acceleration = _LOOP_CALLS[-1]
+    return np.ascontiguousarray(exact_acceleration(grid.nodes, t), dtype=float)
+
+
+@njit(cache=True, inline="always")
+def _set_ends(ends, values, out):
+    """``out[ends] = values`` (:meth:`~mpm_fem.core.step.Dirichlet.velocity`)."""
+    for k in range(ends.size):
+        out[ends[k]] = values[k]
+
+
+@njit(cache=True)
+def _reservoir_quiet(x, window):
+    """Whether the reservoir with ``window = (a, b, spacing)`` leaves the particles at ``x`` as they
+    are (:meth:`mpm_fem.problems.burgers.Reservoir.quiet`): every ``x_p`` in [a, b], and
+    ``floor((min x - a) / spacing) <= 0``, ``floor((b - max x) / spacing) <= 0`` (no gap to fill)."""
+    a, b, s = window[0], window[1], window[2]
+    if x.size == 0:
+        return False
+    lo, hi = x[0], x[0]
+    for q in range(x.size):
+        if not (x[q] >= a and x[q] <= b):
+            return False
+        lo = min(lo, x[q])
+        hi = max(hi, x[q])
+    return not (np.floor((lo - a) / s) > 0) and not (np.floor((b - hi) / s) > 0)
+
+
+@njit(cache=True, inline="always")
+def _nodal_rows(xpic_on, volume_on):
+    """The loop's nodal scratch arrays: ``m_i``, ``P_i``, ``F_i``, ``v_i``, ``a_i``, ``v_i^{n+1}``,
+    MUSL's ``P_i``; XPIC's ``P``, term, ``v*`` and target if it runs; the volume reset's ``V_i`` and
+    ratio if it runs (a plain run allocates 7; the reset's first is ``_nodal_rows(XPIC_ON, 0)``)."""
+    return 7 + 4 * xpic_on + 2 * volume_on
+
+
+def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, remedies):
+    """Up to ``clock.budget`` steps of :meth:`~mpm_fem.fused.step.FusedStep.step` with the lumped mass, each
+    with the time step :func:`mpm_fem.core.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL`` from the
+    previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between ``state[cur]``
+    and ``state[1 - cur]`` (columns ``IX .. IP``: x, v, V, m, rho, eps, p; ``consts[IGM1 .. IXPIC]``
+    the model's constants, ``chunks`` the particle ranges of the threads). Stops before a step that
+    would fail or leave this path (the time step not positive and finite, ``max_steps``, a particle
+    outside the grid, a GIMP row of another width, lost positivity, a non-finite state): the caller
+    takes that step with :meth:`~mpm_fem.fused.step.FusedStep.step`, which raises as the numpy step does.
+    With ``dirichlet`` the ends take :class:`~mpm_fem.core.step.Dirichlet`'s data instead of the walls'
+    zeros (as its ``velocity`` and ``acceleration``: ``v_b = g(t)``, ``a_b = (g(t + dt) - v_b) / dt``,
+    MUSL's re-projection ``g(t + dt)``), ``g`` evaluated in object mode once per step
+    (:func:`_end_values`). A non-empty ``window`` stops the loop after the first step whose particles
+    the reservoir would change (:func:`_reservoir_quiet`): the caller applies it. With ``exact`` the
+    nodal acceleration is the problem's exact one (:func:`_exact_acceleration`, in object mode).
+    The remedies: ``xpic = m > 0``, XPIC(m) as :meth:`~mpm_fem.fused.step.FusedStep._xpic_target` with the lumped mass
+    (``m - 1`` scatter passes, each divided by ``m_i``, the change zero at the end nodes);
+    ``volume_width > 0``, the grid volume reset (domain rows that wide, the reset state in
+    ``reset[0]``) and then the force of the reset state; the Taylor reconstruction, its force in place
+    of the particles' force. ``SCHEME``, ``XPIC_ON``, ``VOLUME_ON`` and ``TAYLOR_ON`` are compile-time
+    constants of the variant; the passes it calls (``PROJECT``, ``MOVE``, ...) are its globals too.
+    Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
+    nodes, h, inv_spacing = geometry
+    ends, dirichlet, window, exact = conditions
+    t, T, speed, fixed_dt, cfl, h_min, refine, viscous_limit, steps, max_steps, budget = clock
+    cell, rows, S, G, grid, flags, upd, values, speeds, reset, sums = scratch
+    xpic, volume_width, integrals, points, G_q, weights, offsets = remedies
+    n = cell.size
+    gas = MODEL == GAS
+    eps = consts[IEPS]
+    store = BASIS == GIMP or BASIS == BSPLINE_GIMP
+    m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[GM], grid[GP], grid[GF], grid[GV], grid[GA], grid[GVN], grid[GPMUSL]
+    done, dt_min, dt_max = 0, np.inf, -np.inf
+    g_t, g_next, known = np.empty(0), np.empty(0), False  # Dirichlet data at t and t + dt
+    while done < budget and t < T * (1 - 1e-12):
+        if fixed_dt > 0:
+            base = fixed_dt
+        elif gas:
+            if not speed > 0:
+                break
+            base = cfl * h_min / speed
+        else:
+            advective = h_min / speed if speed > 0 else np.inf
+            base = cfl * _pymin(advective, h_min * h_min / (2.0 * eps)) if viscous_limit else cfl * advective
+        dt = _pymin(base / refine, T - t)
+        if not (dt > 0 and np.isfinite(dt)) or steps + done >= max_steps:
+            break
+        x, v, V, m, rho, e, p = state[cur, IX, :n], state[cur, IV, :n], state[cur, IVOL, :n], state[cur, IM, :n], \
+            state[cur, IRHO, :n], state[cur, IE, :n], state[cur, IP, :n]
+        o = 1 - cur  # the other set: the new state
+        x_n, v_new, V_n, m_n, rho_n, e_n, p_n = state[o, IX, :n], state[o, IV, :n], state[o, IVOL, :n], \
+            state[o, IM, :n], state[o, IRHO, :n], state[o, IE, :n], state[o, IP, :n]
+        PROJECT(nodes, h, inv_spacing, x, V, m, v, p, gas and SCHEME != USF and not VOLUME_ON and not TAYLOR_ON,
+                store, chunks, rows, S, G, cell, m_i, P_i, F_i, flags)
+        need = 2
+        for k in range(chunks):
+            need = max(need, flags[k, 2])
+        if (flags[:, :2] >= 0).any() or (store and need != WIDTH and n > 0):
+            break
+        _lumped_walls(P_i, m_i, ends, v_i)
+        if dirichlet:
+            if not known:
+                with objmode(g_t="float64[::1]"):
+                    g_t = _end_values(t)
+                known = True
+            t_next = t + dt
+            with objmode(g_next="float64[::1]"):
+                g_next = _end_values(t_next)
+            _set_ends(ends, g_t, v_i)
+        if VOLUME_ON:  # the volume reset, then the force of the reset state
+            V_i = _nodal_rows(XPIC_ON, 0)  # its V_i and ratio follow XPIC's arrays
+            VOLUME(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks,
+                   WIDTH if store else volume_width, grid[V_i], grid[V_i + 1], reset[0, 0, :n], reset[0, 1, :n],
+                   reset[0, 2, :n], upd, values)
+            wide = 0
+            for k in range(chunks):
+                wide = max(wide, upd[k, 1])
+            if (upd[:, 0] >= 0).any() or (not store and wide > volume_width):
+                break
+            V = reset[0, 0, :n]
+            if gas:
+                rho, p = reset[0, 1, :n], reset[0, 2, :n]
+                if SCHEME != USF and not exact and not TAYLOR_ON:
+                    GAS_FORCE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, p, 0.0, chunks, F_i)
+        if SCHEME == USF:  # the state first, then its force
+            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts,
+                   not exact and not TAYLOR_ON, chunks, V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
+            if (upd >= 0).any():
+                break
+        elif not gas and not exact and not TAYLOR_ON:
+            VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, V, eps, chunks, F_i)
+        if TAYLOR_ON and not exact:
+            TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if SCHEME == USF else p, v_i, eps, points, G_q,
+                   weights, offsets, chunks, sums, F_i)
+        if exact:
+            with objmode(a_exact="float64[::1]"):
+                a_exact = _exact_acceleration(t)
+            a_i[:] = a_exact
+            for i in ends:
+                a_i[i] = 0.0
+        else:
+            _lumped_walls(F_i, m_i, ends, a_i)
+        if dirichlet:
+            for k in range(ends.size):
+                a_i[ends[k]] = (g_next[k] - v_i[ends[k]]) / dt
+        for i in range(v_n.size):
+            v_n[i] = v_i[i] + dt * a_i[i]
+        target = a_i
+        if XPIC_ON:  # XPIC(m): v* = sum_k [P (I - B)]^k v_i, and pass 2 interpolates v* + dt a_i
+            P_x, term, v_star, target = grid[GPX], grid[GTERM], grid[GVSTAR], grid[GTARGET]
+            term[:] = v_i
+            v_star[:] = v_i
+            for _ in range(xpic - 1):
+                XPIC(nodes, h, inv_spacing, x, rows, S, G, cell, term, m, m, 0.0, chunks, P_x)
+                _divide_by_lumped(P_x, m_i, P_x)
+                for i in range(term.size):
+                    term[i] = term[i] - P_x[i]
+                for i in ends:
+                    term[i] = 0.0
+                for i in range(term.size):
+                    v_star[i] += term[i]
+            for i in range(target.size):
+                target[i] = v_star[i] + dt * a_i[i]
+        usl, musl = SCHEME == USL, SCHEME == MUSL  # run-time flags: the per-step path's compiled MOVE
+        if SCHEME == USL:
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl,
+                 chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
+        elif SCHEME == USF:
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V_n, m, v, rho_n, e_n, p_n, dt, consts, usl,
+                 musl, chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
+        else:  # MUSL: move, re-project the momentum, then the state
+            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl,
+                 chunks, x_n, v_new, V, m, rho, e, p, P_musl, flags, values, speeds)
+            _lumped_walls(P_musl, m_i, ends, v_n)
+            if dirichlet:
+                _set_ends(ends, g_next, v_n)
+            FINISH(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v_new, rho, e, p, dt, consts, chunks,
+                   V_n, m_n, rho_n, e_n, p_n, x_n, flags, values, speeds)
+        if (flags >= 0).any():
+            break
+        speed = speeds.max()
+        cur = 1 - cur
+        t += dt
+        done += 1
+        dt_min, dt_max = min(dt_min, dt), max(dt_max, dt)
+        g_t = g_next
+        if window.size and not _reservoir_quiet(state[cur, IX, :n], window):
+            break  # the particle boundary acts on these particles: the caller's
+    return cur, t, done, speed, dt_min, dt_max

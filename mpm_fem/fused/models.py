@@ -1,0 +1,101 @@
+"""The models' update of one particle, and the checks a pass tallies.
+
+From the velocity gradient ``L_p = sum_i G_ip v_i``: the ideal gas (:meth:`IdealGas.update`:
+``rho <- rho (1 - L dt)``, ``eps <- eps - p/rho L dt``, ``p = (gamma - 1) rho eps + q``, ``V = m/rho``,
+the sound speed) or viscous Burgers (``V <- V (1 + L dt)``, ``m = V``), the numpy model's
+operations in its order. A pass's checks (the first particle whose factor or energy is not
+positive, the first non-finite one, the largest signal speed) travel as a tally of seven floats
+through the particle loop, so that they stay in registers and numba's parallel analysis accepts them.
+Inlined into the passes, except :func:`all_finite`, the run's own check.
+"""
+
+import numpy as np
+from numba import njit
+
+from mpm_fem.fused.codes import IGGM1, IGM1, ILIN, IQUAD
+
+
+@njit(cache=True, inline="always")
+def _gas_update(rho, e, p, m, L, dt, l, gm1, g_gm1, c_lin, c_quad):
+    """:meth:`IdealGas.update` of one particle: factor, rho, eps, p, V and the sound speed."""
+    factor = 1.0 - L * dt
+    density = rho * factor
+    energy = e - p / rho * L * dt
+    c = np.sqrt(g_gm1 * max(energy, 0.0))
+    jump = l * min(L, 0.0)
+    q = density * (c_quad * (jump * jump) + c_lin * c * abs(jump))
+    return factor, density, energy, gm1 * density * energy + q, m / density, c
+
+
+@njit(cache=True, inline="always")
+def _finite(a, b, c, d, e, f):
+    """Whether all six are finite: ``0 a + ... + 0 f`` is 0 exactly then, NaN otherwise (no branch)."""
+    return a * 0.0 + b * 0.0 + c * 0.0 + d * 0.0 + e * 0.0 + f * 0.0 == 0.0
+
+
+@njit(cache=True)
+def all_finite(x, v, rho, e, p, V):
+    """Whether every entry of the six particle arrays is finite (one pass; the run's check)."""
+    ok = True
+    for q in range(x.size):  # no branch per particle: the loop vectorizes
+        ok &= (np.isfinite(x[q]) & np.isfinite(v[q]) & np.isfinite(rho[q]) & np.isfinite(e[q]) & np.isfinite(p[q])
+               & np.isfinite(V[q]))
+    return ok
+
+
+@njit(cache=True, inline="always")
+def _first(bad, value_at_bad, q, value):
+    """The first particle whose ``value`` is not > 0, and that value: ``(q, value)`` if none yet."""
+    if bad < 0 and not (value > 0):
+        return float(q), value
+    return bad, value_at_bad
+
+
+@njit(cache=True, inline="always")
+def _new_state(gas, q, L, dt, l, V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, tally):
+    """The model's update of particle q from ``L_p`` (gas: :meth:`IdealGas.update`; Burgers:
+    ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``). ``tally = (first particle with a factor <= 0, first
+    with an energy <= 0 (gas), first non-finite, their two values, max speed, this particle's sound
+    speed)`` is returned updated. Seven floats (indices < 2^53 are exact), not arrays: the tally
+    stays in registers, and numba's parallel analysis takes it (it mistakes integer tuples for shapes)."""
+    bad_f, bad_e, bad_n, val_f, val_e, top, _ = tally
+    if gas:
+        factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
+            rho[q], e[q], p[q], m[q], L, dt, l, consts[IGM1], consts[IGGM1], consts[ILIN], consts[IQUAD])
+        bad_e, val_e = _first(bad_e, val_e, q, e_new[q])
+    else:
+        factor, c = 1.0 + L * dt, 0.0
+        V_new[q] = V[q] * factor
+        m_new[q] = V_new[q]
+    bad_f, val_f = _first(bad_f, val_f, q, factor)
+    return bad_f, bad_e, bad_n, val_f, val_e, top, c
+
+
+@njit(cache=True, inline="always")
+def _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, tally):
+    """The tally with ``max(top, c_p + |v_p|)`` (gas) or ``max(top, |v_p|)``, and the first
+    non-finite particle."""
+    bad_f, bad_e, bad_n, val_f, val_e, top, _ = tally
+    if gas:
+        top = max(top, c + abs(v_new[q]))
+        ok = _finite(x_new[q], v_new[q], rho_new[q], e_new[q], p_new[q], V_new[q])
+    else:
+        top = max(top, abs(v_new[q]))
+        ok = _finite(x_new[q], v_new[q], V_new[q], 0.0, 0.0, 0.0)
+    if bad_n < 0 and not ok:
+        bad_n = float(q)
+    return bad_f, bad_e, bad_n, val_f, val_e, top, c
+
+
+@njit(cache=True, inline="always")
+def _flags(k, tally, flags, values):
+    """Chunk k's tally into the pass's outputs: ``flags[k]`` (the first bad particles: factor,
+    energy and, if it has three columns, non-finite), ``values[k]`` (the two values); returns the speed."""
+    flags[k, 0], flags[k, 1] = int(tally[0]), int(tally[1])
+    if flags.shape[1] > 2:
+        flags[k, 2] = int(tally[2])
+    values[k, 0], values[k, 1] = tally[3], tally[4]
+    return tally[5]
+
+
+_NO_TALLY = (-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0)  # no bad particle yet, speed 0
