@@ -173,6 +173,15 @@ def test_the_table_has_the_declared_columns():
     assert study[0]["h"] == 0.01 and study[1]["order_particles_L1"] == pytest.approx(
         np.log(study[0]["particles_L1"] / study[1]["particles_L1"]) / np.log(2.0))
     assert all(r["particles_vs_study"] == pytest.approx(1.0) for r in study)
+    assert [r for r in rows if not r["ok"]][0]["error"] == "positivity lost"
+
+
+def test_the_figure_and_its_caption(tmp_path):
+    got = {(h, n): {"ok": True, "particles_L1": 1e-3 * (1 + k), "nodes_L1": 1e-3, "volume_drift": -1e-4, "steps": 1}
+           for h in (0.01, 0.005) for k, n in enumerate(drift.VARIANTS)}
+    drift.figure(tmp_path, drift.table(got))
+    assert (tmp_path / "drift.png").stat().st_size > 0
+    assert drift.CAPTION in (tmp_path / "figures.json").read_text()
 
 
 # ----------------------------------------------------------------------------- the mechanism's sentence
