@@ -30,6 +30,10 @@ def _header(path: Path) -> list[str]:
 
 @pytest.mark.parametrize("table", schema.TABLES.values(), ids=lambda t: t.name)
 def test_every_committed_table_has_exactly_the_declared_columns(table):
+    """A study not yet in the record (no ``figures/<study>/`` at all: a new study, until the record
+    is regenerated) is skipped; a table missing from a study that is in the record fails."""
+    if not (FIGURES / table.study).is_dir():
+        pytest.skip(f"the study {table.study} is not in figures/ yet")
     path = FIGURES / f"{table.name}.csv"
     assert path.exists(), f"{table.name} is declared but not in figures/"
     assert table.mismatch(_header(path)) == ([], []), table.name

@@ -182,7 +182,7 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
 
 #: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
 #: layer and import it, never the other way round).
-STUDIES = ("projection", "sod", "burgers", "budget", "time", "remedies")
+STUDIES = ("projection", "sod", "burgers", "budget", "time", "remedies", "drift")
 
 
 def run_study(name: str, options: StudyOptions) -> str:

@@ -22,7 +22,7 @@ from tqdm.auto import tqdm
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles, PositivityError
 from mpm_fem.core.shape import basis_integrals, make_shape
-from mpm_fem.core.step import Boundary, GridState, Model, Stages, explicit_step
+from mpm_fem.core.step import Boundary, GridState, Model, Stages, explicit_step, numpy_only
 from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_mass, nodal_momentum
 from mpm_fem.exact_stages import ExactFields
 from mpm_fem.fused import FusedStep, all_finite, check_kernel, supported
@@ -136,14 +136,15 @@ def run(
     """Integrate to ``problem.T``. ``progress=None`` shows a bar on a terminal for runs over 2 s.
 
     ``kernel="fused"`` steps with the compiled :class:`~mpm_fem.fused.step.FusedStep` (on ``threads``
-    threads) wherever it supports the model and stages, the numpy :func:`explicit_step` otherwise;
+    threads) wherever it supports the model and stages (and they use no option of
+    :func:`~mpm_fem.core.step.numpy_only`), the numpy :func:`explicit_step` otherwise;
     ``kernel="numpy"`` always steps with :func:`explicit_step`. Both take the same steps (bit for
     bit on one thread). ``observer(step, t, old, new, state)`` is called after every step, which
     then runs one at a time rather than in compiled loops; the particles it is handed stay valid
     only for the call if it says it keeps none (:func:`_keeps_particles`)."""
     check_kernel(kernel, threads)
     fused = None
-    if kernel == "fused" and supported(problem.model, stages) is None:
+    if kernel == "fused" and supported(problem.model, stages) is None and numpy_only(problem.model, stages) is None:
         fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads,
                           reuse=not _keeps_particles(observer), exact=problem.exact)
     # walls or Dirichlet ends, lumped mass, no observer, and no particle boundary or one that says

@@ -29,7 +29,7 @@ from mpm_fem.core.particles import Particles
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force
 from mpm_fem.core.shape import BASES, make_shape
 from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
-from mpm_fem.core.volume import VOLUMES, grid_volume_factor
+from mpm_fem.core.volume import VOLUME_RATES, VOLUMES, domain_rate, grid_volume_factor
 from mpm_fem.core.xpic import boundary_change_rule, check_order, xpic_velocity
 from mpm_fem.exact_stages import ExactFields, ExactGridStage, GridData
 
@@ -70,14 +70,20 @@ class Stages(StageSwitches):
     ``flip`` in [0, 1] (1: FLIP, 0: PIC), ``xpic`` the order ``m >= 1`` of the XPIC update
     (:mod:`mpm_fem.core.xpic`; 0: off, else in place of the blend), ``reconstruct`` ``"none"`` or
     ``"taylor"``, ``volume`` ``"carried"`` or ``"grid"``, and the basis ``"bspline_gimp"``.
+    ``volume_rate``: the rate the model's volume (and density) update takes, ``"point"`` (``L_p``,
+    the slides') or ``"domain"`` (``dv_h/dx`` integrated over the particle domain,
+    :func:`mpm_fem.core.volume.domain_rate`; a model with ``takes_volume_rate``, the MPM stages, and
+    the numpy step only: :func:`numpy_only`). Not a run setting (:class:`StageSwitches`): the drift
+    study sets it.
     """
 
     acceleration: str = "calculated"
+    volume_rate: str = "point"
 
     def __post_init__(self):
         for name, allowed in (("basis", BASES), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
                               ("scheme", SCHEMES), ("projection", PROJECTIONS), ("interpolation", INTERPOLATIONS),
-                              ("reconstruct", RECONSTRUCTIONS), ("volume", VOLUMES)):
+                              ("reconstruct", RECONSTRUCTIONS), ("volume", VOLUMES), ("volume_rate", VOLUME_RATES)):
             value = getattr(self, name)
             if value not in allowed:
                 raise ValueError(f"unknown {name} {value!r}; choose one of {', '.join(allowed)}")
@@ -95,6 +101,8 @@ class Stages(StageSwitches):
                                        or self.volume != "carried"):
             raise ValueError("the remedies flip, xpic, reconstruct and volume run with the MPM stages only "
                              "(the basis bspline_gimp also with the exact stages)")
+        if self.uses_exact_fields and self.volume_rate != "point":
+            raise ValueError("the volume rate over the particle domain runs with the MPM stages only")
 
     @property
     def uses_remedy(self) -> bool:
@@ -123,6 +131,20 @@ class Model(Protocol):
     # the volume remedy also calls ``with_volume(particles, volume) -> Particles``: the state at
     # the same mass (and specific energy) with the volumes ``volume``
 
+
+
+def numpy_only(model: Model, stages: Stages) -> str | None:
+    """Why only the numpy step (:func:`explicit_step`) can take ``model`` and ``stages``, or ``None``:
+    the drift study's options, the volume rate over the particle domain (``stages.volume_rate``) and
+    a density update other than the slides' (``model.density_update``,
+    :mod:`mpm_fem.core.models.euler`), have no compiled form; :func:`mpm_fem.core.solve.run` then
+    steps with the numpy step."""
+    if stages.volume_rate != "point":
+        return f"the volume rate {stages.volume_rate!r} runs in the numpy step only"
+    form = getattr(model, "density_update", "linear")
+    if form != "linear":
+        return f"the density update {form!r} runs in the numpy step only"
+    return None
 
 
 class Boundary(Protocol):
@@ -216,8 +238,9 @@ def explicit_step(
         particles = _reset_volume(model, particles, grid_volume_factor(grid, particles.x, V, stages.basis, shape))
         V = particles.volume
 
+    x_n = particles.x
     if stages.scheme == "usf":
-        particles = model.update(particles, shape.gather_gradient(v_i), dt, h_p)
+        particles = _update(model, grid, particles, shape, x_n, v_i, dt, h_p, stages)
         V = particles.volume
 
     if stages.acceleration == "exact":
@@ -255,8 +278,24 @@ def explicit_step(
             grid, grid_values(shape, m, m_i, nodal_momentum(shape, m, velocity), stages.mass), t + dt
         )
     if stages.scheme in ("usl", "musl"):
-        particles = model.update(particles, shape.gather_gradient(v_new), dt, h_p)
+        particles = _update(model, grid, particles, shape, x_n, v_new, dt, h_p, stages)
     return particles, GridState(m_i, v_i, a_i, v_new)
+
+
+def _update(model: Model, grid: Grid, particles: Particles, shape, x_n: np.ndarray, v: np.ndarray, dt: float,
+            h_p: np.ndarray, stages: Stages) -> Particles:
+    """The model's state update from ``L_p = sum_i G_ip v_i`` (the shape at ``x_n``, the positions
+    at the start of the step); with ``stages.volume_rate == "domain"`` the volume takes the rate
+    over the particle domains at ``x_n`` (:func:`mpm_fem.core.volume.domain_rate`): their ends move
+    with the grid velocity, as the particle points do."""
+    grad_v = shape.gather_gradient(v)
+    if stages.volume_rate == "point":
+        return model.update(particles, grad_v, dt, h_p)
+    if not getattr(model, "takes_volume_rate", False):
+        raise ValueError(f"the volume rate {stages.volume_rate!r} needs a model whose update takes a volume rate; "
+                         f"{type(model).__name__} has none")
+    rate = domain_rate(grid, x_n, particles.volume, v, stages.basis)
+    return model.update(particles, grad_v, dt, h_p, volume_rate=rate)
 
 
 def _reset_volume(model: Model, particles: Particles, factor: np.ndarray) -> Particles:

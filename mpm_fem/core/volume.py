@@ -16,6 +16,17 @@ no discontinuity. (With point weights ``S_i(x_p)`` instead of the domain average
 carry the projection's own quadrature noise and the reset would feed it into the density.) The masses
 are untouched (mass is conserved exactly) and so are the velocities (momentum too); the model sets the
 state at the new volume (gas: ``rho_p = m_p / V_p`` at the same specific energy, so the total energy is conserved too).
+
+The volume rate over the particle domain (:func:`domain_rate`, the step's ``volume_rate="domain"``):
+instead of the point quadrature ``V_p^{n+1} = V_p^n (1 + dt L_p)``, ``L_p = sum_i G_ip v_i``, the
+volume takes the exact integral of the grid velocity's derivative over the particle domain,
+
+    V_p^{n+1} = V_p^n + dt int_{chi_p} dv_h/dx dx = V_p^n + dt (v_h(x_p + V_p/2) - v_h(x_p - V_p/2)),
+
+``v_h = sum_i v_i S_i`` with the grid functions of the step's basis: the domain's ends move with the
+grid velocity there, so domains that tile the grid keep tiling it to first order in ``dt`` (the sum
+over the domains telescopes to the velocities at the grid's ends). A domain end past the end of the
+grid is cut there (``v_h`` taken constant beyond, the end node's velocity).
 """
 
 from __future__ import annotations
@@ -27,6 +38,8 @@ from mpm_fem.core.shape import Shape, basis_integrals, grid_functions, make_shap
 from mpm_fem.core.transfer import divide_by_lumped
 
 VOLUMES = ("carried", "grid")
+#: The quadrature of the volume rate: at the particle point (``L_p``, the slides') or over its domain.
+VOLUME_RATES = ("point", "domain")
 DOMAIN_BASIS = {"mpm": "gimp", "bspline": "bspline_gimp"}  # grid functions -> their domain averages
 
 
@@ -39,3 +52,17 @@ def grid_volume_factor(grid: Grid, x: np.ndarray, volume: np.ndarray, basis: str
     if shape is None or basis != DOMAIN_BASIS[functions]:
         shape = make_shape(grid, x, volume, DOMAIN_BASIS[functions])
     return shape.gather(divide_by_lumped(basis_integrals(grid, functions), shape.scatter(volume)))
+
+
+def domain_rate(grid: Grid, x: np.ndarray, volume: np.ndarray, v: np.ndarray, basis: str = "mpm") -> np.ndarray:
+    """``D_p = (v_h(x_p + V_p/2) - v_h(x_p - V_p/2)) / V_p`` (n_p,): the grid velocity's derivative
+    integrated exactly over the particle domain, per unit volume (module docstring), for the nodal
+    velocities ``v`` (n_nodes,) and the grid functions of ``basis``. ``V_p (1 + dt D_p)`` is then
+    ``V_p + dt int_{chi_p} dv_h/dx dx``."""
+    half = 0.5 * volume
+    if grid_functions(basis) == "mpm":  # the hats: v_h is the piecewise linear interpolant, constant beyond the ends
+        return (np.interp(x + half, grid.nodes, v) - np.interp(x - half, grid.nodes, v)) / volume
+    a, b = grid.nodes[0], grid.nodes[-1]
+    ends = np.concatenate((np.clip(x + half, a, b), np.clip(x - half, a, b)))
+    at = make_shape(grid, ends, basis=grid_functions(basis)).gather(v)
+    return (at[: x.size] - at[x.size:]) / volume

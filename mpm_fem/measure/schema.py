@@ -145,6 +145,13 @@ REMEDIES_ERRORS = Table("remedies/errors", (
     "ratio_fv_nodes_L1", "ratio_fv_particles_L1", "steps", "n_p", "volume_drift", "error", "order_nodes_L1",
     "order_particles_L1"))
 
+# ----------------------------------------------------------------------------- drift (C11's mechanism)
+
+#: One row per variant and mesh; ``error`` only when a run failed (its row then has no errors).
+DRIFT = Table("drift/drift", (
+    "h", "variant", "change", "kernel", "ok", "particles_L1", "nodes_L1", "volume_drift", "abs_volume_drift",
+    "particles_vs_study", "order_particles_L1", "order_nodes_L1", "steps"), optional=("error",))
+
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
 VERSIONS = Table("versions", ("table", "code", "quick"))
@@ -157,7 +164,8 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     BURGERS_ORDERS, BURGERS_PPC, BURGERS_LUMPING,
     TIME_ORDER, TIME_LOCAL_ERROR, TIME_CROSSING_SUMMARY,
     BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,
-    REMEDIES_ERRORS)}
+    REMEDIES_ERRORS,
+    DRIFT)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}
 
