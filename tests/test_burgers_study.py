@@ -289,12 +289,17 @@ def test_every_json_records_the_settings_used(written):
     assert json.loads((written / "ppc.json").read_text())["settings"]["eps"] == study.EPS[0]
 
 
-def test_no_figure_is_wider_than_two_and_a_half_times_its_height(written):
-    pngs = sorted(written.glob("*.png"))
-    assert {"convergence.png", "seeds.png", "solutions.png"} <= {p.name for p in pngs}
-    for path in pngs:
-        height, width = matplotlib.image.imread(path).shape[:2]
-        assert width <= 2.5 * height, f"{path.name}: {width} x {height}"
+def _aspects(folder) -> dict:
+    return {p.name: matplotlib.image.imread(p).shape[1] / matplotlib.image.imread(p).shape[0]
+            for p in sorted(folder.glob("*.png"))}
+
+
+def test_no_figure_is_wider_than_two_and_a_half_times_its_height(written, tmp_path):
+    """Full tier (five eps: a grid) and quick tier (two eps: one row of two)."""
+    study.run(_FakeRuns(out=tmp_path, quick=True))
+    for aspects in (_aspects(written), _aspects(tmp_path / study.NAME)):
+        assert {"convergence.png", "seeds.png", "solutions.png"} <= set(aspects)
+        assert all(a <= 2.5 for a in aspects.values()), aspects
 
 
 def test_the_errors_table_carries_the_range_the_figure_draws():

@@ -54,12 +54,13 @@ def slope_guides(ax, h, e0: float, slopes=(1, 2)) -> None:
 def panels(path, content: dict, xlabel: str, ylabel: str, title: str = "", ncols: int | None = None,
            slopes=(), size=(4.2, 3.8), log: bool = True, legends: bool = False) -> None:
     """One panel per entry of ``content = {panel title: {label: (x, y, fmt, options)}}`` (``options``
-    optional: matplotlib keywords), log-log unless ``log`` is false, with slope guides through the
+    optional: matplotlib keywords), in ``ncols`` columns (one row when not given; never more columns
+    than panels), log-log unless ``log`` is false, with slope guides through the
     largest value of each panel and the legend in the first one. The source's points are a series
     like any other, drawn black and open (fmt ``"ks"``/``"ko"``/``"k*"``, ``mfc="none"``). With
     ``legends`` every panel gets its own legend (panels that show different series)."""
     names = list(content)
-    ncols = ncols or len(names)
+    ncols = min(ncols or len(names), max(len(names), 1))
     nrows = -(-len(names) // ncols)
     fig, axes = plt.subplots(nrows, ncols, figsize=(size[0] * ncols, size[1] * nrows), squeeze=False)
     for ax, name in zip(axes.ravel(), names, strict=False):
