@@ -1,14 +1,16 @@
 """Viscous Burgers: MPM with exact and calculated acceleration beside FEM and the source's table.
 
 ``v_t + v v_x = eps v_xx`` on [0, 2] up to T, data from an exact solution; MPM takes the nodal
-acceleration from the particles ("calculated") or from the exact solution ("exact"), beside P1 FEM
-with consistent and lumped mass on the same mesh. Tables: ``errors``, ``orders`` (C13), ``norms``
-(which solution and norm match the source), ``timestep``, ``ppc`` (C3), ``lumping`` (C15), ``diagnosis``."""
+acceleration from the particles ("calculated", at 4, 8 and 16 particles per cell) or from the exact
+solution ("exact"), beside P1 FEM with consistent and lumped mass on the same mesh. The settings C13
+judges also run at the largest eps on jittered particle layouts, one per seed of :data:`SEEDS`.
+Tables (their rows: :mod:`mpm_fem.measure.burgers_tables`): ``errors``, ``orders`` and ``seeds``
+(C13), ``norms`` (which solution and norm match the source), ``timestep``, ``ppc`` (C3), ``lumping``
+(C15), ``diagnosis`` (C13's explanation)."""
 
 from __future__ import annotations
 
 import sys
-from collections import defaultdict
 
 import numpy as np
 
@@ -17,10 +19,11 @@ from baselines.exact.burgers import make_solution
 from mpm_fem.app import plots
 from mpm_fem.app.plots import Curve, Plot
 from mpm_fem.app.study import StudyOptions, publish, script_main
+from mpm_fem.measure import burgers_tables as tables
 from mpm_fem.measure import source
 from mpm_fem.measure.claims import BURGERS_SHOWN
-from mpm_fem.measure.errors import fitted_order, observed_orders, orders_row
-from mpm_fem.measure.schema import BURGERS_LUMPING, BURGERS_ORDERS, BURGERS_PPC
+from mpm_fem.measure.schema import BURGERS_DIAGNOSIS, BURGERS_LUMPING, BURGERS_ORDERS, BURGERS_PPC, BURGERS_SEEDS
+from mpm_fem.measure.seeds import LEVEL
 from mpm_fem.problems import burgers
 
 NAME = "burgers"
@@ -31,27 +34,36 @@ SOLUTIONS = ("rarefaction", "cole_hopf", "three_exp", "front")
 DEFAULT, WHERE, NORM = BURGERS_SHOWN["solution"], BURGERS_SHOWN["where"], BURGERS_SHOWN["norm"]
 SOURCE, CORRECTED = source.BURGERS, source.BURGERS_CORRECTED
 T = burgers.BurgersSettings.T
-MPM = dict(ppc=4, cfl=0.5, mass="lumped", basis="mpm", scheme="usl", layout="regular")
+MPM = dict(ppc=4, cfl=0.5, mass="lumped", basis="mpm", scheme="usl", layout="regular", seed=0)
 FEM = dict(cfl=0.5, cfl_visc=0.3)
+#: The calculated acceleration at each number of particles per cell: the source's 4-8 and 16.
+CALCULATED = {4: "mpm_calculated", 8: "mpm_calculated_8", 16: "mpm_calculated_16"}
 METHODS = {  # name: (label, solver, settings, the source's row it stands beside)
-    "mpm_calculated": ("MPM calculated a", "mpm", {"acceleration": "calculated"}, "calculated"),
-    "mpm_calculated_16": ("MPM calculated a, 16 ppc", "mpm", {"acceleration": "calculated", "ppc": 16}, "calculated"),
+    **{m: (f"MPM calculated a, {n} ppc", "mpm", {"acceleration": "calculated", "ppc": n}, "calculated")
+       for n, m in CALCULATED.items()},
     "mpm_exact": ("MPM exact a", "mpm", {"acceleration": "exact"}, "exact"),
     "mpm_exact_dt_h": ("MPM exact a, dt ~ h", "mpm", {"acceleration": "exact", "dt_rule": "advective"}, "exact"),
     "fem_consistent": ("FEM consistent", "fem", {"mass": "consistent"}, None),
     "fem_lumped": ("FEM lumped", "fem", {"mass": "lumped"}, None),
 }
-# The meshes of each method, by tier: a run costs ~ eps/h^3, so the deep tier takes every method to
-# every mesh of the source's table; the full tier every mesh for the rows compared with the source.
+#: The jittered layouts' seeds (the regular layout is seed 0), and the settings run on them (C13's).
+SEEDS, SEEDED = (1, 2, 3, 4, 5), (*CALCULATED.values(), "mpm_exact_dt_h")
+_MORE = ("mpm_calculated_8", "mpm_calculated_16")  # on the default solution only
+# The meshes of each method, by tier: a calculated-acceleration run costs ~ ppc eps / h^3, so the
+# deep tier takes every method and seed to every mesh of the source's table; the full tier every
+# mesh for the rows compared with the source, and all but the finest for 8 and 16 per cell and the
+# calculated acceleration's seeds (16 per cell reaches h = 0.00125 at the seeds' eps only).
 MESHES = {
     "deep": {
         "default": {m: H for m in METHODS},
-        "other": {m: H for m in METHODS if m != "mpm_calculated_16"},
+        "other": {m: H for m in METHODS if m not in _MORE},
+        "seeds": {m: H for m in SEEDED},
     },
     "full": {
-        "default": {**{m: H[:3] for m in METHODS}, "mpm_calculated": H, "mpm_exact_dt_h": H},
-        "other": {**{m: H[:3] for m in METHODS if m != "mpm_calculated_16"}, "mpm_exact_dt_h": H,
+        "default": {**{m: H[:3] for m in METHODS}, "mpm_calculated": H, "mpm_calculated_8": H[:4], "mpm_exact_dt_h": H},
+        "other": {**{m: H[:3] for m in METHODS if m not in _MORE}, "mpm_exact_dt_h": H,
                   "fem_consistent": H[:2], "fem_lumped": H[:2]},
+        "seeds": {**{m: H[:4] for m in SEEDED}, "mpm_exact_dt_h": H},
     },
 }
 _MPM = ("mpm_calculated", "mpm_exact")
@@ -63,9 +75,9 @@ DIAGNOSIS = {  # label: changes to the calculated-acceleration run
     "consistent mass (CFL 0.3)": {"mass": "consistent", "cfl": LUMPING_CFL}, "GIMP basis": {"basis": "gimp"},
     "16 particles per cell": {"ppc": 16}, "exact acceleration": {"acceleration": "exact"},
 }
-QUICK = dict(solutions=(DEFAULT,), eps=(0.045, 0.01), H=H[:3], skip=("mpm_calculated_16",),
-             short=("mpm_exact", "fem_consistent", "fem_lumped"), PPC=(2, 4, 8, 16), PPC_H=(0.01,), TIME_H=0.01,
-             time_eps=(0.045,), time_methods=("mpm_calculated", "mpm_exact_dt_h"), lumping_H=H[:2], diagnosis_H=())
+QUICK = dict(solutions=(DEFAULT,), eps=(0.045, 0.01), H=H[:3], skip=_MORE[1:], short=("mpm_exact", "fem_consistent",
+             "fem_lumped"), PPC=(2, 4, 8, 16), PPC_H=(0.01,), TIME_H=0.01, time_eps=(0.045,),
+             time_methods=("mpm_calculated", "mpm_exact_dt_h"), lumping_H=H[:2], diagnosis_H=(), seeds=SEEDS[:2])
 
 
 def run_case(case: dict) -> dict:
@@ -138,6 +150,9 @@ def _plan(tier: str) -> dict:
                        for h in q.get("lumping_H", H[:3]) for m in fem}},
         "diagnosis": {(label, h): method_case("mpm_calculated", DEFAULT, EPS[0], h, **changes)
                       for h in q.get("diagnosis_H", H[:3]) for label, changes in DIAGNOSIS.items()},
+        "seeds": {(m, EPS[0], h, layout, seed): method_case(m, DEFAULT, EPS[0], h, layout=layout, seed=seed)
+                  for m, hs in meshes["seeds"].items() for h in hs if kept(m, h)
+                  for layout, seed in (("regular", 0), *(("jittered", k) for k in q.get("seeds", SEEDS)))},
     }
 
 
@@ -145,170 +160,128 @@ def run(options: StudyOptions) -> None:
     """Every case in one sweep (shared cases run once, the longest first), then tables and figures."""
     got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)
     folder = options.folder(NAME)
-    settings = {"quick": options.quick, "mpm": MPM, "fem": FEM, "T": T, "domain": [0, 2], "default_solution": DEFAULT,
+    full = {m: {**(MPM if v[1] == "mpm" else FEM), **v[2]} for m, v in METHODS.items()}
+    settings = {"quick": options.quick, "tier": options.tier, "T": T, "domain": [0, 2], "default_solution": DEFAULT,
                 "compared_norm": f"{NORM} over {WHERE}",
-                "methods": {k: {"label": v[0], "solver": v[1], "settings": v[2], "source_row": v[3]}
-                            for k, v in METHODS.items()},
+                "methods": {m: {"label": v[0], "solver": v[1], "settings": full[m], "source_row": v[3]}
+                            for m, v in METHODS.items()},
                 "time_steps": {
-                    "mpm_calculated and mpm_exact": f"dt = CFL min(h/max|v_p|, h^2/(2 eps)), CFL {MPM['cfl']}",
+                    "mpm_calculated* and mpm_exact": f"dt = CFL min(h/max|v_p|, h^2/(2 eps)), CFL {MPM['cfl']}",
                     "mpm_exact_dt_h": f"dt = CFL h/max|v_p|, CFL {MPM['cfl']} "
                                       "(no viscous limit: no viscous force computed)",
                     "fem": f"dt = min(cfl h/max|v(x,0)|, cfl_visc h^2/(2 eps)), cfl {FEM['cfl']}, "
                            f"cfl_visc {FEM['cfl_visc']}, SSP-RK3"},
-                "source_corrections": "exponents of the entries marked * in docs/claims.md moved by one power of ten",
-                "time_h": QUICK["TIME_H"] if options.quick else TIME_H, "problem": burgers.BurgersSettings().as_dict()}
-    errors, orders = _errors(got)
-    tables = {"errors": errors, BURGERS_ORDERS: orders, "norms": _norms(got),
-              "timestep": _timestep(got, settings["time_h"]), BURGERS_PPC: _ppc(got), BURGERS_LUMPING: _lumping(got),
-              "diagnosis": _diagnosis(got) if got.get("diagnosis") else []}
-    extra = {"timestep": {"refine": list(REFINE), "meaning": "time_error = |E(dt) - E(dt/16)|; time_below_space: time "
-                          "error < E(dt/16) (the space error)"}, BURGERS_LUMPING.stem: {"mpm_cfl": LUMPING_CFL},
-             "diagnosis": {"diagnosis": dict(DIAGNOSIS), "solution": DEFAULT}}
-    publish(folder, tables, settings, extra, PLOTS)
+                "source_corrections": "exponents of the entries marked * in docs/claims.md moved by one power of ten"}
+    methods = {m: {"source_row": v[3], "ppc": full[m].get("ppc", "")} for m, v in METHODS.items()}
+    errors, orders = tables.errors_and_orders(got["table"], got["seeds"], methods, SOLUTIONS, DEFAULT, WHERE, NORM)
+    time_h = QUICK["TIME_H"] if options.quick else TIME_H
+    rows = {"errors": errors, BURGERS_ORDERS: orders, BURGERS_SEEDS: tables.seeds_rows(got["seeds"], full),
+            "norms": tables.norms_rows(got["table"], {m: v[3] for m, v in METHODS.items()}),
+            "timestep": tables.timestep_rows(got["timestep"], time_h, REFINE, WHERE, NORM),
+            BURGERS_PPC: tables.ppc_rows(got["ppc"], EPS[0], WHERE, NORM),
+            BURGERS_LUMPING: tables.lumping_rows(got["lumping"], EPS[0], WHERE),
+            BURGERS_DIAGNOSIS: tables.diagnosis_rows(got["diagnosis"], DIAGNOSIS, EPS[0], WHERE)}
+    seeded = {"layouts": {"regular": f"seed {MPM['seed']}: the midpoints of N_p equal sub-cells of every cell",
+                          "jittered": "each regular point moved uniformly within its sub-cell (numpy "
+                                      "default_rng(seed)); every particle's volume h/N_p"},
+              "seeds": sorted({k[4] for k in got["seeds"]}), "eps": EPS[0], "solution": DEFAULT,
+              "meshes": tables.meshes_of({(k[0], k[2]) for k in got["seeds"]})}
+    extra = {"errors": {"meshes": tables.meshes_of({(f"{k[0]}/{k[1]}", k[3]) for k in got["table"]})},
+             BURGERS_ORDERS.stem: {"seeds": seeded, "interval": "fitted_lo, fitted_hi: the least and largest of the "
+                                   "runs' fitted orders on runs_h_range; fitted_t_lo, fitted_t_hi: the Student-t "
+                                   f"interval of their mean at level {LEVEL}"},
+             BURGERS_SEEDS.stem: seeded,
+             "timestep": {"h": time_h, "refine": list(REFINE),
+                          "meaning": "time_error = |E(dt) - E(dt/16)|; time_below_space: time error < E(dt/16) "
+                                     "(the space error)"},
+             BURGERS_PPC.stem: {"eps": EPS[0], "solution": DEFAULT,
+                                "meshes": tables.meshes_of({(k[0], k[1]) for k in got["ppc"]})},
+             BURGERS_LUMPING.stem: {"mpm_cfl": LUMPING_CFL, "eps": EPS[0], "solution": DEFAULT},
+             BURGERS_DIAGNOSIS.stem: {"diagnosis": dict(DIAGNOSIS), "base": "mpm_calculated", "eps": EPS[0],
+                                      "solution": DEFAULT}}
+    publish(folder, rows, settings, extra, PLOTS)
     _profiles(folder / "profiles.png", got)
 
 
-def _value(r: dict, where: str, norm: str) -> float:
-    return r[where][norm] if r.get("ok") and where in r else float("nan")
+#: Each method's marker and line, and its colour in every figure; a second grouping of the curves (the
+#: mesh, eps, mass) is drawn in the line styles of LINES, the colour kept.
+STYLE = {"mpm_calculated": ("o-", "tab:blue"), "mpm_calculated_8": ("o-.", "tab:cyan"),
+         "mpm_calculated_16": ("o--", "tab:purple"), "mpm_exact": ("s-", "tab:orange"),
+         "mpm_exact_dt_h": ("D-", "tab:red"), "fem_consistent": ("^--", "tab:green"),
+         "fem_lumped": ("v--", "tab:olive")}
+LINES = ("-", "--", ":")
+#: The diagnosis' variants' colours: a method's for the variant that is one (the first, the last two).
+_VARIANT_COLOURS = dict(zip(DIAGNOSIS, (STYLE["mpm_calculated"][1], "tab:brown", "tab:pink", "tab:gray", "black",
+                                        "gold", STYLE["mpm_calculated_16"][1], STYLE["mpm_exact"][1]), strict=True))
 
 
-def _norms_of(r: dict, wheres=("particles", "nodes")) -> dict:
-    return {f"{w}_{k}": _value(r, w, k) for w in wheres for k in ("L1", "L2", "max")}
+def _y(m: str) -> str:
+    """The compared error's column (FEM: over nodes)."""
+    return f"{'nodes' if m.startswith('fem') else WHERE}_{NORM}"
 
 
-def _errors(got: dict) -> tuple[list, list]:
-    rows, order_rows, series = [], [], defaultdict(dict)
-    key = lambda kv: (SOLUTIONS.index(kv[0][0]), list(METHODS).index(kv[0][1]), -kv[0][2], -kv[0][3])  # noqa: E731
-    for (sol, m, eps, h), r in sorted(got["table"].items(), key=key):
-        src = source.burgers_value(METHODS[m][3], eps, h)
-        row = {"solution": sol, "method": m, "eps": eps, "h": h, **_norms_of(r)}
-        row.update({"source": src if src is not None else "",
-                    "source_corrected": "yes" if (METHODS[m][3], eps, h) in CORRECTED else "",
-                    f"ratio_{WHERE}_{NORM}": row[f"{WHERE}_{NORM}"] / src if src else "",
-                    "steps": r.get("steps", ""), "dt": r.get("dt", ""), "particles": r.get("n_p", ""),
-                    "error": r.get("error", "")})
-        rows.append(row)
-        series[(sol, m, eps)][h] = row
-    for (sol, m, eps), by_h in series.items():
-        hs = sorted(by_h, reverse=True)
-        src = [source.burgers_value(METHODS[m][3], eps, h) for h in hs]
-        for where in ("particles", "nodes"):
-            for norm in ("L1", "L2", "max"):
-                v = np.array([by_h[h][f"{where}_{norm}"] for h in hs])
-                if len(hs) > 1 and np.all(np.isfinite(v) & (v > 0)):
-                    order_rows.append({"solution": sol, "method": m, "eps": eps, "where": where, "norm": norm,
-                                       **orders_row(hs, v),
-                                       **({"source_fitted": fitted_order(hs, src)} if None not in src else {})})
-    return rows, order_rows
+def _curves(methods, label="{m}", y=None, by="", values=(), **where) -> tuple[Curve, ...]:
+    """A curve per method in its style (``{m}`` in ``label``: its name), and per value ``v`` of column
+    ``by`` in ``values`` (``{v}`` in ``label``) in the line styles of :data:`LINES`; ``y`` defaults to
+    the compared error."""
+    return tuple(Curve(label.format(m=METHODS[m][0], v=v), y or _y(m),
+                       STYLE[m][0] if not by else STYLE[m][0][0] + LINES[k % len(LINES)],
+                       {**where, "method": m, **({by: v} if by else {})}, options={"color": STYLE[m][1]})
+                 for m in methods for k, v in enumerate(values or ("",)))
 
 
-def _norms(got: dict) -> list[dict]:
-    """For each solution, MPM method, place and norm: median of measured/source and its spread
-    (max/min over the common cells of the table), and the spread over eps on the finest common mesh."""
-    groups = defaultdict(list)
-    for (sol, m, eps, h), r in got["table"].items():
-        src = source.burgers_value(METHODS[m][3], eps, h)
-        measured = {} if src is None else {tuple(k.split("_")): v for k, v in _norms_of(r).items()}
-        for (where, norm), v in measured.items():
-            if np.isfinite(v) and v > 0:
-                groups[(sol, m, where, norm)].append((eps, h, v, src))
-    rows = []
-    for (sol, m, where, norm), vals in sorted(groups.items()):
-        ratio = np.array([v / s for _, _, v, s in vals])
-        finest = min(h for _, h, _, _ in vals)
-        fine = [(v, s) for _, h, v, s in vals if h == finest]
-        spread = lambda xs, fine=fine: float(max(xs) / min(xs)) if len(fine) > 1 else ""  # noqa: E731
-        rows.append({"solution": sol, "method": m, "where": where, "norm": norm, "cells": len(vals),
-                     "median_ratio": float(np.median(ratio)), "ratio_spread": float(ratio.max() / ratio.min()),
-                     "log10_ratio_rms": float(np.sqrt(np.mean(np.log10(ratio) ** 2))),
-                     "eps_spread_finest": spread([v for v, _ in fine]),
-                     "source_eps_spread_finest": spread([s for _, s in fine]),
-                     "finest_h": finest})
-    return rows
+def _sources(methods, **where) -> tuple[Curve, ...]:
+    """The source's entries beside ``methods`` (open black: squares for the exact, circles for the
+    calculated acceleration)."""
+    return tuple(Curve(f"source, {METHODS[m][3]} a", "source", "ks" if METHODS[m][3] == "exact" else "ko",
+                       {**where, "method": m}) for m in methods)
 
 
-def _timestep(got: dict, time_h: float) -> list[dict]:
-    rows = []
-    for (m, eps, k), r in sorted(got["timestep"].items(), key=lambda kv: (kv[0][0], -kv[0][1], kv[0][2])):
-        finest = got["timestep"][(m, eps, REFINE[-1])]
-        row = {"method": m, "eps": eps, "h": time_h, "refine": k, "steps": r.get("steps", ""), "dt": r.get("dt", "")}
-        for norm in ("L1", "L2", "max"):  # the time error of this dt, estimated against dt/16
-            v, ref = _value(r, WHERE, norm), _value(finest, WHERE, norm)
-            row.update({f"{WHERE}_{norm}": v, f"time_error_{norm}": abs(v - ref) if k != REFINE[-1] else ""})
-        ref = _value(finest, WHERE, NORM)
-        row["time_below_space"] = (("yes" if abs(row[f"{WHERE}_{NORM}"] - ref) < ref else "no")
-                                   if k != REFINE[-1] else "")
-        rows.append(row)
-    return rows
+def _range(m: str, labels=("_{m} mean", "_{m} lo", "_{m} hi"), panel: str = "", **where) -> tuple[Curve, ...]:
+    """The mean (crosses) and the least and largest (dotted) compared error over the runs of seeded
+    ``m``, labelled ``labels`` (``{m}``: its name; a label from ``_`` stays out of the legend)."""
+    return tuple(Curve(label.format(m=METHODS[m][0]), f"{_y(m)}_{k}", fmt, {**where, "method": m}, panel,
+                       options={"color": STYLE[m][1], "lw": 0.8})
+                 for label, k, fmt in zip(labels, ("mean", "lo", "hi"), ("+", ":", ":"), strict=True))
 
 
-def _ppc(got: dict) -> list[dict]:
-    rows = [{"method": m, "eps": EPS[0], "h": h, "ppc": n, **_norms_of(r), "steps": r.get("steps", ""),
-             "error": r.get("error", "")}
-            for (m, h, n), r in sorted(got["ppc"].items(), key=lambda kv: (kv[0][0], -kv[0][1], kv[0][2]))]
-    for m, h in {(r["method"], r["h"]) for r in rows}:
-        sub = [r for r in rows if r["method"] == m and r["h"] == h and np.isfinite(r[f"{WHERE}_{NORM}"])]
-        for r in sub:
-            r["best_ppc"] = min(sub, key=lambda r: r[f"{WHERE}_{NORM}"])["ppc"]
-    return rows
+def _seed_panel(m: str) -> tuple[Curve, ...]:
+    """The panel of seeded ``m``: its regular layout's run, the mean and range over its runs, the source."""
+    name, row, where = METHODS[m][0], METHODS[m][3], {"method": m, "solution": DEFAULT, "eps": EPS[0]}
+    return (Curve("regular layout", _y(m), STYLE[m][0], where, name, options={"color": STYLE[m][1]}),
+            *_range(m, ("mean over the layouts", "least", "largest"), name, solution=DEFAULT, eps=EPS[0]),
+            Curve(f"source, {row} a", "source", "ks" if row == "exact" else "ko", where, name))
 
 
-def _lumping(got: dict) -> list[dict]:
-    return [{"method": m, "mass": mass, "eps": EPS[0], "h": h, "where": "nodes" if m.startswith("fem") else WHERE,
-             **{k: _value(r, "nodes" if m.startswith("fem") else WHERE, k) for k in ("L1", "L2", "max")},
-             "nodes_L2": _value(r, "nodes", "L2"), "dt": r.get("dt", ""), "error": r.get("error", "")}
-            for (m, mass, h), r in sorted(got["lumping"].items(), key=lambda kv: (kv[0][0], kv[0][1], -kv[0][2]))]
-
-
-def _diagnosis(got: dict) -> list[dict]:
-    rows = [{"variant": label, "changes": repr(DIAGNOSIS[label]), "eps": EPS[0], "h": h, **_norms_of(r),
-             "error": r.get("error", "")}
-            for (label, h), r in got["diagnosis"].items()]
-    for label in DIAGNOSIS:
-        sub = sorted((r for r in rows if r["variant"] == label), key=lambda r: -r["h"])
-        v = np.array([r[f"{WHERE}_L1"] for r in sub])
-        if len(sub) > 1 and np.all(np.isfinite(v) & (v > 0)):
-            for r, o in zip(sub[1:], observed_orders([r["h"] for r in sub], v), strict=True):
-                r["order_L1"] = float(o)
-    return rows
-
-
-STYLE = {"mpm_calculated": ("o-", "tab:blue"), "mpm_calculated_16": ("o--", "tab:purple"),
-         "mpm_exact": ("s-", "tab:orange"), "mpm_exact_dt_h": ("D-", "tab:red"),
-         "fem_consistent": ("^--", "tab:green"), "fem_lumped": ("v--", "tab:olive")}
-
-
-def _curves(methods, label="{m}", y=None, group=(), **where) -> tuple[Curve, ...]:
-    """A curve per method in its style (``{m}`` in ``label``: its name); ``y`` defaults to the compared
-    norm (FEM: over nodes)."""
-    return tuple(Curve(label.replace("{m}", METHODS[m][0]), y or f"{'nodes' if m.startswith('fem') else WHERE}_{NORM}",
-                       STYLE[m][0], {**where, "method": m}, group=group, options={"color": STYLE[m][1]})
-                 for m in methods)
-
-
-def _beside_source(**where) -> tuple[Curve, ...]:
-    sources = (("exact", "ks", "mpm_exact_dt_h"), ("calculated", "ko", "mpm_calculated"))
-    return _curves(METHODS, **where) + tuple(Curve(f"source, {row} a", "source", fmt, {**where, "method": m})
-                                             for row, fmt, m in sources)
-
-
-_ERROR = dict(ylabel=f"velocity error ({NORM}; MPM over {WHERE}, FEM over nodes)", slopes=(1, 2))
+_ERROR = dict(ylabel=f"velocity error ({NORM})", slopes=(1, 2))
+_OVER = f"{NORM} velocity error over {WHERE} (MPM) or nodes (FEM)"
+_RANGE = "crosses and dotted: mean and range over the layouts"
 PLOTS = (
-    Plot("convergence.png", f"Burgers, T = {T}: velocity error against h ({DEFAULT} solution), open black: the source",
-         "errors", "h", _beside_source(solution=DEFAULT), split=("eps",), size=(4.2, 4.0), **_ERROR),
-    Plot("solutions.png", "Every candidate exact solution: velocity error against h", "errors", "h",
-         _beside_source(eps=(EPS[0], EPS[-1])), split=("eps", "solution"), ncols=len(SOLUTIONS), size=(4.2, 3.8),
-         **_ERROR),
+    Plot("convergence.png", f"Burgers, T = {T}, {DEFAULT} solution: {_OVER} against h; open black: the source; "
+         f"{_RANGE}", "errors", "h",
+         _curves(METHODS, solution=DEFAULT) + tuple(c for m in SEEDED for c in _range(m, solution=DEFAULT))
+         + _sources(("mpm_exact_dt_h", "mpm_calculated"), solution=DEFAULT),
+         split=("eps",), ncols=3, size=(4.2, 4.0), **_ERROR),
+    Plot("seeds.png", f"C13's settings, eps = {EPS[0]}: the regular layout, and the mean and range over the layouts",
+         "errors", "h", tuple(c for m in SEEDED for c in _seed_panel(m)), ncols=2, size=(4.6, 3.8),
+         **{**_ERROR, "ylabel": f"velocity error ({NORM} over {WHERE})"}),
+    Plot("solutions.png", f"Every candidate exact solution: {_OVER} against h", "errors", "h",
+         _curves(METHODS, eps=EPS[::4]) + _sources(("mpm_exact_dt_h", "mpm_calculated"), eps=EPS[::4]),
+         split=("eps", "solution"), ncols=len(SOLUTIONS), size=(4.2, 3.8), **_ERROR),
     Plot("ppc.png", f"C3, Burgers: error against N_p ({DEFAULT}, eps = {EPS[0]})", BURGERS_PPC.stem, "ppc",
-         _curves(_MPM, "{m}, h = {h}", group=("h",)), xlabel="particles per cell N_p", ylabel=_ERROR["ylabel"]),
+         _curves(_MPM, "{m}, h = {v}", by="h", values=PPC_H), xlabel="particles per cell N_p",
+         ylabel=f"velocity error ({NORM} over {WHERE})"),
     Plot("lumping.png", f"C15: lumped against consistent mass ({DEFAULT}, eps = {EPS[0]}; MPM CFL {LUMPING_CFL})",
-         BURGERS_LUMPING.stem, "h", _curves(_MPM + ("fem_consistent", "fem_lumped"), "{m}, {mass}", "L2", ("mass",)),
-         **{**_ERROR, "ylabel": "velocity error (L2)"}),
+         BURGERS_LUMPING.stem, "h", _curves(_MPM + ("fem_consistent", "fem_lumped"), "{m}, {v}", "L2", "mass",
+                                            ("consistent", "lumped")),
+         size=(6.2, 4.2), **{**_ERROR, "ylabel": "velocity error (L2)"}),
     Plot("timestep.png", f"Time error at fixed h: dt / {', '.join(map(str, REFINE))}", "timestep", "dt",
-         _curves(_MPM + ("mpm_exact_dt_h",), "{m}, eps = {eps}", group=("eps",)),
-         xlabel="dt (smallest step of the run)", ylabel=_ERROR["ylabel"]),
-    Plot("diagnosis.png", f"Why the calculated acceleration stalls ({DEFAULT}, eps = {EPS[0]}): one change at a time",
-         "diagnosis", "h", (Curve("{variant}", f"{WHERE}_L1", "o-", group=("variant",)),),
+         _curves(_MPM + ("mpm_exact_dt_h",), "{m}, eps = {v}", by="eps", values=(EPS[0], EPS[-1])),
+         xlabel="dt (smallest step of the run)", ylabel=f"velocity error ({NORM} over {WHERE})", size=(6.2, 4.2)),
+    Plot("diagnosis.png", f"The calculated acceleration ({DEFAULT}, eps = {EPS[0]}): one change at a time",
+         BURGERS_DIAGNOSIS.stem, "h",
+         tuple(Curve(label, f"{WHERE}_L1", "o-", {"variant": label}, options={"color": colour})
+               for label, colour in _VARIANT_COLOURS.items()),
          ylabel=f"velocity error (L1 over {WHERE})", slopes=(1, 2), size=(6.2, 4.6)),
 )
 

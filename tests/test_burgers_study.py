@@ -4,14 +4,19 @@ The numbers asserted here are measured by ``studies/burgers.py`` on the full set
 fast tests run the coarse meshes of the same settings.
 """
 
+import csv
+import json
 from dataclasses import replace
 from functools import lru_cache
 
+import matplotlib.image
 import numpy as np
 import pytest
 
 from baselines import fem_burgers
 from baselines.exact.burgers import make_solution
+from mpm_fem.app.study import StudyOptions
+from mpm_fem.measure import burgers_tables
 from mpm_fem.problems import burgers
 from studies import burgers as study
 
@@ -100,10 +105,8 @@ def test_exact_acceleration_with_the_viscous_time_step_is_second_order():
 @pytest.mark.parametrize("norm", ["L1", "max"])
 def test_calculated_acceleration_stalls_with_four_particles_per_cell(norm):
     """Not the source's first order: with 4 particles per cell the calculated acceleration stops
-    converging by h = 0.01 (study: 0.01 -> 0.0025 gives orders -0.4 (L1) and 0.05 (max)). Cause
-    (diagnosis.csv): the force F_i = -sum_p V_p eps (dv/dx)_p G_ip is a particle quadrature whose
-    cell sums sum_{p in I} V_p jump by a particle volume h/4 whenever a particle crosses a node, an
-    O(eps v_x / (N_p h)) acceleration error; GIMP or 16 particles per cell remove the stall."""
+    converging by h = 0.01 (study: 0.01 -> 0.0025 gives orders -0.4 (L1) and 0.05 (max)). What
+    changes it, one change at a time, is diagnosis.csv's (C13's evidence states it)."""
     order, errs = _order(0.01, 0.005, "particles", norm)
     assert -0.5 <= order <= 0.4, f"{norm} errors {errs}, observed order {order:.2f}"
 
@@ -180,3 +183,131 @@ def test_the_reported_step_is_the_run_step_not_the_last_sliver():
     r = study.run_case({"solver": "mpm", "h": 0.04, "refine": 1024, "ppc": 4})
     assert r["steps"] == 57601 and r["dt_min"] < 1e-9, "the case no longer ends with a sliver step: pick another"
     assert r["dt"] == pytest.approx(0.5 / 57600, rel=1e-9)
+
+
+# ---------------------------------------------------------------- the plan: settings shown, seeds
+
+def test_the_calculated_acceleration_runs_at_four_eight_and_sixteen_per_cell_on_every_mesh():
+    """Deep tier: every eps and mesh of the source's table at 4, 8 and 16 per cell, and the seeds on
+    every mesh; full tier: every mesh but the finest at 8 and 16 per cell (16: at the seeds' eps)."""
+    deep, full = study._plan("deep"), study._plan("full")
+    for n, m in study.CALCULATED.items():
+        assert {(e, h) for s, mm, e, h in deep["table"] if (s, mm) == (study.DEFAULT, m)} == {
+            (e, h) for e in study.EPS for h in study.H}, n
+        meshes = {h for s, mm, e, h in full["table"] if (s, mm, e) == (study.DEFAULT, m, study.EPS[0])}
+        meshes |= {h for mm, e, h, layout, _ in full["seeds"] if mm == m and layout == "regular"}
+        assert set(study.H[:4]) <= meshes, n
+    for tier, plan in (("deep", deep), ("full", full)):
+        for m, hs in study.MESHES[tier]["seeds"].items():
+            for h in hs:
+                layouts = {(layout, seed) for mm, e, hh, layout, seed in plan["seeds"] if (mm, hh) == (m, h)}
+                assert layouts == {("regular", 0)} | {("jittered", k) for k in study.SEEDS}, (tier, m, h)
+                assert len(study.SEEDS) >= 5
+
+
+def test_the_regular_seed_is_the_table_run():
+    """The regular layout's run of the seeds is the table's run (the same case: the sweep runs it once)."""
+    plan = study._plan("full")
+    for (m, eps, h, layout, _), case in plan["seeds"].items():
+        if layout == "regular" and (study.DEFAULT, m, eps, h) in plan["table"]:
+            assert case == plan["table"][(study.DEFAULT, m, eps, h)]
+    jittered = [c for (_, _, _, layout, _), c in plan["seeds"].items() if layout == "jittered"]
+    assert {c["seed"] for c in jittered} == set(study.SEEDS) and all(c["layout"] == "jittered" for c in jittered)
+
+
+def _fake(case: dict) -> dict:
+    """A run's result without running it: errors ``(1 + seed / 10) h^p``, ``p`` by method and layout."""
+    if case.get("profile"):
+        return {"ok": False, "error": "not run"}
+    p = 1.0 if case.get("acceleration") == "exact" or case["solver"] == "fem" else (
+        0.0 if case.get("layout") == "jittered" else 0.5 * np.log2(case.get("ppc", 4)) - 0.5)
+    e = (1 + case.get("seed", 0) / 10) * case["h"] ** p
+    errors = {"L1": e, "L2": 1.1 * e, "max": 2 * e}
+    return {"ok": True, "nodes": errors, **({} if case["solver"] == "fem" else {"particles": errors, "n_p": 10}),
+            "steps": 10, "dt": 0.01}
+
+
+class _FakeRuns(StudyOptions):
+    """The full tier's options, its sweep returning :func:`_fake` results."""
+
+    def sweep_plan(self, name, fn, plan, cost=None):
+        return {g: {k: _fake(c) for k, c in group.items()} for g, group in plan.items()}
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    """The full tier's tables, JSON files and figures, written from :func:`_fake` results."""
+    out = tmp_path_factory.mktemp("figures")
+    study.run(_FakeRuns(out=out))
+    return out / study.NAME
+
+
+def _read(folder, name):
+    with open(folder / f"{name}.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_the_seeds_table_has_a_row_per_run(written):
+    rows = _read(written, "seeds")
+    assert len(rows) == len(study._plan("full")["seeds"])
+    assert {"h", "ppc", "layout", "seed", "eps", "acceleration", "particles_L1", "nodes_L1", "particles_max"} <= set(
+        rows[0])
+    sixteen = [r for r in rows if r["method"] == "mpm_calculated_16" and r["layout"] == "jittered"]
+    assert sixteen and all(r["ppc"] == "16" and r["acceleration"] == "calculated" for r in sixteen)
+
+
+def test_the_orders_carry_the_spread_over_the_runs(written):
+    """Fake errors: the regular layout's order at 4 / 8 / 16 per cell is 0.5 / 1 / 1.5, the jittered
+    ones' 0: the mean, range and successive ranges of the table are theirs."""
+    rows = [r for r in _read(written, "orders") if r["where"] == "particles" and r["norm"] == "max"]
+    for n, m in study.CALCULATED.items():
+        row = next(r for r in rows if r["method"] == m and float(r["eps"]) == study.EPS[0])
+        regular = 0.5 * np.log2(n) - 0.5
+        assert int(row["runs"]) == 1 + len(study.SEEDS) and row["ppc"] == str(n)
+        assert float(row["fitted_lo"]) == pytest.approx(min(0, regular), abs=1e-6)
+        assert float(row["fitted_hi"]) == pytest.approx(max(0, regular), abs=1e-6)
+        assert float(row["fitted_mean"]) == pytest.approx(regular / 6, abs=1e-6)
+        assert float(row["order_hi_0.01_0.005"]) == pytest.approx(max(0, regular), abs=1e-6)
+        other = next(r for r in rows if r["method"] == m and float(r["eps"]) == study.EPS[-1])
+        assert other["runs"] == "1" and other["fitted_lo"] == ""
+
+
+def test_every_json_records_the_settings_used(written):
+    """The methods' settings are the cases' own (no default block contradicting them); the seeds'
+    tables record the layouts, seeds and meshes run."""
+    plan = study._plan("full")
+    for path in written.glob("*.json"):
+        if path.name == "figures.json":
+            continue
+        settings = json.loads(path.read_text())["settings"]
+        assert "problem" not in settings and settings["tier"] == "full", path.name
+        for (_, m, _, _), case in plan["table"].items():
+            recorded = settings["methods"][m]["settings"]
+            assert {k: case[k] for k in recorded} == recorded, (path.name, m)
+    seeds = json.loads((written / "seeds.json").read_text())["settings"]
+    assert seeds["seeds"] == [0, *study.SEEDS] and seeds["meshes"]["mpm_calculated_16"] == list(study.H[:4])
+    assert json.loads((written / "ppc.json").read_text())["settings"]["eps"] == study.EPS[0]
+
+
+def _aspects(folder) -> dict:
+    return {p.name: matplotlib.image.imread(p).shape[1] / matplotlib.image.imread(p).shape[0]
+            for p in sorted(folder.glob("*.png"))}
+
+
+def test_no_figure_is_wider_than_two_and_a_half_times_its_height(written, tmp_path):
+    """Full tier (five eps: a grid) and quick tier (two eps: one row of two)."""
+    study.run(_FakeRuns(out=tmp_path, quick=True))
+    for aspects in (_aspects(written), _aspects(tmp_path / study.NAME)):
+        assert {"convergence.png", "seeds.png", "solutions.png"} <= set(aspects)
+        assert all(a <= 2.5 for a in aspects.values()), aspects
+
+
+def test_the_errors_table_carries_the_range_the_figure_draws():
+    seeds = {("mpm_calculated", 0.045, h, layout, k): _fake({"solver": "mpm", "h": h, "layout": layout, "seed": k})
+             for h in (0.01, 0.005) for layout, k in (("regular", 0), ("jittered", 1), ("jittered", 2))}
+    methods = {"mpm_calculated": {"source_row": "calculated", "ppc": 4}}
+    errors, _ = burgers_tables.errors_and_orders({}, seeds, methods, study.SOLUTIONS, study.DEFAULT, "particles", "max")
+    assert [r["h"] for r in errors] == [0.01, 0.005]  # the regular runs of the seeds are the table's
+    row = errors[0]
+    assert row["runs"] == 3 and row["particles_max_lo"] == pytest.approx(2 * 0.01**0.5)
+    assert row["particles_max_hi"] == pytest.approx(2 * 1.2) and row["particles_max"] == row["particles_max_lo"]

@@ -116,14 +116,6 @@ def test_c15_burgers_follows_the_mass_ratios():
     assert_flips("C15 (burgers)", failing, passing)
 
 
-def test_c13_needs_both_accelerations_first_order():
-    passing = mutate(TABLES, "burgers/orders", {"method": "mpm_calculated"}, fitted=1.0)
-    assert_flips("C13", TABLES, passing)
-    failing = mutate(passing, "burgers/orders", {"method": "mpm_exact_dt_h"}, fitted=2.0)
-    failing = mutate(failing, "burgers/orders", {"method": "mpm_calculated"}, fitted=0.0)
-    assert judge("C13", failing)[0] == "differs"
-
-
 def test_e3_needs_every_method_on_every_mesh():
     failing = mutate(TABLES, "sod/convergence", {"h": 0.01}, fv_L1="")
     assert_flips("E3", failing, TABLES)

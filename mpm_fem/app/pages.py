@@ -87,16 +87,22 @@ PAGES = (
          )),
     Page("burgers", "Viscous Burgers",
          "The viscous Burgers equation with initial and boundary data from an exact solution, MPM with the exact and "
-         "with the calculated acceleration beside P1 FEM with consistent and lumped mass, against the source's table "
-         "(the corrected entries are marked in the source_corrected column). The solution and norm compared with "
-         "the source are chosen by the norms table.",
+         "with the calculated acceleration (the latter at each number of particles per cell the JSON beside each "
+         "table records, the source's among them) beside P1 FEM with consistent and lumped mass, against the "
+         "source's table (the corrected entries are marked in the source_corrected column). The settings C13 judges "
+         "also run, at the largest eps, on jittered particle layouts, one per seed: each order comes with its mean "
+         "and range over the layouts. The solution and norm compared with the source are chosen by the norms table.",
          views=(
-             View("burgers/orders", "Least-squares orders of the solution and norm compared with the source",
-                  ("method", "eps", "fitted", "first", "last", "h_range", "source_fitted"),
+             View("burgers/orders", "Least-squares orders of the solution and norm compared with the source: the "
+                  "regular layout's (fitted), and the mean and range over the runs of the regular and jittered layouts",
+                  ("method", "ppc", "eps", "fitted", "h_range", "runs", "fitted_mean", "fitted_lo", "fitted_hi",
+                   "runs_h_range", "source_fitted"),
                   {"solution": _SOLUTION, "where": _WHERE, "norm": _NORM}, "convergence.png"),
-             View("burgers/errors", "Errors on every mesh beside the source, largest eps", (
-                 "method", "h", _COMPARED, "source", "source_corrected", f"ratio_{_COMPARED}", "steps"),
-                  {"solution": _SOLUTION, "eps": _FIRST_EPS}),
+             View("burgers/errors", "Errors on every mesh beside the source, largest eps: the regular layout, and the "
+                  "mean and range over the layouts", (
+                      "method", "h", _COMPARED, "runs", f"{_COMPARED}_mean", f"{_COMPARED}_lo", f"{_COMPARED}_hi",
+                      "source", "source_corrected", f"ratio_{_COMPARED}", "steps"),
+                  {"solution": _SOLUTION, "eps": _FIRST_EPS}, "seeds.png"),
              View("burgers/norms", "Which solution and norm: median measured/source and spread over eps", (
                  "solution", "method", "median_ratio", "eps_spread_finest", "source_eps_spread_finest"),
                   {"where": _WHERE, "norm": _NORM}, "solutions.png"),
@@ -107,7 +113,7 @@ PAGES = (
                   "ppc.png"),
              View("burgers/lumping", "Lumped against consistent mass",
                   ("method", "mass", "h", "where", "L1", "L2", "max"), {}, "lumping.png"),
-             View("burgers/diagnosis", "Why the calculated acceleration stalls: one change at a time",
+             View("burgers/diagnosis", "The calculated acceleration with one change at a time (regular layout)",
                   ("variant", "h", f"{_WHERE}_L1", "order_L1"), {}, "diagnosis.png"),
          )),
     Page("budget", "Error budget (E1) and bases (E2)",

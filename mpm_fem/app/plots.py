@@ -69,7 +69,8 @@ def grid_shape(n: int, size: tuple[float, float], max_aspect: float = MAX_ASPECT
 def panels(path, content: dict, xlabel: str, ylabel: str, title: str = "", ncols: int | None = None,
            slopes=(), size=(4.2, 3.8), log: bool = True, legends: bool = False) -> None:
     """One panel per entry of ``content = {panel title: {label: (x, y, fmt, options)}}`` (``options``
-    optional: matplotlib keywords), log-log unless ``log`` is false, with slope guides through the
+    optional: matplotlib keywords), in ``ncols`` columns (one row when not given; never more columns
+    than panels), log-log unless ``log`` is false, with slope guides through the
     largest value of each panel and the legend in the first one. The source's points are a series
     like any other, drawn black and open (fmt ``"ks"``/``"ko"``/``"k*"``, ``mfc="none"``). With
     ``legends`` every panel gets its own legend (panels that show different series)."""

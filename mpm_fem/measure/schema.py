@@ -105,15 +105,32 @@ SOD_MASS = Table("sod/mass", (
 
 # ----------------------------------------------------------------------------- Burgers (C3, C13, C15)
 
+#: One row per series (solution, method, eps) and error: the regular layout's orders on its meshes
+#: (``fitted``, ``first``, ``last``, ``h_range``, ``order_<h1>_<h2>``) and, over the ``runs`` of the
+#: series (the regular and jittered layouts; one where only the regular runs) on the meshes they share
+#: (``runs_h_range``), the mean of their fitted orders, its range (``fitted_lo``, ``fitted_hi``) and
+#: Student-t interval (``fitted_t_lo``, ``fitted_t_hi``; empty for one run), and the range of each
+#: successive order (``order_lo_<h1>_<h2>``, ``order_hi_<h1>_<h2>``, series of several runs).
 #: ``source_fitted`` only where the source's table has every mesh of the series.
 BURGERS_ORDERS = Table("burgers/orders", (
-    "solution", "method", "eps", "where", "norm", "fitted", "first", "last", "h_range"),
-    optional=("source_fitted",), families=(r"order_[0-9.e+-]+_[0-9.e+-]+",))
+    "solution", "method", "ppc", "eps", "where", "norm", "fitted", "first", "last", "h_range", "runs", "runs_h_range",
+    "fitted_mean", "fitted_lo", "fitted_hi", "fitted_t_lo", "fitted_t_hi"),
+    optional=("source_fitted",),
+    families=(r"order_[0-9.e+-]+_[0-9.e+-]+", r"order_(lo|hi)_[0-9.e+-]+_[0-9.e+-]+"))
+#: One row per run of the settings C13 judges on several particle layouts (``layout``, ``seed``).
+BURGERS_SEEDS = Table("burgers/seeds", (
+    "method", "acceleration", "dt_rule", "ppc", "eps", "h", "layout", "seed", "particles_L1", "particles_L2",
+    "particles_max", "nodes_L1", "nodes_L2", "nodes_max", "steps", "error"))
 BURGERS_PPC = Table("burgers/ppc", (
     "method", "eps", "h", "ppc", "particles_L1", "particles_L2", "particles_max", "nodes_L1", "nodes_L2", "nodes_max",
     "steps", "error", "best_ppc"))
 BURGERS_LUMPING = Table("burgers/lumping", (
     "method", "mass", "eps", "h", "where", "L1", "L2", "max", "nodes_L2", "dt", "error"))
+#: One change at a time to the calculated-acceleration run (``variant``, ``changes``); ``order_L1``:
+#: the observed order of the particles' L1 error against the next coarser mesh (absent on one mesh).
+BURGERS_DIAGNOSIS = Table("burgers/diagnosis", (
+    "variant", "changes", "eps", "h", "particles_L1", "particles_L2", "particles_max", "nodes_L1", "nodes_L2",
+    "nodes_max", "error"), optional=("order_L1",))
 
 # ----------------------------------------------------------------------------- time (C1, C2)
 
@@ -161,7 +178,7 @@ SETTINGS = Table("settings", ("table", "key", "value"))
 TABLES: dict[str, Table] = {t.name: t for t in (
     PROJECTION_ORDERS, PROJECTION_BOUNDS, PROJECTION_D2_CONSTANT,
     SOD_CONVERGENCE, SOD_REGIONS, SOD_EXTREMA, SOD_PPC, SOD_MASS,
-    BURGERS_ORDERS, BURGERS_PPC, BURGERS_LUMPING,
+    BURGERS_ORDERS, BURGERS_SEEDS, BURGERS_PPC, BURGERS_LUMPING, BURGERS_DIAGNOSIS,
     TIME_ORDER, TIME_LOCAL_ERROR, TIME_CROSSING_SUMMARY,
     BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,
     REMEDIES_ERRORS,
