@@ -303,5 +303,9 @@ def _profiles(path, got) -> None:
                            f"{DEFAULT} solution at T = {T}, h = {PROFILE_H}: particles (MPM), nodes (FEM)")
 
 
+#: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`_cost`, from the full
+#: tier's run on the 2-core machine (2026-11-25: 171 s wall on 2 workers for 8.4e9 units).
+PLAN, COST, SECONDS_PER_COST = _plan, _cost, 4.1e-8
+
 if __name__ == "__main__":
     sys.exit(script_main(NAME))
