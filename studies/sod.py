@@ -50,7 +50,7 @@ PLATEAU_VARIANTS = {"study settings": {}, "CFL 0.025": {"cfl": 0.025}, "CFL 0.1"
 #: cell at the study's CFL, and 4 per cell at the CLI's default CFL; each on every mesh, regular and jittered
 SETTINGS = ((MPM["ppc"], MPM["cfl"]), (8, MPM["cfl"]), (4, MPM["cfl"]), (4, sod.SodSettings.cfl))
 SEEDS = (1, 2, 3, 4, 5)  # the jittered layouts' seeds, beside the regular layout
-SEED_H = H[:6]  # the deep tier adds the next mesh
+SEED_H = H[:6]  # the other settings' meshes too; the deep tier runs them on every mesh, the seeds one mesh further
 #: C14: a particle moves when |v_p| exceeds this fraction of the smaller sound speed of the two initial states
 MOVING_FRACTION = 0.01
 MOVING_SPEED = MOVING_FRACTION * min((sod.SodSettings.gamma * p / rho) ** 0.5 for rho, _, p in (sod.SodSettings.left,
@@ -116,7 +116,8 @@ def _plan(tier: str) -> dict:
     seed_h, seeds = q.get("SEED_H", H[:len(SEED_H) + 1] if tier == "deep" else SEED_H), q.get("SEEDS", SEEDS)
     return {
         "mpm": {h: mpm_case(h) for h in hs},
-        "settings": {(n, cfl, h): _setting_case(h, n, cfl) for n, cfl in SETTINGS for h in hs},
+        "settings": {(n, cfl, h): _setting_case(h, n, cfl) for n, cfl in SETTINGS
+                     for h in (hs if (n, cfl) == SETTINGS[0] or tier == "deep" else seed_h)},
         "seeds": {(n, cfl, h, seed): _setting_case(h, n, cfl, layout="jittered", seed=seed)
                   for n, cfl in SETTINGS for h in seed_h for seed in seeds},
         "mpm_consistent": {h: mpm_case(h, mass="consistent") for h in consistent_h},
