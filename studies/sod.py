@@ -19,10 +19,9 @@ from mpm_fem.app.plots import Curve, Plot
 from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import PositivityError
-from mpm_fem.measure import shock_tube, source
-from mpm_fem.measure.errors import orders_column
+from mpm_fem.measure import shock_tube, sod_tables, source
 from mpm_fem.measure.regions import REGION_NAMES, ExtremaCounter, describe
-from mpm_fem.measure.schema import SOD_CONVERGENCE, SOD_EXTREMA, SOD_MASS, SOD_PPC, SOD_REGIONS
+from mpm_fem.measure.schema import SOD_CONVERGENCE, SOD_EXTREMA, SOD_MASS, SOD_PPC, SOD_REGIONS, SOD_SEEDS
 from mpm_fem.problems import sod
 
 NAME = "sod"
@@ -47,7 +46,16 @@ PLATEAU_VARIANTS = {"study settings": {}, "CFL 0.025": {"cfl": 0.025}, "CFL 0.1"
                     "32 ppc": {"ppc": 32}, "viscosity x0.5": {"av_linear": 0.25, "av_quadratic": 1.0},
                     "viscosity x2": {"av_linear": 1.0, "av_quadratic": 4.0}, "USF": {"scheme": "usf"},
                     "MUSL": {"scheme": "musl"}, "GIMP": {"basis": "gimp"}, "consistent mass": {"mass": "consistent"}}
-QUICK = dict(H=H[:3], PPC_H=(0.01,), CONSISTENT_H=H[:2], PLATEAU_H=())
+#: the convergence study's MPM settings, (particles per cell, CFL): the study's own first, the source's 4-8 per
+#: cell at the study's CFL, and 4 per cell at the CLI's default CFL; each on every mesh, regular and jittered
+SETTINGS = ((MPM["ppc"], MPM["cfl"]), (8, MPM["cfl"]), (4, MPM["cfl"]), (4, sod.SodSettings.cfl))
+SEEDS = (1, 2, 3, 4, 5)  # the jittered layouts' seeds, beside the regular layout
+SEED_H = H[:6]  # the other settings' meshes too; the deep tier runs them on every mesh, the seeds one mesh further
+#: C14: a particle moves when |v_p| exceeds this fraction of the smaller sound speed of the two initial states
+MOVING_FRACTION = 0.01
+MOVING_SPEED = MOVING_FRACTION * min((sod.SodSettings.gamma * p / rho) ** 0.5 for rho, _, p in (sod.SodSettings.left,
+                                                                             sod.SodSettings.right))
+QUICK = dict(H=H[:3], PPC_H=(0.01,), CONSISTENT_H=H[:2], PLATEAU_H=(), SEED_H=H[:3])
 
 
 def run_case(case: dict) -> dict:
@@ -64,12 +72,13 @@ def run_case(case: dict) -> dict:
             return {"ok": False, "error": str(err)}
         return shock_tube.fem(r, uniform_grid(0.0, 1.0, h).lumped_mass, width, profiles)
     settings = sod.SodSettings(h=h, **{k: case[k] for k in MPM})
-    counter = ExtremaCounter(uniform_grid(0.0, 1.0, h))
+    counter = ExtremaCounter(uniform_grid(0.0, 1.0, h), moving_speed=MOVING_SPEED) if case["extrema"] else None
     try:
         result = sod.simulate(settings, progress=False, observer=counter)
     except (PositivityError, FloatingPointError) as err:
-        return {"ok": False, "error": str(err), "steps": counter.steps}
-    return shock_tube.mpm(settings, result, sod.errors(settings, result), counter.summary(), width, profiles)
+        return {"ok": False, "error": str(err), "steps": counter.steps if counter else None}
+    return shock_tube.mpm(settings, result, sod.errors(settings, result), counter and counter.summary(), width,
+                          profiles)
 
 
 def _viscosity(fem: dict) -> fem_euler.Viscosity:
@@ -77,9 +86,15 @@ def _viscosity(fem: dict) -> fem_euler.Viscosity:
 
 
 def mpm_case(h: float, **changes) -> dict:
-    """The MPM case at ``h`` with the study settings, ``changes`` applied."""
-    return {"solver": "mpm", "h": h, **MPM, **changes, "region_half_width": REGION_HALF_WIDTH,
-            "profiles": h in PROFILE_H and not changes}
+    """The MPM case at ``h`` with the study settings, ``changes`` applied; new extrema counted on a
+    regular layout (``extrema``)."""
+    case = {"solver": "mpm", "h": h, **MPM, **changes, "region_half_width": REGION_HALF_WIDTH}
+    return {**case, "profiles": h in PROFILE_H and not changes, "extrema": case["layout"] == "regular"}
+
+
+def _setting_case(h: float, ppc: int, cfl: float, **changes) -> dict:
+    """The case of one setting of :data:`SETTINGS` (the study's own case for the study's settings)."""
+    return mpm_case(h, **{k: v for k, v in dict(ppc=ppc, cfl=cfl, **changes).items() if MPM.get(k) != v})
 
 
 def fem_case(h: float, mass: str) -> dict:
@@ -98,8 +113,13 @@ def _plan(tier: str) -> dict:
     q = QUICK if tier == "quick" else {}
     hs, ppc_h = q.get("H", H + DEEP_H if tier == "deep" else H), q.get("PPC_H", PPC_H)
     consistent_h, plateau_h = q.get("CONSISTENT_H", CONSISTENT_H), q.get("PLATEAU_H", PLATEAU_H)
+    seed_h, seeds = q.get("SEED_H", H[:len(SEED_H) + 1] if tier == "deep" else SEED_H), q.get("SEEDS", SEEDS)
     return {
         "mpm": {h: mpm_case(h) for h in hs},
+        "settings": {(n, cfl, h): _setting_case(h, n, cfl) for n, cfl in SETTINGS
+                     for h in (hs if (n, cfl) == SETTINGS[0] or tier == "deep" else seed_h)},
+        "seeds": {(n, cfl, h, seed): _setting_case(h, n, cfl, layout="jittered", seed=seed)
+                  for n, cfl in SETTINGS for h in seed_h for seed in seeds},
         "mpm_consistent": {h: mpm_case(h, mass="consistent") for h in consistent_h},
         "fem_consistent": {h: fem_case(h, "consistent") for h in hs},
         "fem_lumped": {h: fem_case(h, "lumped") for h in hs},
@@ -114,84 +134,39 @@ def run(options: StudyOptions) -> None:
     """All cases in one sweep (shared ones run once), then tables and figures."""
     got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)
     folder = options.folder(NAME)
+    gas = sod.SodSettings()
     settings = {"mpm": MPM, "fem": {**FEM, "viscosity": _viscosity(FEM).name},
                 "fv": {**FV, "scheme": fv_euler.label(FV["limiter"])}, "region_half_width": REGION_HALF_WIDTH, "T": T,
-                "quick": options.quick, "problem": sod.SodSettings().as_dict()}
-    tables = {SOD_CONVERGENCE: _convergence(got), SOD_REGIONS: _regions(got), SOD_EXTREMA: _extrema(got),
-              SOD_PPC: _ppc(got), SOD_MASS: _mass(got), "plateau": _plateau(got) if got["plateau"] else []}
+                "quick": options.quick, "tier": options.tier,
+                "problem": {k: getattr(gas, k) for k in ("gamma", "left", "right", "x0", "T")}}
+    seeds = sod_tables.seed_rows(got["settings"], got["seeds"])
+    refs = (got["fem_consistent"], got["fem_lumped"])
+    tables = {SOD_CONVERGENCE: sod_tables.convergence_rows(seeds, got["settings"], *refs, got["fv"], SOURCE),
+              SOD_SEEDS: seeds, SOD_REGIONS: sod_tables.region_rows(got["settings"], *refs),
+              SOD_EXTREMA: sod_tables.extrema_rows(got["settings"]), SOD_PPC: _ppc(got), SOD_MASS: _mass(got),
+              "plateau": _plateau(got) if got["plateau"] else []}
     waves = riemann.wave_positions(T, sod.SodSettings.left, sod.SodSettings.right)
-    extra = {SOD_REGIONS.stem: {"regions": describe(REGION_HALF_WIDTH, waves, T)}, SOD_EXTREMA.stem: {
-        "rtol": 1e-9, "definition": "new strict local extremum among position-ordered particles"}}
+    runs = {"runs": {"ppc_cfl": [list(x) for x in SETTINGS], "other settings": "as in mpm",
+                     "layouts": {"regular": [0], "jittered": sorted({k[3] for k in got["seeds"]})},
+                     "jittered_meshes": sorted({k[2] for k in got["seeds"]}, reverse=True)}}
+    extra = {SOD_CONVERGENCE.stem: runs, SOD_SEEDS.stem: runs,
+             SOD_REGIONS.stem: {**runs, "regions": describe(REGION_HALF_WIDTH, waves, T)},
+             SOD_EXTREMA.stem: {**runs, "rtol": 1e-9, "moving": f"|v_p| > {MOVING_FRACTION:g} x the smaller sound "
+                                f"speed of the initial states = {MOVING_SPEED:.6g}", "definition":
+                                "new strict local extremum among position-ordered particles"},
+             SOD_PPC.stem: {"ppc": list(PPC), "other settings": "as in mpm"},
+             "plateau": {"variants": {k: v or "none" for k, v in PLATEAU_VARIANTS.items()}}}
     publish(folder, tables, settings, extra, PLOTS)
-    plots.stacked_shares(folder / "regions.png", tables[SOD_REGIONS], REGION_NAMES,
-                         f"C12: density L1 error by region of the exact solution at T = {T} "
-                         f"(half-width {REGION_HALF_WIDTH})", "share of the density L1 error (total above)")
+    shown = [r for r in tables[SOD_REGIONS] if (r["ppc"], r["cfl"]) in (("", ""), (MPM["ppc"], MPM["cfl"]))]
+    plots.stacked_shares(folder / "regions.png", shown,
+                         REGION_NAMES, f"C12: density L1 error by region of the exact solution at T = {T} "
+                         f"(half-width {REGION_HALF_WIDTH}), MPM at {MPM['ppc']} per cell",
+                         "share of the density L1 error (total above)")
     _profiles(folder, got)
 
 
 def _L1(r, where="nodes", norm="L1"):
     return r["density"][where][norm] if r["ok"] else float("nan")
-
-
-def _convergence(got) -> list[dict]:
-    hs = sorted(got["mpm"], reverse=True)
-    mpm = [got["mpm"][h] for h in hs]
-    cols = {f"{w}_{n}": [_L1(r, w, n) for r in mpm] for w in ("nodes", "particles") for n in ("L1", "L2")}
-    cols.update({f"{m}_L1": [_L1(got[m][h], where) for h in hs]
-                 for m, where in (("fem_consistent", "nodes"), ("fem_lumped", "nodes"), ("fv", "cells"))})
-    orders = {k: orders_column(hs, v) for k, v in cols.items()}
-    in_source = [h for h in hs if h in SOURCE]  # meshes finer than the source's have no source value
-    src_orders = dict(zip(in_source, orders_column(in_source, [SOURCE[h][0] for h in in_source]), strict=True))
-    rows = []
-    for k, (h, r) in enumerate(zip(hs, mpm, strict=True)):
-        s = dict(zip(("L1", "L2"), SOURCE.get(h, ("", "")), strict=True))
-        row = {"h": h, "source_L1": s["L1"], "source_L2": s["L2"], "source_order_L1": src_orders.get(h, "")}
-        for key in ("nodes_L1", "nodes_L2", "particles_L1", "particles_L2"):
-            row.update({f"mpm_{key}": cols[key][k], f"ratio_{key}": cols[key][k] / s[key[-2:]] if h in SOURCE else ""})
-            if key != "particles_L2":
-                row[f"order_{key}"] = orders[key][k]
-        for m in ("fem_consistent", "fem_lumped", "fv"):
-            row.update({f"{m}_L1": cols[f"{m}_L1"][k], f"order_{m}_L1": orders[f"{m}_L1"][k]})
-        row.update({
-            "mpm_particles_mean_error_smooth": r["mean_error"]["particles"][2] if r["ok"] else "",
-            "mpm_nodes_mean_error_smooth": r["mean_error"]["nodes"][2] if r["ok"] else "",
-            "mpm_volume_drift": r.get("volume_drift", ""), "mpm_head_shift": r.get("head_shift", ""),
-            "fem_consistent_head_shift": got["fem_consistent"][h].get("head_shift", ""),
-            "mpm_steps": r.get("steps"), "mpm_particles": r.get("particles"),
-            "mpm_wall_s": round(r.get("wall_s", float("nan")), 2), "mpm_energy_drift": r.get("energy_drift", "")})
-        rows.append(row)
-    return rows
-
-
-def _regions(got) -> list[dict]:
-    rows = []
-    for label, group, where in (("MPM nodes", "mpm", "nodes"), ("MPM particles", "mpm", "particles"),
-                                ("FEM consistent", "fem_consistent", "nodes"), ("FEM lumped", "fem_lumped", "nodes")):
-        for h, r in sorted(got[group].items(), reverse=True):
-            if r["ok"]:
-                parts, total = np.asarray(r["regions"][where]), r["density"][where]["L1"]
-                rows.append({"method": label, "h": h, "L1": total, "sum_of_regions": float(parts.sum()),
-                             **{f"L1_{k}_{n.replace(' ', '_')}": float(p)
-                                for k, (n, p) in enumerate(zip(REGION_NAMES, parts, strict=True))},
-                             **{f"share_{k}": float(p / total) for k, p in enumerate(parts)}})
-    return rows
-
-
-def _extrema(got) -> list[dict]:
-    rows = []
-    for h, r in sorted(got["mpm"].items(), reverse=True):
-        if r["ok"]:
-            x = r["extrema"]
-            row = {"h": h, "steps": x["steps"], "crossings": x["crossings"],
-                   "crossings_per_step": x["crossings"] / x["steps"]}
-            for name in ("density", "energy"):
-                f = x[name]
-                row.update({f"{name}_{k}": f[k] for k in ("new_at_crossing", "new_elsewhere", "new_per_step",
-                                                          "max_per_step", "rate_crossing", "rate_elsewhere")})
-                row[f"{name}_rate_ratio"] = (f["rate_crossing"] / f["rate_elsewhere"] if f["rate_elsewhere"]
-                                             else float("inf"))
-            rows.append(row)
-    return rows
 
 
 def _ppc(got) -> list[dict]:
@@ -238,21 +213,24 @@ def _plateau(got) -> list[dict]:
     return rows
 
 
-_STYLES = {"density": "o-", "energy": "s--"}
+_JITTERED = {"color": "tab:orange", "lw": 0.7}
+_SETTING = ("ppc", "cfl")
 PLOTS = (
-    Plot("convergence.png", f"Sod, T = {T}: density L1 error against h, beside the source's table",
-         SOD_CONVERGENCE.stem, "h", (
-        Curve("MPM, grid nodes", "mpm_nodes_L1"), Curve("MPM, particles", "mpm_particles_L1", "s-"),
-        Curve("FEM consistent", "fem_consistent_L1", "^--"), Curve("FEM lumped", "fem_lumped_L1", "v--"),
-        Curve(fv_euler.label(FV["limiter"]), "fv_L1", "x-."), Curve("source (slides)", "source_L1", "k*")),
-        ylabel="density error (L1)", slopes=(0.5, 1)),
-    Plot("extrema.png", "C14: new extrema of particle density and energy, per step and per particle-step",
-         SOD_EXTREMA.stem, "h",
-         tuple(Curve(n, f"{n}_new_per_step", f, panel="new extrema per step") for n, f in _STYLES.items())
-         + tuple(Curve(f"{n}: {who}", f"{n}_rate_{k}", f, panel="new extrema per particle-step", options=o)
-                 for n, f in _STYLES.items() for k, who, o in (("crossing", "particles crossing a node", {}),
-                                                               ("elsewhere", "other particles", {"alpha": 0.5}))),
-         ylabel="new extrema", size=(4.5, 3.6)),
+    Plot("convergence.png", f"Sod, T = {T}: density L1 error against h per setting (particles per cell, CFL), "
+         "regular layout and the range of the jittered ones, beside the source's table", SOD_CONVERGENCE.stem, "h", (
+        Curve("MPM particles, regular", "mpm_particles_L1", "s-"), Curve("MPM nodes, regular", "mpm_nodes_L1"),
+        Curve("MPM particles, jittered: mean", "jittered_particles_L1_mean", "d-", options=_JITTERED),
+        *(Curve(f"MPM particles, jittered: {k}", f"jittered_particles_L1_{k}", ":", options=_JITTERED)
+          for k in ("lo", "hi")),
+        Curve("FEM lumped", "fem_lumped_L1", "v--"), Curve(fv_euler.label(FV["limiter"]), "fv_L1", "x-."),
+        Curve("source (slides)", "source_L1", "k*")),
+        ylabel="density error (L1)", slopes=(0.5, 1), split=_SETTING, ncols=2, size=(4.6, 3.8)),
+    Plot("extrema.png", "C14: new extrema per particle-step, at particles crossing a node and at moving particles "
+         "that do not cross, per setting (particles per cell, CFL)", SOD_EXTREMA.stem, "h", tuple(
+        Curve(f"{{ppc}} ppc, CFL {{cfl}}: {who}", f"{name}_rate_{k}", fmt, panel=name, group=_SETTING)
+        for name in ("density", "energy")
+        for k, who, fmt in (("crossing", "crossing", "o-"), ("moving", "moving, not crossing", "s:"))),
+         ylabel="new extrema per particle-step", size=(4.8, 3.8)),
     Plot("ppc.png", "C3: density error against particles per cell, one line per mesh", SOD_PPC.stem, "ppc", tuple(
         Curve("h = {h}", f"{w}_L1", panel=f"over {name}", group=("h",), where={"ok": True})
         for w, name in (("nodes", "grid nodes"), ("particles", "particles"))),

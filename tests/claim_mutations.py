@@ -5,8 +5,8 @@ Usage in a test module (``tests/`` is on the path when pytest runs)::
     from claim_mutations import TABLES, judge, mutate
 
     def test_c14_follows_its_numbers():
-        fail = mutate(TABLES, "sod/extrema", density_rate_ratio=1.0)
-        ok = mutate(TABLES, "sod/extrema", density_rate_ratio=30.0)
+        fail = mutate(TABLES, "sod/extrema", density_moving_ratio=1.0)
+        ok = mutate(TABLES, "sod/extrema", density_moving_ratio=30.0)
         assert_flips("C14", fail, ok)
 
 ``mutate`` returns a copy of the tables in which the rows of one table that match ``where`` get new

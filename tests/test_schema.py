@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 from claim_mutations import TABLES
+from sod_fixture import made_up_tables
 
 from mpm_fem.app.study import publish, write_table
 from mpm_fem.measure import schema
@@ -23,7 +24,8 @@ FIGURES = Path(__file__).resolve().parent.parent / "figures"
 #: their declaration changed: the code writes them, and they join figures/ when the record is
 #: regenerated from one code version; then they leave this set (the test fails on a listed table whose
 #: committed columns already are the declared ones).
-AWAITING_RECORD = {"burgers/orders", "burgers/seeds"}
+AWAITING_RECORD = {"burgers/orders", "burgers/seeds", "sod/seeds", "sod/convergence", "sod/regions",
+                   "sod/extrema"}
 
 
 def _header(path: Path) -> list[str]:
@@ -46,6 +48,10 @@ def test_every_committed_table_has_exactly_the_declared_columns(table):
         pytest.skip(f"{table.name}: declared, not yet in the committed record")
     assert path.exists(), f"{table.name} is declared but not in figures/"
     assert table.mismatch(_header(path)) == ([], []), table.name
+
+
+def test_a_table_not_yet_committed_is_declared_and_written_by_a_study():
+    assert NOT_YET_COMMITTED <= set(schema.TABLES)
 
 
 def test_the_tables_built_from_the_json_files_have_their_declared_columns():
@@ -171,8 +177,11 @@ def _undeclared_reads(claim, tables) -> list[str]:
 
 
 def test_every_table_and_column_a_claim_reads_is_declared():
-    assert all(c.verdict(TABLES)[0] != "not measured" for c in CLAIMS)  # every criterion runs on its tables
-    found = [line for c in CLAIMS for line in _undeclared_reads(c, TABLES)]
+    """On the committed tables, the Sod tables of made-up runs in place of theirs (``sod_fixture``: the
+    study's own builders, so that a table not yet committed, or committed before its columns changed, is read)."""
+    tables = {**TABLES, **made_up_tables()}
+    assert all(c.verdict(tables)[0] != "not measured" for c in CLAIMS)  # every criterion runs on its tables
+    found = [line for c in CLAIMS for line in _undeclared_reads(c, tables)]
     assert not found, "\n".join(found)
 
 

@@ -60,24 +60,36 @@ PAGES = (
                   "d2.png"),
          )),
     Page("sod", "Sod's shock tube",
-         "Density error at the final time against the exact Riemann solution, with one set of MPM settings for every "
-         "mesh (recorded in the JSON beside each table), over particles and over grid nodes, beside P1 FEM with "
-         "consistent and lumped mass and a finite-volume reference on the same mesh, and beside the source's table.",
+         "Density and internal energy error at the final time against the exact Riemann solution, for each setting of "
+         "particles per cell and CFL number on every mesh (the same on every mesh, recorded in the JSON beside each "
+         "table), with the regular particle layout and jittered ones (one row per run in the seeds table), over "
+         "particles and over grid nodes, beside P1 FEM with consistent and lumped mass and a finite-volume reference "
+         "on the same mesh, and beside the source's table. An order's range is the range of the orders of every seed "
+         "run on both meshes, the regular layout included.",
          views=(
-             View("sod/convergence", "Density L1 against h, beside the source", (
-                 "h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "source_order_L1",
-                 "mpm_particles_L1", "order_particles_L1", "fem_consistent_L1", "fem_lumped_L1", "fv_L1",
-                 "order_fv_L1"), {}, "convergence.png"),
+             View("sod/convergence", "Particle density and energy L1 per setting: the regular layout, the jittered "
+                  "layouts' mean and range, and each order's range over the seeds", (
+                      "ppc", "cfl", "h", "mpm_particles_L1", "order_particles_L1", "jittered_particles_L1_mean",
+                      "jittered_particles_L1_lo", "jittered_particles_L1_hi", "order_particles_L1_lo",
+                      "order_particles_L1_hi", "mpm_energy_L1", "order_energy_L1", "order_energy_L1_lo",
+                      "order_energy_L1_hi"), {}, "convergence.png"),
+             View("sod/convergence", "Nodal density L1 per setting beside the source's table, the fixed-mesh FEM and "
+                  "the finite-volume reference", (
+                      "ppc", "cfl", "h", "source_L1", "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1",
+                      "order_nodes_L1_lo", "order_nodes_L1_hi", "source_order_L1", "fem_lumped_L1",
+                      "order_fem_lumped_L1", "fv_L1", "order_fv_L1")),
              View("sod/convergence", "What sets the floor: volume gained by the particles, relative drift of the "
                   "total energy, signed mean error in the smooth region, position error of the rarefaction head", (
-                      "h", "mpm_volume_drift", "mpm_energy_drift", "mpm_particles_mean_error_smooth",
+                      "ppc", "cfl", "h", "mpm_volume_drift", "mpm_energy_drift", "mpm_particles_mean_error_smooth",
                       "mpm_nodes_mean_error_smooth", "mpm_head_shift", "fem_consistent_head_shift")),
-             View("sod/regions", "Share of the L1 error by region of the exact solution",
-                  ("method", "h", "L1") + tuple(f"share_{k}" for k in range(len(REGION_NAMES))), {}, "regions.png"),
-             View("sod/extrema", "New extrema per step, at cell crossings and elsewhere", (
-                 "h", "steps", "crossings_per_step", "density_new_per_step", "density_rate_crossing",
-                 "density_rate_elsewhere", "density_rate_ratio", "energy_new_per_step", "energy_rate_ratio"), {},
-                  "extrema.png"),
+             View("sod/regions", "Share of the nodal L1 error by region of the exact solution, per setting",
+                  ("ppc", "cfl", "h", "L1") + tuple(f"share_{k}" for k in range(len(REGION_NAMES))),
+                  {"method": "MPM nodes"}, "regions.png"),
+             View("sod/extrema", "New extrema per particle-step at particles crossing a node, at moving particles that "
+                  "do not cross and at every particle that does not cross", (
+                      "ppc", "cfl", "h", "crossings_per_step", "moving_share", "density_new_per_step",
+                      "density_rate_crossing", "density_rate_moving", "density_moving_ratio", "density_rate_ratio",
+                      "energy_rate_crossing", "energy_rate_moving", "energy_moving_ratio"), {}, "extrema.png"),
              View("sod/ppc", "Error against particles per cell", ("h", "ppc", "ok", "nodes_L1", "particles_L1"), {},
                   "ppc.png"),
              View("sod/mass", "Lumped against consistent mass, MPM and FEM"),

@@ -25,7 +25,10 @@ particles in position order, particle ``p`` is a strict local extremum of a fiel
 (the first and last particle are never extrema). A *new* extremum in a step is a particle that
 is an extremum after the step and was not before it. :class:`ExtremaCounter` counts them each
 step, separately for the particles that crossed a cell boundary in that step (cell of ``x_p^n``
-differs from the cell of ``x_p^{n+1}``) and for those that did not.
+differs from the cell of ``x_p^{n+1}``) and for those that did not; among the latter, separately
+again for the *moving* ones, ``|v_p^{n+1}| > v_min`` (``moving_speed``): a particle at rest ahead of
+the waves never crosses and never becomes an extremum, so the comparison that isolates the crossing
+is between crossing particles and moving particles that do not cross.
 """
 
 from __future__ import annotations
@@ -201,19 +204,23 @@ def _extrema_in_particle_order(q: np.ndarray, x: np.ndarray, rtol: float) -> np.
 @dataclass(eq=False)
 class ExtremaCounter:
     """An observer for :func:`mpm_fem.core.solve.run` that counts new extrema of density and energy
-    per step (module docstring). After the run, :meth:`summary` gives the totals. It keeps no
-    particles (``keeps_particles``): a run may hand it arrays it overwrites two steps later."""
+    per step (module docstring), at crossings, at the other particles and at the other particles
+    that move faster than ``moving_speed``. After the run, :meth:`summary` gives the totals. It keeps
+    no particles (``keeps_particles``): a run may hand it arrays it overwrites two steps later."""
 
     keeps_particles = False  # a class attribute, not a field: what solve.run asks of an observer
 
     grid: Grid
     rtol: float = 1e-9
     fields: tuple = ("density", "energy")
+    moving_speed: float = 0.0
     steps: int = 0
     crossings: int = 0
     particle_steps: int = 0
+    moving_staying: int = 0
     new_crossing: dict = field(default_factory=dict)
     new_staying: dict = field(default_factory=dict)
+    new_moving: dict = field(default_factory=dict)
     per_step_max: dict = field(default_factory=dict)
     _last: tuple | None = field(default=None, repr=False)
 
@@ -228,8 +235,10 @@ class ExtremaCounter:
         after = {n: _extrema_in_particle_order(getattr(new, n), new.x, self.rtol) for n in self.fields}
         self._last = (new, new_cell, after)
         crossed = old_cell != new_cell
+        moving = ~crossed & (np.abs(new.velocity) > self.moving_speed)
         self.steps += 1
         self.crossings += int(np.count_nonzero(crossed))
+        self.moving_staying += int(np.count_nonzero(moving))
         self.particle_steps += new.n
         for name in self.fields:
             fresh = after[name] & ~before[name]
@@ -237,21 +246,27 @@ class ExtremaCounter:
             at_crossing = int(np.count_nonzero(fresh & crossed)) if total else 0
             self.new_crossing[name] = self.new_crossing.get(name, 0) + at_crossing
             self.new_staying[name] = self.new_staying.get(name, 0) + total - at_crossing
+            self.new_moving[name] = self.new_moving.get(name, 0) + (int(np.count_nonzero(fresh & moving))
+                                                                    if total else 0)
             self.per_step_max[name] = max(self.per_step_max.get(name, 0), total)
 
     def summary(self) -> dict:
-        """Totals over the run and rates: new extrema per crossing and per non-crossing particle-step."""
+        """Totals over the run and rates: new extrema per crossing particle-step, per non-crossing
+        particle-step and per moving non-crossing particle-step (``rate_moving``)."""
         staying = self.particle_steps - self.crossings
-        out = {"steps": self.steps, "crossings": self.crossings, "particle_steps": self.particle_steps}
+        out = {"steps": self.steps, "crossings": self.crossings, "particle_steps": self.particle_steps,
+               "moving_speed": self.moving_speed, "moving_steps": self.moving_staying}
         for name in self.fields:
-            c, s = self.new_crossing.get(name, 0), self.new_staying.get(name, 0)
+            c, s, m = self.new_crossing.get(name, 0), self.new_staying.get(name, 0), self.new_moving.get(name, 0)
             out[name] = {
                 "new_at_crossing": c,
                 "new_elsewhere": s,
+                "new_moving": m,
                 "new_per_step": (c + s) / max(self.steps, 1),
                 "max_per_step": self.per_step_max.get(name, 0),
                 "rate_crossing": c / max(self.crossings, 1),
                 "rate_elsewhere": s / max(staying, 1),
+                "rate_moving": m / max(self.moving_staying, 1),
             }
         return out
 

@@ -78,24 +78,34 @@ PROJECTION_D2_CONSTANT = Table("projection/d2_constant", (
 
 # ----------------------------------------------------------------------------- Sod (C3, C11, C12, C14, C15, E3)
 
+#: One row per setting (``ppc``, ``cfl``) and mesh: the regular layout's errors (``mpm_*``, ``order_*``) beside
+#: the source's table, the jittered layouts' mean and range (``jittered_<q>_mean|lo|hi``) and each order's mean
+#: and range over every seed run on both meshes (``order_<q>_mean|lo|hi``), FEM and FV on the same mesh.
 SOD_CONVERGENCE = Table("sod/convergence", (
-    "h", "source_L1", "source_L2", "source_order_L1",
+    "ppc", "cfl", "h", "source_L1", "source_L2", "source_order_L1",
     "mpm_nodes_L1", "ratio_nodes_L1", "order_nodes_L1", "mpm_nodes_L2", "ratio_nodes_L2", "order_nodes_L2",
     "mpm_particles_L1", "ratio_particles_L1", "order_particles_L1", "mpm_particles_L2", "ratio_particles_L2",
+    "mpm_energy_L1", "order_energy_L1", "seeds",
+    *(f"{kind}_{q}_{stat}" for q in ("particles_L1", "energy_L1", "nodes_L1") for kind in ("jittered", "order")
+      for stat in ("mean", "lo", "hi")),
     "fem_consistent_L1", "order_fem_consistent_L1", "fem_lumped_L1", "order_fem_lumped_L1", "fv_L1", "order_fv_L1",
     "mpm_particles_mean_error_smooth", "mpm_nodes_mean_error_smooth", "mpm_volume_drift", "mpm_head_shift",
     "fem_consistent_head_shift", "mpm_steps", "mpm_particles", "mpm_wall_s", "mpm_energy_drift"))
+#: One row per MPM run of the convergence study: the regular layout (seed 0) and the jittered ones.
+SOD_SEEDS = Table("sod/seeds", (
+    "h", "ppc", "cfl", "layout", "seed", "ok", "particles_L1", "particles_L2", "nodes_L1", "nodes_L2", "energy_L1",
+    "volume_drift", "steps", "error"))
+#: ``ppc`` and ``cfl`` empty for the fixed-mesh FEM.
 SOD_REGIONS = Table("sod/regions", (
-    "method", "h", "L1", "sum_of_regions",
+    "method", "ppc", "cfl", "h", "L1", "sum_of_regions",
     "L1_0_undisturbed", "L1_1_rarefaction_head", "L1_2_smooth", "L1_3_rarefaction_tail", "L1_4_contact",
     "L1_5_behind_shock", "L1_6_shock_front",
     "share_0", "share_1", "share_2", "share_3", "share_4", "share_5", "share_6"))
 SOD_EXTREMA = Table("sod/extrema", (
-    "h", "steps", "crossings", "crossings_per_step",
-    "density_new_at_crossing", "density_new_elsewhere", "density_new_per_step", "density_max_per_step",
-    "density_rate_crossing", "density_rate_elsewhere", "density_rate_ratio",
-    "energy_new_at_crossing", "energy_new_elsewhere", "energy_new_per_step", "energy_max_per_step",
-    "energy_rate_crossing", "energy_rate_elsewhere", "energy_rate_ratio"))
+    "ppc", "cfl", "h", "steps", "crossings", "crossings_per_step", "moving_speed", "moving_share",
+    *(f"{name}_{k}" for name in ("density", "energy") for k in (
+        "new_at_crossing", "new_elsewhere", "new_moving", "new_per_step", "max_per_step", "rate_crossing",
+        "rate_elsewhere", "rate_moving", "rate_ratio", "moving_ratio"))))
 SOD_PPC = Table("sod/ppc", (
     "h", "ppc", "ok", "nodes_L1", "nodes_L2", "particles_L1", "particles_L2", "steps", "wall_s", "error"))
 SOD_MASS = Table("sod/mass", (
@@ -177,7 +187,7 @@ SETTINGS = Table("settings", ("table", "key", "value"))
 #: Every declared table a study writes, by name.
 TABLES: dict[str, Table] = {t.name: t for t in (
     PROJECTION_ORDERS, PROJECTION_BOUNDS, PROJECTION_D2_CONSTANT,
-    SOD_CONVERGENCE, SOD_REGIONS, SOD_EXTREMA, SOD_PPC, SOD_MASS,
+    SOD_CONVERGENCE, SOD_SEEDS, SOD_REGIONS, SOD_EXTREMA, SOD_PPC, SOD_MASS,
     BURGERS_ORDERS, BURGERS_SEEDS, BURGERS_PPC, BURGERS_LUMPING, BURGERS_DIAGNOSIS,
     TIME_ORDER, TIME_LOCAL_ERROR, TIME_CROSSING_SUMMARY,
     BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,

@@ -3,8 +3,9 @@
 The density error ``e = rho - rho_exact(x, t)`` against the exact Riemann solution at the points of
 each method (particles with weights ``V_p``, grid nodes with ``int S_i dx``, cells with ``h``), its
 norms (:mod:`mpm_fem.measure.errors`), its L1 and signed mean by region of the exact solution (C12,
-:mod:`mpm_fem.measure.regions`), and the position error of the rarefaction head. Every result is a
-JSON-able dict, as a sweep stores it.
+:mod:`mpm_fem.measure.regions`), and the position error of the rarefaction head. At the particles
+also the specific internal energy error ``e_p - p(x_p)/((gamma - 1) rho(x_p))`` (weights ``V_p``).
+Every result is a JSON-able dict, as a sweep stores it.
 """
 
 from __future__ import annotations
@@ -22,6 +23,12 @@ def exact_density(x, t: float = SodSettings.T):
     return riemann.sample(x, t, SodSettings.left, SodSettings.right, x0=0.5, gamma=1.4)[0]
 
 
+def exact_energy(x, t: float = SodSettings.T, gamma: float = 1.4):
+    """The exact specific internal energy ``p / ((gamma - 1) rho)`` of Sod's tube at ``x`` and ``t``."""
+    rho, _, p = riemann.sample(x, t, SodSettings.left, SodSettings.right, x0=0.5, gamma=gamma)
+    return p / ((gamma - 1.0) * rho)
+
+
 def measure(x, rho, weights, t: float, half_width: float) -> tuple[np.ndarray, dict]:
     """The density error at ``x`` and its ``{"L1", "mean"}`` by region of half-width ``half_width``."""
     e = rho - exact_density(x, t)
@@ -34,8 +41,9 @@ def _profile(values: dict) -> dict:
 
 
 def mpm(settings: SodSettings, result, errors: dict, extrema: dict, half_width: float, profiles: bool) -> dict:
-    """An MPM run measured: norms over particles and nodes (``errors``, from the problem), the error
-    by region at both, the new extrema counted during the run, the particles' volume gain, the
+    """An MPM run measured: norms over particles and nodes (``errors``, from the problem), the norms
+    of the particles' internal energy error (``energy``), the error by region at both, the new
+    extrema counted during the run (``extrema``: ``None`` when not counted), the particles' volume gain, the
     relative drift of the total energy (:func:`mpm_fem.problems.sod.conservation`), the head shift at
     the nodes and, when asked for, the profiles."""
     P, g, t = result.particles, result.grid, result.t
@@ -43,6 +51,7 @@ def mpm(settings: SodSettings, result, errors: dict, extrema: dict, half_width: 
              "nodes": measure(g.nodes, result.nodal_density, g.lumped_mass, t, half_width)[1]}
     out = {"ok": True, "steps": result.steps, "wall_s": result.wall_s, "particles": int(P.n),
            **{k: errors[k] for k in ("density", "velocity", "pressure")},
+           "energy": {"particles": norms(P.energy - exact_energy(P.x, t, settings.gamma), P.volume)},
            "regions": {k: s["L1"] for k, s in split.items()}, "mean_error": {k: s["mean"] for k, s in split.items()},
            "extrema": extrema, "volume_drift": float(P.volume.sum() - 1.0),
            "energy_drift": conservation(settings, result)["relative_change"]["energy"],

@@ -1,0 +1,140 @@
+"""The Sod claims C11, C12, C14 and E3 follow their numbers: made-up runs (``sod_fixture``) turned into
+the study's tables, perturbed to pass and to fail (mutation tests), judged per setting, with the
+headline on the settings the source prescribes and an order counted only when its range over the
+seeds lies on one side of a threshold."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from claim_mutations import judge, mutate
+from sod_fixture import MESHES, diverging, extrema, made_up_tables
+
+from mpm_fem.measure.claims import sod as criteria
+from mpm_fem.measure.spread import Spread
+from studies import sod as study
+
+FINEST = MESHES[-1]
+
+
+def _model(particles, nodes=None, fem=lambda h: 1.1 * h, noise=0.02, only=None):
+    """Errors ``particles(h)`` (the energy three times it), ``nodes(h)`` and ``fem(h)``, a relative deviation
+    per seed and mesh within ``noise``; ``only`` a setting (ppc, cfl) that takes this model, the others
+    :func:`diverging`."""
+    nodes = nodes or particles
+
+    def model(quantity, ppc, cfl, h, seed):
+        if only is not None and quantity != "fem" and (ppc, cfl) != only:
+            return diverging(quantity, ppc, cfl, h, seed)
+        value = {"particles": particles, "energy": lambda x: 3 * particles(x), "nodes": nodes, "fem": fem}[quantity](h)
+        return value * (1.0 + (0.0 if seed in (None, 0) else noise * math.sin(7.0 * seed + 3.0 * math.log(h))))
+    return model
+
+
+def _levelling(h):
+    return 0.001 + 0.5 * h
+
+
+@pytest.fixture(scope="module")
+def tables():
+    return made_up_tables()
+
+
+# ----------------------------------------------------------------------------- C11
+
+def test_trend_reads_the_range_of_the_last_orders():
+    def orders(*ranges):
+        return [Spread((lo + hi) / 2, lo, hi, 6) for lo, hi in ranges]
+    assert criteria.trend(orders((0.9, 1.0), (-0.6, -0.4), (-0.7, -0.2))) == "diverges"
+    assert criteria.trend(orders((0.9, 1.0), (-0.3, 0.2), (-0.7, -0.2))) == "stops converging"
+    assert criteria.trend(orders((0.9, 1.0), (0.8, 0.9), (0.75, 1.1))) == "converges"
+    assert criteria.trend(orders((0.9, 1.0), (0.3, 0.6), (-0.7, -0.2))) == "undecided"  # 0.6 straddles 0.5
+    assert criteria.trend(orders((0.9, 1.0), (0.6, 0.8), (0.8, 0.9))) == "undecided"  # 0.6 below 0.7
+
+
+def test_c11_confirms_a_particle_error_that_grows_and_says_it_diverges(tables):
+    verdict, evidence = judge("C11", tables)
+    assert verdict == "confirmed"
+    assert evidence.startswith("particle density at 4-8 per cell: diverges (8 ppc at CFL 0.05)")
+    assert "nodal density stops converging" in evidence and "-0.51 [-0.55, -0.46]" in evidence
+    assert evidence.count("ppc, CFL") == len(study.SETTINGS)  # one clause per setting
+
+
+def test_c11_says_stops_converging_for_a_level_error_and_is_refuted_by_convergence():
+    level = made_up_tables(_model(_levelling))
+    verdict, evidence = judge("C11", level)
+    assert verdict == "confirmed" and "particle density stops converging" in evidence
+    assert "diverges" not in evidence
+    converging = made_up_tables(_model(lambda h: 1.2 * h))
+    assert judge("C11", converging)[0] == "refuted"
+
+
+def test_c11_counts_an_order_only_when_its_range_over_the_seeds_is_below_the_floor(tables):
+    """One jittered run perturbed on the finest mesh widens the last order's range across the floor."""
+    smaller = lambda r: float(r["particles_L1"]) / 8  # noqa: E731
+    perturbed = mutate(tables, "sod/seeds", {"h": FINEST, "seed": 3}, particles_L1=smaller)
+    assert judge("C11", perturbed)[0] == "partly"
+    noisy = made_up_tables(_model(_levelling, noise=0.4))  # the seeds scatter by 40%: no order is decided
+    assert judge("C11", noisy)[0] == "partly"
+
+
+def test_c11_headline_is_the_verdict_on_the_prescribed_settings():
+    one_converges = made_up_tables(_model(lambda h: 1.2 * h, only=(4, 0.1)))
+    verdict, evidence = judge("C11", one_converges)
+    assert verdict == "partly" and "4 ppc, CFL 0.1: refuted" in evidence and "8 ppc, CFL 0.05: confirmed" in evidence
+    study_setting = made_up_tables(_model(lambda h: 1.2 * h, only=(16, 0.05)))  # not a setting the source prescribes
+    verdict, evidence = judge("C11", study_setting)
+    assert verdict == "confirmed" and "16 ppc, CFL 0.05: refuted" in evidence
+
+
+def test_c11_needs_five_meshes_and_six_runs_on_each():
+    assert judge("C11", made_up_tables(meshes=MESHES[:4]))[0] == "not measured"
+    assert judge("C11", made_up_tables(seeds=study.SEEDS[:4]))[0] == "not measured"
+
+
+# ----------------------------------------------------------------------------- E3
+
+def test_e3_is_confirmed_when_mpm_stays_within_a_constant_factor_of_fem():
+    constant = made_up_tables(_model(lambda h: 2.2 * h, nodes=lambda h: 1.5 * h))
+    verdict, evidence = judge("E3", constant)
+    assert verdict == "confirmed" and "particles x0.99 [0.97, 1.03] (constant)" in evidence
+    assert "FV: FV MUSCL-HLLC (MC); FEM: viscosity everywhere" in evidence
+
+
+def test_e3_names_the_error_that_grows(tables):
+    verdict, evidence = judge("E3", tables)  # MPM's particle error grows below h = 0.00125, FEM's falls
+    assert verdict == "refuted" and "(MPM's grows)" in evidence
+    fem_worse = made_up_tables(_model(lambda h: 50 * h ** 2, fem=lambda h: 0.1 * h ** 0.5))
+    assert judge("E3", fem_worse)[0] == "refuted" and "(FEM's grows)" in judge("E3", fem_worse)[1]
+
+
+def test_e3_counts_a_change_only_when_its_range_over_the_seeds_is_decided():
+    # MPM over FEM grows by (0.01 / 0.0003125)^0.117 = 1.5 at the finest mesh: the seeds straddle the factor
+    straddling = made_up_tables(_model(lambda h: 2.0 * h ** 0.883 * 0.01 ** 0.117, noise=0.1))
+    assert judge("E3", straddling)[0] == "partly"
+
+
+# ----------------------------------------------------------------------------- C12, C14
+
+def test_c12_follows_the_share_of_the_waves_per_setting(tables):
+    assert judge("C12", tables)[0] == "confirmed"
+    fewer = mutate(tables, "sod/regions", {"method": "MPM nodes", "h": FINEST}, share_1=0.0, share_6=0.0)
+    assert judge("C12", fewer)[0] == "partly"
+    none = mutate(tables, "sod/regions", {"method": "MPM nodes"}, share_1=0.0, share_6=0.0)
+    assert judge("C12", none)[0] == "differs"
+    only_16 = mutate(tables, "sod/regions", {"method": "MPM nodes", "ppc": 16}, share_1=0.0, share_6=0.0)
+    verdict, evidence = judge("C12", only_16)
+    assert verdict == "confirmed" and "16 ppc, CFL 0.05: differs" in evidence
+
+
+def test_c14_compares_crossing_particles_with_moving_ones():
+    """Particles at rest make no extrema: against every non-crossing particle the crossing rate looks
+    five times larger, against the moving ones it is 1.5x, below the threshold."""
+    weak = made_up_tables(counter=lambda: extrema(crossing=0.0015, moving=0.001))
+    verdict, evidence = judge("C14", weak)
+    assert verdict == "refuted", evidence
+    assert float(weak["sod/extrema"][0]["density_rate_ratio"]) == pytest.approx(5.0)
+    assert judge("C14", made_up_tables())[0] == "confirmed"
+    some = mutate(made_up_tables(), "sod/extrema", {"ppc": 4}, density_moving_ratio=1.5)
+    assert judge("C14", some)[0] == "partly"
