@@ -51,7 +51,7 @@ def test_every_committed_table_has_exactly_the_declared_columns(table):
 
 
 def test_a_table_not_yet_committed_is_declared_and_written_by_a_study():
-    assert NOT_YET_COMMITTED <= set(schema.TABLES)
+    assert AWAITING_RECORD <= set(schema.TABLES)
 
 
 def test_the_tables_built_from_the_json_files_have_their_declared_columns():
