@@ -50,9 +50,10 @@ METHODS = {  # name: (label, solver, settings, the source's row it stands beside
 SEEDS, SEEDED = (1, 2, 3, 4, 5), (*CALCULATED.values(), "mpm_exact_dt_h")
 _MORE = ("mpm_calculated_8", "mpm_calculated_16")  # on the default solution only
 # The meshes of each method, by tier: a calculated-acceleration run costs ~ ppc eps / h^3, so the
-# deep tier takes every method and seed to every mesh of the source's table; the full tier every
-# mesh for the rows compared with the source, and all but the finest for 8 and 16 per cell and the
-# calculated acceleration's seeds (16 per cell reaches h = 0.00125 at the seeds' eps only).
+# deep tier takes every method and seed to every mesh of the source's table; the full tier takes every
+# mesh for the rows compared with the source, all but the finest for 8 per cell and the calculated
+# acceleration's seeds, and 16 per cell to the third mesh (its regular layout one mesh further at the
+# seeds' eps: "headline", the meshes of the seeds' eps where they differ).
 MESHES = {
     "deep": {
         "default": {m: H for m in METHODS},
@@ -61,9 +62,10 @@ MESHES = {
     },
     "full": {
         "default": {**{m: H[:3] for m in METHODS}, "mpm_calculated": H, "mpm_calculated_8": H[:4], "mpm_exact_dt_h": H},
+        "headline": {"mpm_calculated_16": H[:4]},
         "other": {**{m: H[:3] for m in METHODS if m not in _MORE}, "mpm_exact_dt_h": H,
                   "fem_consistent": H[:2], "fem_lumped": H[:2]},
-        "seeds": {**{m: H[:4] for m in SEEDED}, "mpm_exact_dt_h": H},
+        "seeds": {**{m: H[:4] for m in SEEDED}, "mpm_calculated_16": H[:3], "mpm_exact_dt_h": H},
     },
 }
 _MPM = ("mpm_calculated", "mpm_exact")
@@ -135,8 +137,9 @@ def _plan(tier: str) -> dict:
     kept = lambda m, h: m not in skip and not (quick and (h not in q["H"] or (m in q["short"] and h not in q["H"][:2])))  # noqa: E731
     return {
         "table": {(s, m, e, h): method_case(m, s, e, h) for s in q.get("solutions", SOLUTIONS)
-                  for m, hs in meshes["default" if s == DEFAULT else "other"].items()
-                  for e in eps_list for h in hs if kept(m, h)},
+                  for m, hs in meshes["default" if s == DEFAULT else "other"].items() for e in eps_list
+                  for h in (meshes.get("headline", {}).get(m, hs) if (s, e) == (DEFAULT, EPS[0]) else hs)
+                  if kept(m, h)},
         "profile": {(m, e): {**method_case(m, DEFAULT, e, PROFILE_H), "profile": True}
                     for e in (EPS[0], EPS[-1]) if e in eps_list for m in METHODS if m not in skip},
         "timestep": {(m, e, k): method_case(m, DEFAULT, e, time_h, **({"refine": k} if k > 1 else {}))
