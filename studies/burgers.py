@@ -23,7 +23,6 @@ from mpm_fem.measure import burgers_tables as tables
 from mpm_fem.measure import source
 from mpm_fem.measure.claims import BURGERS_SHOWN
 from mpm_fem.measure.schema import BURGERS_DIAGNOSIS, BURGERS_LUMPING, BURGERS_ORDERS, BURGERS_PPC, BURGERS_SEEDS
-from mpm_fem.measure.seeds import LEVEL
 from mpm_fem.problems import burgers
 
 NAME = "burgers"
@@ -79,7 +78,8 @@ DIAGNOSIS = {  # label: changes to the calculated-acceleration run
 }
 QUICK = dict(solutions=(DEFAULT,), eps=(0.045, 0.01), H=H[:3], skip=_MORE[1:], short=("mpm_exact", "fem_consistent",
              "fem_lumped"), PPC=(2, 4, 8, 16), PPC_H=(0.01,), TIME_H=0.01, time_eps=(0.045,),
-             time_methods=("mpm_calculated", "mpm_exact_dt_h"), lumping_H=H[:2], diagnosis_H=(), seeds=SEEDS[:2])
+             time_methods=("mpm_calculated", "mpm_exact_dt_h"), lumping_H=H[:2], diagnosis_H=(), seeds=SEEDS[:1],
+             seeds_H=H[:2])
 
 
 def run_case(case: dict) -> dict:
@@ -154,7 +154,7 @@ def _plan(tier: str) -> dict:
         "diagnosis": {(label, h): method_case("mpm_calculated", DEFAULT, EPS[0], h, **changes)
                       for h in q.get("diagnosis_H", H[:3]) for label, changes in DIAGNOSIS.items()},
         "seeds": {(m, EPS[0], h, layout, seed): method_case(m, DEFAULT, EPS[0], h, layout=layout, seed=seed)
-                  for m, hs in meshes["seeds"].items() for h in hs if kept(m, h)
+                  for m, hs in meshes["seeds"].items() for h in q.get("seeds_H", hs) if h in hs and kept(m, h)
                   for layout, seed in (("regular", 0), *(("jittered", k) for k in q.get("seeds", SEEDS)))},
     }
 
@@ -184,16 +184,10 @@ def run(options: StudyOptions) -> None:
             BURGERS_PPC: tables.ppc_rows(got["ppc"], EPS[0], WHERE, NORM),
             BURGERS_LUMPING: tables.lumping_rows(got["lumping"], EPS[0], WHERE),
             BURGERS_DIAGNOSIS: tables.diagnosis_rows(got["diagnosis"], DIAGNOSIS, EPS[0], WHERE)}
-    seeded = {"layouts": {"regular": f"seed {MPM['seed']}: the midpoints of N_p equal sub-cells of every cell",
-                          "jittered": "each regular point moved uniformly within its sub-cell (numpy "
-                                      "default_rng(seed)); every particle's volume h/N_p"},
-              "seeds": sorted({k[4] for k in got["seeds"]}), "eps": EPS[0], "solution": DEFAULT,
-              "meshes": tables.meshes_of({(k[0], k[2]) for k in got["seeds"]})}
+    seeded = {"layouts": tables.LAYOUTS, "seeds": sorted({k[4] for k in got["seeds"]}), "eps": EPS[0],
+              "solution": DEFAULT, "meshes": tables.meshes_of({(k[0], k[2]) for k in got["seeds"]})}
     extra = {"errors": {"meshes": tables.meshes_of({(f"{k[0]}/{k[1]}", k[3]) for k in got["table"]})},
-             BURGERS_ORDERS.stem: {"seeds": seeded, "interval": "fitted_lo, fitted_hi: the least and largest of the "
-                                   "runs' fitted orders on runs_h_range; fitted_t_lo, fitted_t_hi: the Student-t "
-                                   f"interval of their mean at level {LEVEL}"},
-             BURGERS_SEEDS.stem: seeded,
+             BURGERS_ORDERS.stem: {"seeds": seeded, "interval": tables.INTERVAL}, BURGERS_SEEDS.stem: seeded,
              "timestep": {"h": time_h, "refine": list(REFINE),
                           "meaning": "time_error = |E(dt) - E(dt/16)|; time_below_space: time error < E(dt/16) "
                                      "(the space error)"},
