@@ -23,7 +23,6 @@ from mpm_fem.measure import burgers_tables as tables
 from mpm_fem.measure import source
 from mpm_fem.measure.claims import BURGERS_SHOWN
 from mpm_fem.measure.schema import BURGERS_DIAGNOSIS, BURGERS_LUMPING, BURGERS_ORDERS, BURGERS_PPC, BURGERS_SEEDS
-from mpm_fem.measure.seeds import LEVEL
 from mpm_fem.problems import burgers
 
 NAME = "burgers"
@@ -50,9 +49,10 @@ METHODS = {  # name: (label, solver, settings, the source's row it stands beside
 SEEDS, SEEDED = (1, 2, 3, 4, 5), (*CALCULATED.values(), "mpm_exact_dt_h")
 _MORE = ("mpm_calculated_8", "mpm_calculated_16")  # on the default solution only
 # The meshes of each method, by tier: a calculated-acceleration run costs ~ ppc eps / h^3, so the
-# deep tier takes every method and seed to every mesh of the source's table; the full tier every
-# mesh for the rows compared with the source, and all but the finest for 8 and 16 per cell and the
-# calculated acceleration's seeds (16 per cell reaches h = 0.00125 at the seeds' eps only).
+# deep tier takes every method and seed to every mesh of the source's table; the full tier takes every
+# mesh for the rows compared with the source, all but the finest for 8 per cell and the calculated
+# acceleration's seeds, and 16 per cell to the third mesh (its regular layout one mesh further at the
+# seeds' eps: "headline", the meshes of the seeds' eps where they differ).
 MESHES = {
     "deep": {
         "default": {m: H for m in METHODS},
@@ -61,9 +61,10 @@ MESHES = {
     },
     "full": {
         "default": {**{m: H[:3] for m in METHODS}, "mpm_calculated": H, "mpm_calculated_8": H[:4], "mpm_exact_dt_h": H},
+        "headline": {"mpm_calculated_16": H[:4]},
         "other": {**{m: H[:3] for m in METHODS if m not in _MORE}, "mpm_exact_dt_h": H,
                   "fem_consistent": H[:2], "fem_lumped": H[:2]},
-        "seeds": {**{m: H[:4] for m in SEEDED}, "mpm_exact_dt_h": H},
+        "seeds": {**{m: H[:4] for m in SEEDED}, "mpm_calculated_16": H[:3], "mpm_exact_dt_h": H},
     },
 }
 _MPM = ("mpm_calculated", "mpm_exact")
@@ -77,7 +78,8 @@ DIAGNOSIS = {  # label: changes to the calculated-acceleration run
 }
 QUICK = dict(solutions=(DEFAULT,), eps=(0.045, 0.01), H=H[:3], skip=_MORE[1:], short=("mpm_exact", "fem_consistent",
              "fem_lumped"), PPC=(2, 4, 8, 16), PPC_H=(0.01,), TIME_H=0.01, time_eps=(0.045,),
-             time_methods=("mpm_calculated", "mpm_exact_dt_h"), lumping_H=H[:2], diagnosis_H=(), seeds=SEEDS[:2])
+             time_methods=("mpm_calculated", "mpm_exact_dt_h"), lumping_H=H[:2], diagnosis_H=(), seeds=SEEDS[:1],
+             seeds_H=H[:2])
 
 
 def run_case(case: dict) -> dict:
@@ -135,8 +137,9 @@ def _plan(tier: str) -> dict:
     kept = lambda m, h: m not in skip and not (quick and (h not in q["H"] or (m in q["short"] and h not in q["H"][:2])))  # noqa: E731
     return {
         "table": {(s, m, e, h): method_case(m, s, e, h) for s in q.get("solutions", SOLUTIONS)
-                  for m, hs in meshes["default" if s == DEFAULT else "other"].items()
-                  for e in eps_list for h in hs if kept(m, h)},
+                  for m, hs in meshes["default" if s == DEFAULT else "other"].items() for e in eps_list
+                  for h in (meshes.get("headline", {}).get(m, hs) if (s, e) == (DEFAULT, EPS[0]) else hs)
+                  if kept(m, h)},
         "profile": {(m, e): {**method_case(m, DEFAULT, e, PROFILE_H), "profile": True}
                     for e in (EPS[0], EPS[-1]) if e in eps_list for m in METHODS if m not in skip},
         "timestep": {(m, e, k): method_case(m, DEFAULT, e, time_h, **({"refine": k} if k > 1 else {}))
@@ -151,7 +154,7 @@ def _plan(tier: str) -> dict:
         "diagnosis": {(label, h): method_case("mpm_calculated", DEFAULT, EPS[0], h, **changes)
                       for h in q.get("diagnosis_H", H[:3]) for label, changes in DIAGNOSIS.items()},
         "seeds": {(m, EPS[0], h, layout, seed): method_case(m, DEFAULT, EPS[0], h, layout=layout, seed=seed)
-                  for m, hs in meshes["seeds"].items() for h in hs if kept(m, h)
+                  for m, hs in meshes["seeds"].items() for h in q.get("seeds_H", hs) if h in hs and kept(m, h)
                   for layout, seed in (("regular", 0), *(("jittered", k) for k in q.get("seeds", SEEDS)))},
     }
 
@@ -181,16 +184,10 @@ def run(options: StudyOptions) -> None:
             BURGERS_PPC: tables.ppc_rows(got["ppc"], EPS[0], WHERE, NORM),
             BURGERS_LUMPING: tables.lumping_rows(got["lumping"], EPS[0], WHERE),
             BURGERS_DIAGNOSIS: tables.diagnosis_rows(got["diagnosis"], DIAGNOSIS, EPS[0], WHERE)}
-    seeded = {"layouts": {"regular": f"seed {MPM['seed']}: the midpoints of N_p equal sub-cells of every cell",
-                          "jittered": "each regular point moved uniformly within its sub-cell (numpy "
-                                      "default_rng(seed)); every particle's volume h/N_p"},
-              "seeds": sorted({k[4] for k in got["seeds"]}), "eps": EPS[0], "solution": DEFAULT,
-              "meshes": tables.meshes_of({(k[0], k[2]) for k in got["seeds"]})}
+    seeded = {"layouts": tables.LAYOUTS, "seeds": sorted({k[4] for k in got["seeds"]}), "eps": EPS[0],
+              "solution": DEFAULT, "meshes": tables.meshes_of({(k[0], k[2]) for k in got["seeds"]})}
     extra = {"errors": {"meshes": tables.meshes_of({(f"{k[0]}/{k[1]}", k[3]) for k in got["table"]})},
-             BURGERS_ORDERS.stem: {"seeds": seeded, "interval": "fitted_lo, fitted_hi: the least and largest of the "
-                                   "runs' fitted orders on runs_h_range; fitted_t_lo, fitted_t_hi: the Student-t "
-                                   f"interval of their mean at level {LEVEL}"},
-             BURGERS_SEEDS.stem: seeded,
+             BURGERS_ORDERS.stem: {"seeds": seeded, "interval": tables.INTERVAL}, BURGERS_SEEDS.stem: seeded,
              "timestep": {"h": time_h, "refine": list(REFINE),
                           "meaning": "time_error = |E(dt) - E(dt/16)|; time_below_space: time error < E(dt/16) "
                                      "(the space error)"},

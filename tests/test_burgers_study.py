@@ -285,7 +285,8 @@ def test_every_json_records_the_settings_used(written):
             recorded = settings["methods"][m]["settings"]
             assert {k: case[k] for k in recorded} == recorded, (path.name, m)
     seeds = json.loads((written / "seeds.json").read_text())["settings"]
-    assert seeds["seeds"] == [0, *study.SEEDS] and seeds["meshes"]["mpm_calculated_16"] == list(study.H[:4])
+    assert seeds["seeds"] == [0, *study.SEEDS]
+    assert seeds["meshes"] == {m: list(hs) for m, hs in study.MESHES["full"]["seeds"].items()}
     assert json.loads((written / "ppc.json").read_text())["settings"]["eps"] == study.EPS[0]
 
 

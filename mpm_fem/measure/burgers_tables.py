@@ -18,11 +18,18 @@ import numpy as np
 
 from mpm_fem.measure import source
 from mpm_fem.measure.errors import fitted_order, observed_orders, orders_row
-from mpm_fem.measure.seeds import order_spread, spread
+from mpm_fem.measure.seeds import LEVEL, order_spread, spread
 
 WHERES, NORMS = ("particles", "nodes"), ("L1", "L2", "max")
 #: The errors whose spread over the runs of a seeded setting the errors table carries (besides the compared one).
 SPREAD_ERRORS = ("particles_L1", "nodes_L1")
+#: The particle layouts (``mpm_fem.core.particles.seed_positions``) and the orders' intervals, as the
+#: JSON beside the seeded tables states them.
+LAYOUTS = {"regular": "the midpoints of N_p equal sub-cells of every cell (no random draw)",
+           "jittered": "each regular point moved uniformly within its sub-cell (numpy default_rng(seed)); every "
+                       "particle's volume h/N_p"}
+INTERVAL = ("fitted_lo, fitted_hi: the least and largest of the runs' fitted orders on runs_h_range; fitted_t_lo, "
+            f"fitted_t_hi: the Student-t interval of their mean at level {LEVEL}")
 
 
 def value(r: dict, where: str, norm: str) -> float:

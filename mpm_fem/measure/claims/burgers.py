@@ -77,10 +77,10 @@ def _c13(t: Tables) -> tuple[str, str]:
     """An order is the least-squares slope of the error against h, fitted per run; its interval is the
     range over the runs of the regular and the jittered particle layouts, and only an interval on one side
     of the threshold counts. With the exact acceleration and dt ~ h the O(dt) error of the time step sets
-    the order; with the viscous time step the exact acceleration's order is higher. The last clause reads
-    the diagnosis table (when the study wrote one): each change to the calculated-acceleration run, one at
-    a time on the regular layout, by whether its particles' error grows, stalls or falls as h shrinks; it
-    names no cause beyond what these changes show."""
+    the order; beside it, the evidence gives the exact acceleration's order with the viscous time step
+    (dt ~ h^2; one run per eps). The last clause reads the diagnosis table (when the study wrote one):
+    each change to the calculated-acceleration run, one at a time on the regular layout, by whether its
+    particles' error grows, stalls or falls as h shrinks; it names no cause beyond what these changes show."""
     rows = select(t[BURGERS_ORDERS.name], **BURGERS_SHOWN)
     exact = c13_order(rows, C13_EXACT)
     calc = {n: c13_order(rows, m) for n, m in C13_CALCULATED.items()}
@@ -123,8 +123,9 @@ def diagnosis_text(rows: list[dict]) -> str:
             + "; ".join(f"the error {b} with {', '.join(v)}" for b, v in groups.items()))
     base, slides = of.get(repr({})), of.get(repr({"force": "slides"}))
     if base and slides and not base.startswith("falls") and not slides.startswith("falls"):
-        text += (f"; with the slides' second-difference force, which sums no particle stresses, the error {slides} "
-                 f"as with the weak force ({base}): the particle quadrature of the force is not the only cause")
+        text += (f"; with the slides' second-difference force, which sums no particle stresses, the error {slides}"
+                 + ("" if slides == base else f" (with the weak force: {base})")
+                 + ": the particle quadrature of the force is not the only cause")
     return text
 
 
