@@ -66,7 +66,13 @@ def test_every_embedded_figure_is_at_most_two_and_a_half_wide(committed):
 
     from mpm_fem.app.plots import MAX_ASPECT
 
+    # a study whose tables an older code wrote keeps that code's figures: E4 reports the lag
+    from mpm_fem.measure.version import code_version
+
+    current = {r["table"].split("/")[0] for r in load_tables(FIGURES)["versions"] if r["code"] == code_version()}
     for target in re.findall(r"!\[[^]]*\]\(([^)]+)\)", committed):
+        if target.split("/")[0] not in current:
+            continue
         height, width = image.imread(FIGURES / target).shape[:2]
         assert width <= MAX_ASPECT * height * 1.01, (target, width, height)
 
