@@ -212,9 +212,16 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
     out.append("- These tables come from `mpm-fem reproduce --quick`: a subset of the meshes of each study."
                if is_quick(tables) else "- These tables come from `mpm-fem reproduce --full`.")
     written = code_version(tables)
+    rows = tables.get("versions", [])
+    behind = sorted({r["table"].split("/")[0] for r in rows if r["code"] != current})
     if current is not None and current != written:
         out.append(f"- **The figures lag the code**: the tables were written by code version {written}, the code "
                    f"is now {current}; `mpm-fem reproduce --full` regenerates them.")
+    elif current is not None and behind:
+        out.append(f"- **Part of the figures lag the code**: {len(rows) - sum(r['code'] != current for r in rows)} "
+                   f"of {len(rows)} tables come from the current code ({current}); the studies "
+                   f"{', '.join(behind)} still hold tables of an older code (the versions table, E4); "
+                   "`mpm-fem reproduce --full` regenerates them.")
     elif current is not None:
         out.append(f"- The tables were written by the current code ({written}).")
     setting = {r["key"]: r["value"] for r in tables.get("settings", []) if r["table"] == "sod/convergence"}
