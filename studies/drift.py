@@ -67,8 +67,9 @@ VARIANTS = {
     "32 ppc": {"ppc": 32},
     "grid volume": {"volume": "grid"},
 }
-#: Deep tier only (``"V + dt int dv/dx"`` shows the domain rate in the full tier).
-DEEP_VARIANTS = ("domain rate, rho(1-dt D)",)
+#: Deep tier only: the full tier shows the domain rate with ``"V + dt int dv/dx"`` and the forms of the
+#: density update with ``"rho/(1+dt L)"`` (the study's cost in the full tier).
+DEEP_VARIANTS = ("rho exp(-dt L)", "domain rate, rho(1-dt D)")
 #: The layouts beside the regular one: jittered, seeds SEEDS, on the meshes SEED_H, for the variants
 #: SEEDED (the deep tier adds DEEP_SEEDED, and DEEP_H to the seeded meshes).
 SEEDS = (1, 2, 3, 4, 5)
@@ -118,28 +119,36 @@ def _cost(c: dict) -> float:
     return c["ppc"] / (c["h"] ** 2 * c["cfl"]) * (5.0 if c["kernel"] == "numpy" else 1.0)
 
 
-def _plan(tier: str) -> dict:
-    """``{"drift": {(h, variant, layout, seed): case}}``: every variant on the regular layout on every
-    mesh of the tier, and the seeded variants on the jittered layouts of SEEDS."""
+def _config(tier: str) -> dict:
+    """What the tier runs: the variants and meshes on the regular layout, the seeded variants, their
+    seeds and meshes."""
     q = QUICK if tier == "quick" else {}
     deep = tier == "deep"
-    names = [n for n in VARIANTS if deep or n not in DEEP_VARIANTS]
-    hs = q.get("H", H + DEEP_H if deep else H)
-    seeded = q.get("SEEDED", SEEDED + DEEP_SEEDED if deep else SEEDED)
-    seed_h = q.get("SEED_H", SEED_H + DEEP_H if deep else SEED_H)
-    plan = {(h, n, "regular", 0): case(h, n) for n in names for h in hs}
-    plan.update({(h, n, "jittered", s): case(h, n, "jittered", s) for n in seeded for s in q.get("SEEDS", SEEDS)
-                 for h in seed_h})
+    return {"variants": [n for n in VARIANTS if deep or n not in DEEP_VARIANTS],
+            "h": list(q.get("H", H + DEEP_H if deep else H)),
+            "jittered": {"variants": list(q.get("SEEDED", SEEDED + DEEP_SEEDED if deep else SEEDED)),
+                         "seeds": list(q.get("SEEDS", SEEDS)), "h": list(q.get("SEED_H", SEED_H + DEEP_H if deep
+                                                                                   else SEED_H))}}
+
+
+def _plan(tier: str) -> dict:
+    """``{"drift": {(h, variant, layout, seed): case}}``: every variant of the tier on the regular layout
+    on every mesh of the tier, and the seeded variants on the jittered layouts (:func:`_config`)."""
+    c = _config(tier)
+    j = c["jittered"]
+    plan = {(h, n, "regular", 0): case(h, n) for n in c["variants"] for h in c["h"]}
+    plan.update({(h, n, "jittered", s): case(h, n, "jittered", s) for n in j["variants"] for s in j["seeds"]
+                 for h in j["h"]})
     return {"drift": plan}
 
 
 def run(options: StudyOptions) -> None:
     got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)["drift"]
     rows, folder = table(got), options.folder(NAME)
-    publish(folder, {DRIFT: rows}, {"mpm": MPM, "variants": {k: v or "none" for k, v in VARIANTS.items()},
-                                    "jittered": {"seeds": list(SEEDS), "h": list(SEED_H), "deep_h": list(DEEP_H),
-                                                 "variants": list(SEEDED), "deep_variants": list(DEEP_SEEDED)},
-                                    "quick": options.quick, "T": sod.SodSettings.T})
+    config = _config(options.tier)
+    publish(folder, {DRIFT: rows}, {"mpm": MPM, "tier": options.tier, **config,
+                                    "changes": {n: VARIANTS[n] or "none" for n in config["variants"]},
+                                    "T": sod.SodSettings.T})
     figure(folder, rows)
 
 

@@ -173,6 +173,16 @@ def test_the_plan_per_tier_and_the_kernels():
             k: v for k, v in drift.MPM.items() if k not in drift.VARIANTS[name] and k not in ("layout", "seed")}
 
 
+def test_the_settings_recorded_are_the_tiers():
+    for tier in ("quick", "full", "deep"):
+        c, plan = drift._config(tier), drift._plan(tier)["drift"]
+        assert {(h, n) for h, n, layout, _ in plan if layout == "regular"} == {
+            (h, n) for h in c["h"] for n in c["variants"]}
+        j = c["jittered"]
+        assert {k for k in plan if k[2] == "jittered"} == {
+            (h, n, "jittered", s) for h in j["h"] for n in j["variants"] for s in j["seeds"]}
+
+
 def _got(hs=(0.01, 0.005), seeds=(1, 2)) -> dict:
     rng = np.random.default_rng(0)
     got = {(h, n, "regular", 0): {"ok": True, "particles_L1": float(rng.uniform(1e-3, 1e-2)), "nodes_L1": 1e-3,
@@ -314,6 +324,17 @@ def test_the_jittered_clause_counts_an_order_only_when_every_seed_agrees():
     assert "reduced on every seed" in mechanism(_tables(jittered={**JITTERED, "grid volume": halved}))
     flat = {s: (e[0], e[0] * 0.99) for s, e in JITTERED["grid volume"].items()}
     assert "removed on every seed by: grid volume" in mechanism(_tables(jittered={**JITTERED, "grid volume": flat}))
+    assert ("There the growth outlasts the drift: grid volume grows on every seed at |drift| at most 0.01, below "
+            f"the {STUDY}' least 0.01") not in text  # the same drift in the fixture: nothing to say
+    low = _tables(jittered=JITTERED)
+    for r in low[DRIFT.name]:
+        if r["variant"] == "grid volume" and r["layout"] == "jittered":
+            r["volume_drift"] = "1e-06"
+    assert ("There the growth outlasts the drift: grid volume grows on every seed at |drift| at most 1e-06, below "
+            f"the {STUDY}' least 0.01.") in mechanism(low)
+    falling = {s: (e[0], e[0] * 0.8) for s, e in JITTERED[STUDY].items()}
+    text = mechanism(_tables(jittered={**JITTERED, STUDY: falling}))
+    assert f"{STUDY} {_order(1.0, 0.8):.2f} (grows on no seed" in text and "): no growth to remove." in text
     mixed = {**JITTERED[STUDY], 5: (0.0173, 0.0150)}
     assert "growth is not resolved over seeds" in mechanism(_tables(jittered={**JITTERED, STUDY: mixed}))
 
