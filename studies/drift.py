@@ -23,9 +23,14 @@ The density-update and volume-rate options run in the numpy step only
 which takes the same steps as the numpy step (to round-off on a uniform grid). Neither option
 changes the motion (:mod:`mpm_fem.core.models.euler`): their nodal error is the study settings'.
 
+Layouts: every variant runs the regular layout (the study settings'); the seeded variants also run
+jittered layouts (``SEEDS``, on ``SEED_H``), which show how far an order from one layout resolves
+growth (the ``layout`` and ``seed`` columns).
+
 The issue names ``figures/sod/drift.csv``: the table lives in its own study folder,
 ``figures/drift/``, so that no two studies write one folder (each study's tables, JSON and case
-cache are its own). The full tier runs ``H``; the deep tier adds ``DEEP_H`` for every variant.
+cache are its own). The full tier runs ``H``; the deep tier adds ``DEEP_H`` for every variant, the
+``DEEP_VARIANTS`` on every mesh, and the ``DEEP_SEEDED`` variants' seeds.
 """
 
 from __future__ import annotations
@@ -62,7 +67,16 @@ VARIANTS = {
     "32 ppc": {"ppc": 32},
     "grid volume": {"volume": "grid"},
 }
-QUICK = dict(H=(0.01, 0.005))
+#: Deep tier only: the full tier shows the domain rate with ``"V + dt int dv/dx"`` and the forms of the
+#: density update with ``"rho/(1+dt L)"`` (the study's cost in the full tier).
+DEEP_VARIANTS = ("rho exp(-dt L)", "domain rate, rho(1-dt D)")
+#: The layouts beside the regular one: jittered, seeds SEEDS, on the meshes SEED_H, for the variants
+#: SEEDED (the deep tier adds DEEP_SEEDED, and DEEP_H to the seeded meshes).
+SEEDS = (1, 2, 3, 4, 5)
+SEED_H = (0.00125, 0.000625)
+SEEDED = (STUDY, "grid volume")
+DEEP_SEEDED = ("V + dt int dv/dx",)
+QUICK = dict(H=(0.01, 0.005), SEED_H=(0.01, 0.005), SEEDS=SEEDS[:2], SEEDED=(STUDY,))
 
 
 def _settings(case: dict) -> sod.SodSettings:
@@ -79,11 +93,11 @@ def run_case(case: dict) -> dict:
     settings = _settings(case)
     grid = uniform_grid(*sod.DOMAIN, settings.h)
     problem = solve.Problem(model=_model(case), boundary=Walls(), T=settings.T, cfl=settings.cfl,
-                      exact=sod.exact_fields(settings))
+                            exact=sod.exact_fields(settings))
     stages = dataclasses.replace(settings.stages, volume_rate=case["volume_rate"])
     try:
         result = solve.run(problem, grid, sod.initial_particles(settings, grid), stages, progress=False,
-                     kernel=settings.kernel)
+                           kernel=settings.kernel)
     except (PositivityError, FloatingPointError) as err:
         return {"ok": False, "error": str(err)}
     density = sod.errors(settings, result)["density"]
@@ -92,10 +106,10 @@ def run_case(case: dict) -> dict:
             "wall_s": result.wall_s}
 
 
-def case(h: float, name: str) -> dict:
-    """The case of variant ``name`` at ``h``: the study settings, the variant's changes, and the kernel
-    that can take it (the fused one unless :func:`mpm_fem.core.step.numpy_only` says otherwise)."""
-    c = {"h": h, **MPM, "volume": "carried", **OFF, **VARIANTS[name]}
+def case(h: float, name: str, layout: str = "regular", seed: int = 0) -> dict:
+    """The case of variant ``name`` at ``h`` on a layout: the study settings, the variant's changes, and
+    the kernel that can take it (the fused one unless :func:`mpm_fem.core.step.numpy_only` says otherwise)."""
+    c = {"h": h, **MPM, "volume": "carried", **OFF, **VARIANTS[name], "layout": layout, "seed": seed}
     stages = dataclasses.replace(_settings({**c, "kernel": "fused"}).stages, volume_rate=c["volume_rate"])
     return {**c, "kernel": "numpy" if numpy_only(_model(c), stages) else "fused"}
 
@@ -105,31 +119,56 @@ def _cost(c: dict) -> float:
     return c["ppc"] / (c["h"] ** 2 * c["cfl"]) * (5.0 if c["kernel"] == "numpy" else 1.0)
 
 
+def _config(tier: str) -> dict:
+    """What the tier runs: the variants and meshes on the regular layout, the seeded variants, their
+    seeds and meshes."""
+    q = QUICK if tier == "quick" else {}
+    deep = tier == "deep"
+    return {"variants": [n for n in VARIANTS if deep or n not in DEEP_VARIANTS],
+            "h": list(q.get("H", H + DEEP_H if deep else H)),
+            "jittered": {"variants": list(q.get("SEEDED", SEEDED + DEEP_SEEDED if deep else SEEDED)),
+                         "seeds": list(q.get("SEEDS", SEEDS)), "h": list(q.get("SEED_H", SEED_H + DEEP_H if deep
+                                                                                   else SEED_H))}}
+
+
 def _plan(tier: str) -> dict:
-    hs = QUICK["H"] if tier == "quick" else H + DEEP_H if tier == "deep" else H
-    return {"drift": {(h, name): case(h, name) for name in VARIANTS for h in hs}}
+    """``{"drift": {(h, variant, layout, seed): case}}``: every variant of the tier on the regular layout
+    on every mesh of the tier, and the seeded variants on the jittered layouts (:func:`_config`)."""
+    c = _config(tier)
+    j = c["jittered"]
+    plan = {(h, n, "regular", 0): case(h, n) for n in c["variants"] for h in c["h"]}
+    plan.update({(h, n, "jittered", s): case(h, n, "jittered", s) for n in j["variants"] for s in j["seeds"]
+                 for h in j["h"]})
+    return {"drift": plan}
 
 
 def run(options: StudyOptions) -> None:
     got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)["drift"]
     rows, folder = table(got), options.folder(NAME)
-    publish(folder, {DRIFT: rows}, {"mpm": MPM, "variants": {k: v or "none" for k, v in VARIANTS.items()},
-                                    "quick": options.quick, "T": sod.SodSettings.T})
+    config = _config(options.tier)
+    publish(folder, {DRIFT: rows}, {"mpm": MPM, "tier": options.tier, **config,
+                                    "changes": {n: VARIANTS[n] or "none" for n in config["variants"]},
+                                    "T": sod.SodSettings.T})
     figure(folder, rows)
 
 
 def table(got: dict) -> list[dict]:
-    """The rows of ``drift.csv`` from ``{(h, variant): result}``: by variant, then by decreasing h."""
+    """The rows of ``drift.csv`` from ``{(h, variant, layout, seed): result}``: by variant, layout and
+    seed, then by decreasing h; orders between successive meshes of one series, the ratio to the study
+    settings on the same mesh and layout."""
     rows = []
-    for name in VARIANTS:
-        series = sorted(((h, r) for (h, n), r in got.items() if n == name), key=lambda hr: -hr[0])
+    series = dict.fromkeys((n, layout, seed) for n in VARIANTS for (_, v, layout, seed) in sorted(got, key=_order)
+                           if v == n)
+    for name, layout, seed in series:
+        runs = sorted(((h, r) for (h, n, lay, s), r in got.items() if (n, lay, s) == (name, layout, seed)),
+                      key=lambda hr: -hr[0])
         out = []
-        for h, r in series:
-            c = case(h, name)
-            row = {"h": h, "variant": name, "change": str(VARIANTS[name]) if VARIANTS[name] else "none",
-                   "kernel": c["kernel"], "ok": r["ok"], "steps": r.get("steps", "")}
+        for h, r in runs:
+            row = {"h": h, "variant": name, "layout": layout, "seed": seed,
+                   "change": str(VARIANTS[name]) if VARIANTS[name] else "none",
+                   "kernel": case(h, name, layout, seed)["kernel"], "ok": r["ok"], "steps": r.get("steps", "")}
             if r["ok"]:
-                base = got.get((h, STUDY), {})
+                base = got.get((h, STUDY, layout, seed), {})
                 row.update(particles_L1=r["particles_L1"], nodes_L1=r["nodes_L1"], volume_drift=r["volume_drift"],
                            abs_volume_drift=abs(r["volume_drift"]),
                            particles_vs_study=r["particles_L1"] / base["particles_L1"] if base.get("ok") else "")
@@ -145,6 +184,12 @@ def table(got: dict) -> list[dict]:
     return rows
 
 
+def _order(key: tuple) -> tuple:
+    """Regular before jittered, then by seed."""
+    _, _, layout, seed = key
+    return layout != "regular", seed
+
+
 _PANELS = (("particles_L1", "particle density L1"), ("nodes_L1", "nodal density L1"),
            ("abs_volume_drift", "|sum of particle volumes - 1|"))
 #: Line style per variant: the study settings black, the density forms dashed, the volume rate solid,
@@ -158,7 +203,8 @@ CAPTION = ("C11's mechanism: Sod's particle density L1 error, nodal density L1 e
 
 def figure(folder, rows: list[dict]) -> None:
     """``drift.png``: three log-log panels against h (particle L1, nodal L1, ``|sum_p V_p - 1|``), one
-    line per variant (:data:`STYLES`), the legend in the fourth place of the grid."""
+    line per variant on the regular layout (:data:`STYLES`), its jittered seeds as dots of its colour,
+    the legend in the fourth place of the grid."""
     import matplotlib.pyplot as plt
     from matplotlib.ticker import NullFormatter
 
@@ -166,16 +212,22 @@ def figure(folder, rows: list[dict]) -> None:
 
     fig, axes = plt.subplots(2, 2, figsize=(9.6, 7.6))
     for name in VARIANTS:
-        series = sorted((r for r in rows if r["variant"] == name and r["ok"]), key=lambda r: r["h"])
+        ok = [r for r in rows if r["variant"] == name and r["ok"]]
+        line = sorted((r for r in ok if r["layout"] == "regular"), key=lambda r: r["h"])
+        dots = [r for r in ok if r["layout"] != "regular"]
         for ax, (y, _) in zip(axes.ravel(), _PANELS, strict=False):
-            ax.loglog([r["h"] for r in series], [r[y] for r in series], STYLES.get(name, "o-"), ms=4, lw=1.1,
-                      mfc="none", label=name)
+            drawn = ax.loglog([r["h"] for r in line], [r[y] for r in line], STYLES.get(name, "o-"), ms=4, lw=1.1,
+                              mfc="none", label=name)
+            if dots:
+                ax.loglog([r["h"] for r in dots], [r[y] for r in dots], ".", ms=3, alpha=0.6,
+                          color=drawn[0].get_color() if drawn else None)
     for ax, (_, title) in zip(axes.ravel(), _PANELS, strict=False):
         ax.set(title=title, xlabel="h")
         ax.title.set_fontsize(9)
         ax.xaxis.set_minor_formatter(NullFormatter())
     axes[1, 1].axis("off")
-    axes[1, 1].legend(*axes[0, 0].get_legend_handles_labels(), loc="center", fontsize=8, title="variant")
+    axes[1, 1].legend(*axes[0, 0].get_legend_handles_labels(), loc="center", fontsize=8,
+                      title="variant, regular layout (dots: jittered seeds)", title_fontsize=8)
     plots.save(fig, folder / "drift.png", CAPTION)
 
 

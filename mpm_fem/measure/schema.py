@@ -174,10 +174,10 @@ REMEDIES_ERRORS = Table("remedies/errors", (
 
 # ----------------------------------------------------------------------------- drift (C11's mechanism)
 
-#: One row per variant and mesh; ``error`` only when a run failed (its row then has no errors).
+#: One row per variant, layout, seed and mesh; ``error`` only when a run failed (its row then has no errors).
 DRIFT = Table("drift/drift", (
-    "h", "variant", "change", "kernel", "ok", "particles_L1", "nodes_L1", "volume_drift", "abs_volume_drift",
-    "particles_vs_study", "order_particles_L1", "order_nodes_L1", "steps"), optional=("error",))
+    "h", "variant", "layout", "seed", "change", "kernel", "ok", "particles_L1", "nodes_L1", "volume_drift",
+    "abs_volume_drift", "particles_vs_study", "order_particles_L1", "order_nodes_L1", "steps"), optional=("error",))
 
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
