@@ -18,8 +18,9 @@ from mpm_fem.measure.claims import STATEMENTS
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"
 TABLES = {
-    "sod/convergence.csv": (("h",),
+    "sod/convergence.csv": (("ppc", "cfl", "h"),
                             ("mpm_nodes_L1", "mpm_particles_L1", "fem_lumped_L1", "fem_consistent_L1", "fv_L1")),
+    "sod/seeds.csv": (("ppc", "cfl", "h", "layout", "seed"), ("particles_L1", "nodes_L1", "energy_L1")),
     "burgers/errors.csv": (("solution", "method", "eps", "h"), ("particles_L1", "particles_max", "nodes_L1")),
     "projection/errors.csv": (("quantity", "layout", "weights", "basis", "N_p", "h", "norm", "seeds"), ("value",)),
     "budget/subsets.csv": (("problem", "h", "basis", "norm", "mpm_stages"), ("error",)),
