@@ -157,10 +157,11 @@ def _c11(t: Tables) -> tuple[str, str]:
                                 + ", ".join(density) + "; " + _settings_text(verdicts, lines))
 
 
-def _density_trend(rows: list[dict], setting: tuple, verdict: str) -> str:
+def _density_trend(rows: list[dict], ppc_cfl: tuple, verdict: str) -> str:
+    """The particle density's trend for one setting (``not measured`` when its verdict is)."""
     if verdict == "not measured":
         return verdict
-    return _trends(select(rows, ppc=setting[0], cfl=setting[1]))["particle density"][0]
+    return _trends(select(rows, ppc=ppc_cfl[0], cfl=ppc_cfl[1]))["particle density"][0]
 
 
 @claim("C12", source="regions 1 and 3 rarefaction edges, 4 contact, 6 shock front, 2 smooth, 5 behind the shock",
