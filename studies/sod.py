@@ -1,9 +1,11 @@
 """Sod's shock tube: MPM beside fixed-mesh FEM, a finite-volume reference and the exact solution.
 
-Density error at T against the exact Riemann solution on every mesh of the source's table, with one
-set of MPM settings for every mesh (``MPM``), over particles and over grid nodes (``m_i / int S_i``).
-Tables: ``convergence`` (C11, E3), ``regions`` (C12), ``extrema`` (C14), ``ppc`` (C3), ``mass``
-(C15), ``plateau`` (what moves the floor: one setting changed at a time).
+Density (and, at the particles, internal energy) error at T against the exact Riemann solution on every
+mesh of the source's table, over particles and over grid nodes (``m_i / int S_i``), for each setting of
+:data:`SETTINGS` (particles per cell, CFL; the same on every mesh), with the regular particle layout and
+the jittered ones of :data:`SEEDS`. Tables: ``seeds`` (one row per run) and ``convergence`` (per setting
+and mesh, the spread over seeds; C11, E3), ``regions`` (C12), ``extrema`` (C14), ``ppc`` (C3), ``mass``
+(C15), ``plateau`` (what moves the floor: one setting of the study's own, :data:`MPM`, changed at a time).
 """
 
 from __future__ import annotations
@@ -46,21 +48,22 @@ PLATEAU_VARIANTS = {"study settings": {}, "CFL 0.025": {"cfl": 0.025}, "CFL 0.1"
                     "32 ppc": {"ppc": 32}, "viscosity x0.5": {"av_linear": 0.25, "av_quadratic": 1.0},
                     "viscosity x2": {"av_linear": 1.0, "av_quadratic": 4.0}, "USF": {"scheme": "usf"},
                     "MUSL": {"scheme": "musl"}, "GIMP": {"basis": "gimp"}, "consistent mass": {"mass": "consistent"}}
-#: the convergence study's MPM settings, (particles per cell, CFL): the study's own first, the source's 4-8 per
-#: cell at the study's CFL, and 4 per cell at the CLI's default CFL; each on every mesh, regular and jittered
+#: the convergence study's MPM settings, (particles per cell, CFL): the study's own first (on every mesh), the
+#: source's 4-8 per cell at the study's CFL and 4 per cell at the CLI's default CFL (down to the last of SEED_H)
 SETTINGS = ((MPM["ppc"], MPM["cfl"]), (8, MPM["cfl"]), (4, MPM["cfl"]), (4, sod.SodSettings.cfl))
-SEEDS = (1, 2, 3, 4, 5)  # the jittered layouts' seeds, beside the regular layout
-SEED_H = H[:6]  # the other settings' meshes too; the deep tier runs them on every mesh, the seeds one mesh further
+SEEDS = (1, 2, 3, 4, 5)  # the jittered layouts' seeds, beside the regular layout (seed 0)
+SEED_H = H[:6]  # the jittered layouts' meshes; the deep tier: one mesh further, and every setting on every mesh
 #: C14: a particle moves when |v_p| exceeds this fraction of the smaller sound speed of the two initial states
 MOVING_FRACTION = 0.01
-MOVING_SPEED = MOVING_FRACTION * min((sod.SodSettings.gamma * p / rho) ** 0.5 for rho, _, p in (sod.SodSettings.left,
-                                                                             sod.SodSettings.right))
+_GAS = sod.SodSettings()
+MOVING_SPEED = MOVING_FRACTION * min((_GAS.gamma * p / rho) ** 0.5 for rho, _, p in (_GAS.left, _GAS.right))
 QUICK = dict(H=H[:3], PPC_H=(0.01,), CONSISTENT_H=H[:2], PLATEAU_H=(), SEED_H=H[:3])
 
 
 def run_case(case: dict) -> dict:
     """One run, measured (:mod:`mpm_fem.measure.shock_tube`): ``case["solver"]`` is ``"mpm"`` (keys of
-    :data:`MPM` and ``h``), ``"fem"`` (``h``, ``mass`` and the keys of :data:`FEM`) or ``"fv"``."""
+    :data:`MPM` and ``h``; ``extrema``: count new extrema, :class:`ExtremaCounter`), ``"fem"`` (``h``,
+    ``mass`` and the keys of :data:`FEM`) or ``"fv"``."""
     h, width, profiles = case["h"], case.get("region_half_width"), case.get("profiles", False)
     if case["solver"] == "fv":
         return shock_tube.fv(fv_euler.solve(h, cfl=case["cfl"], limiter=case["limiter"]), h)
@@ -134,11 +137,10 @@ def run(options: StudyOptions) -> None:
     """All cases in one sweep (shared ones run once), then tables and figures."""
     got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)
     folder = options.folder(NAME)
-    gas = sod.SodSettings()
     settings = {"mpm": MPM, "fem": {**FEM, "viscosity": _viscosity(FEM).name},
                 "fv": {**FV, "scheme": fv_euler.label(FV["limiter"])}, "region_half_width": REGION_HALF_WIDTH, "T": T,
                 "quick": options.quick, "tier": options.tier,
-                "problem": {k: getattr(gas, k) for k in ("gamma", "left", "right", "x0", "T")}}
+                "problem": {k: getattr(_GAS, k) for k in ("gamma", "left", "right", "x0", "T")}}
     seeds = sod_tables.seed_rows(got["settings"], got["seeds"])
     refs = (got["fem_consistent"], got["fem_lumped"])
     tables = {SOD_CONVERGENCE: sod_tables.convergence_rows(seeds, got["settings"], *refs, got["fv"], SOURCE),
@@ -213,11 +215,11 @@ def _plateau(got) -> list[dict]:
     return rows
 
 
-_JITTERED = {"color": "tab:orange", "lw": 0.7}
+_JITTERED = {"color": "tab:purple", "lw": 0.7}
 _SETTING = ("ppc", "cfl")
 PLOTS = (
-    Plot("convergence.png", f"Sod, T = {T}: density L1 error against h per setting (particles per cell, CFL), "
-         "regular layout and the range of the jittered ones, beside the source's table", SOD_CONVERGENCE.stem, "h", (
+    Plot("convergence.png", f"Sod, T = {T}: density L1 against h per setting, the regular layout and the jittered "
+         "ones (mean, range), beside the source's table", SOD_CONVERGENCE.stem, "h", (
         Curve("MPM particles, regular", "mpm_particles_L1", "s-"), Curve("MPM nodes, regular", "mpm_nodes_L1"),
         Curve("MPM particles, jittered: mean", "jittered_particles_L1_mean", "d-", options=_JITTERED),
         *(Curve(f"MPM particles, jittered: {k}", f"jittered_particles_L1_{k}", ":", options=_JITTERED)

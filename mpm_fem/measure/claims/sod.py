@@ -150,10 +150,17 @@ def _c11(t: Tables) -> tuple[str, str]:
     the next mesh, the regular layout being seed 0; the range over seeds holds the order of every layout."""
     rows = t[SEEDS]
     verdicts, lines = _per_setting(_c11_setting, rows, t[CONVERGENCE])
-    density = [f"{_trends(select(rows, ppc=n, cfl=c))['particle density'][0]} ({n} ppc at CFL {c:g})"
-               for n, c in verdicts if _prescribed(n)]
+    density = [f"{_density_trend(rows, k, verdicts[k])} ({k[0]} ppc at CFL {k[1]:g})" for k in verdicts
+               if _prescribed(k[0])]
     return headline(verdicts), (f"particle density at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell: "
                                 + ", ".join(density) + "; " + _settings_text(verdicts, lines))
+
+
+def _density_trend(rows: list[dict], ppc_cfl: tuple, verdict: str) -> str:
+    """The particle density's trend for one setting (``not measured`` when its verdict is)."""
+    if verdict == "not measured":
+        return verdict
+    return _trends(select(rows, ppc=ppc_cfl[0], cfl=ppc_cfl[1]))["particle density"][0]
 
 
 @claim("C12", source="regions 1 and 3 rarefaction edges, 4 contact, 6 shock front, 2 smooth, 5 behind the shock",
@@ -163,8 +170,14 @@ def _c11(t: Tables) -> tuple[str, str]:
                   f"partly, on none -> differs. Headline: the settings with {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} "
                   "particles per cell, their common verdict, partly when they differ")
 def _c12(t: Tables) -> tuple[str, str]:
-    verdicts, lines = _per_setting(_c12_setting, select(t[SOD_REGIONS.name], method="MPM nodes"))
-    return headline(verdicts), _settings_text(verdicts, lines)
+    rows = select(t[SOD_REGIONS.name], method="MPM nodes")
+    verdicts, lines = _per_setting(_c12_setting, rows)
+    finest = {k: min(select(rows, ppc=k[0], cfl=k[1]), key=lambda r: num(r, "h"))
+              for k in verdicts if _prescribed(k[0])}
+    return headline(verdicts), (
+        f"the waves' share of the nodal L1 on the finest mesh at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell: "
+        + ", ".join(f"{sum(num(r, f'share_{i}') for i in WAVE_REGIONS):.0%} ({k[0]} ppc at CFL {k[1]:g}, h = {r['h']})"
+                    for k, r in finest.items()) + "; " + _settings_text(verdicts, lines))
 
 
 def _c12_setting(rows: list[dict], n: int, cfl: float) -> tuple[str, str]:
