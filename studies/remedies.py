@@ -15,17 +15,18 @@ combinations that promise most, errors over grid nodes and over particles:
   time, for MPM with each remedy, fixed-mesh P1 FEM (lumped mass) and FV. Wall time is the last
   column: it varies from run to run and no verdict uses it.
 
-Meshes: Sod h = 0.01 ... 0.00015625, the convergence study's first seven. Every remedy runs the first six
-(to 0.0003125); the finest, 0.00015625, runs plain MPM and the three remedies that removed the
-plateau on the six coarser meshes in the last full run (``FINEST``: the B-spline domain, alone, with
-Taylor + volume and with XPIC(5)); E5 counts a remedy as removing the plateau only if it ran on every
-Sod mesh of the table, so the others count as not removing it, which they do not on the coarser
-meshes already. Every remedy runs the fused compiled step (:mod:`mpm_fem.fused.step`, equal to the numpy
-step), all of them in its compiled loop (the Taylor reconstruction, XPIC(m) and the grid volume
-included). What each run cost is in ``cost.csv`` (``wall_s``, measured in the run that wrote it). A
-halving of h costs about 4x (twice the particles, twice the steps), so the finest mesh costs about
-three times the six coarser ones together, and each of the seven other remedies would add there about
-four times its cost at h = 0.0003125.
+Meshes: Sod h = 0.01 ... 0.0003125 in the full tier, the convergence study's first six, for every
+remedy; the deep tier adds h = 0.00015625 for plain MPM and the three remedies that removed the
+plateau on the six coarser meshes in the last deep run (``FINEST``: the B-spline domain, alone, with
+Taylor + volume and with XPIC(5)). E5 counts a remedy as removing the plateau only if it ran on every
+Sod mesh of the table, so in the deep tier the others count as not removing it, which they do not on
+the coarser meshes already. A halving of h costs about 4x (twice the particles, twice the steps), so
+the finest mesh costs about three times the six coarser ones together: it is what moved to the deep
+tier to keep the full one within its budget. Every remedy of the full and deep tiers runs the fused
+compiled step (:mod:`mpm_fem.fused.step`, equal to the numpy step), all of them in its compiled loop
+(the Taylor reconstruction, XPIC(m) and the grid volume included); the quick tier runs the numpy step
+(``QUICK_KERNEL``), which on its two coarse meshes costs less than compiling the remedies' variants.
+What each run cost is in ``cost.csv`` (``wall_s``, measured in the run that wrote it).
 Burgers h = 0.04 ... 0.005 (the viscous step limit makes a halving of h cost 8x).
 
 XPIC(m) (:mod:`mpm_fem.core.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline, on every
@@ -71,9 +72,12 @@ REMEDIES = {
     "B-spline domain + XPIC(5)": {"basis": "bspline_gimp", "xpic": 5},
 }
 FINEST = ("MPM", "B-spline domain", "B-spline domain + Taylor + volume", "B-spline domain + XPIC(5)")
-SOD_MESHES = {name: 7 if name in FINEST else 6 for name in REMEDIES}  # docstring: the measured costs
+SOD_MESHES = {name: 6 for name in REMEDIES}  # the full tier (docstring: the measured costs)
+DEEP_SOD_MESHES = {name: 7 if name in FINEST else 6 for name in REMEDIES}
 QUICK = dict(SOD_H=SOD_H[:2], BURGERS_H=BURGERS_H[:2],
              REMEDIES=("MPM", "Taylor LS", "grid volume", "FLIP 0.99", "Taylor + volume", "XPIC(5)"))
+#: the quick tier's step: compiling its six remedies' variants costs more than its numpy runs (docstring)
+QUICK_KERNEL = {"kernel": "numpy"}
 
 
 # ---------------------------------------------------------------- one case (runs in a worker)
@@ -118,10 +122,13 @@ def _plan(tier: str) -> dict:
     q = QUICK if quick else {}
     names = q.get("REMEDIES", tuple(REMEDIES))
     sod_h, burgers_h = q.get("SOD_H", SOD_H), q.get("BURGERS_H", BURGERS_H)
+    meshes, kernel = DEEP_SOD_MESHES if tier == "deep" else SOD_MESHES, QUICK_KERNEL if quick else {}
+    sod_h = sod_h[:max(meshes[n] for n in names)]
     return {
-        "sod": {(n, h): {"solver": "sod", "h": h, **SOD_MPM, **REMEDIES[n]}
-                for n in names for h in sod_h[:SOD_MESHES[n]]},
-        "burgers": {(n, h): {"solver": "burgers", "h": h, **BURGERS, **REMEDIES[n]} for n in names for h in burgers_h},
+        "sod": {(n, h): {"solver": "sod", "h": h, **SOD_MPM, **REMEDIES[n], **kernel}
+                for n in names for h in sod_h[:meshes[n]]},
+        "burgers": {(n, h): {"solver": "burgers", "h": h, **BURGERS, **REMEDIES[n], **kernel}
+                    for n in names for h in burgers_h},
         "fem": {h: {"solver": "fem", "h": h} for h in sod_h},
         "fv": {h: {"solver": "fv", "h": h} for h in sod_h},
     }

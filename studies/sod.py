@@ -52,7 +52,9 @@ PLATEAU_VARIANTS = {"study settings": {}, "CFL 0.025": {"cfl": 0.025}, "CFL 0.1"
 #: source's 4-8 per cell at the study's CFL and 4 per cell at the CLI's default CFL (down to the last of SEED_H)
 SETTINGS = ((MPM["ppc"], MPM["cfl"]), (8, MPM["cfl"]), (4, MPM["cfl"]), (4, sod.SodSettings.cfl))
 SEEDS = (1, 2, 3, 4, 5)  # the jittered layouts' seeds, beside the regular layout (seed 0)
-SEED_H = H[:6]  # the jittered layouts' meshes; the deep tier: one mesh further, and every setting on every mesh
+SEED_H = H[:6]  # the jittered layouts' meshes, in every tier
+#: the settings the deep tier runs on every mesh (16 and 4 per cell at the study's CFL); the others run to H's finest
+DEEP_SETTINGS = (SETTINGS[0], (4, MPM["cfl"]))
 #: C14: a particle moves when |v_p| exceeds this fraction of the smaller sound speed of the two initial states
 MOVING_FRACTION = 0.01
 _GAS = sod.SodSettings()
@@ -116,11 +118,16 @@ def _plan(tier: str) -> dict:
     q = QUICK if tier == "quick" else {}
     hs, ppc_h = q.get("H", H + DEEP_H if tier == "deep" else H), q.get("PPC_H", PPC_H)
     consistent_h, plateau_h = q.get("CONSISTENT_H", CONSISTENT_H), q.get("PLATEAU_H", PLATEAU_H)
-    seed_h, seeds = q.get("SEED_H", H[:len(SEED_H) + 1] if tier == "deep" else SEED_H), q.get("SEEDS", SEEDS)
+    seed_h, seeds = q.get("SEED_H", SEED_H), q.get("SEEDS", SEEDS)
+
+    def meshes(setting):
+        if setting == SETTINGS[0] or (tier == "deep" and setting in DEEP_SETTINGS):
+            return hs
+        return H if tier == "deep" else seed_h
+
     return {
         "mpm": {h: mpm_case(h) for h in hs},
-        "settings": {(n, cfl, h): _setting_case(h, n, cfl) for n, cfl in SETTINGS
-                     for h in (hs if (n, cfl) == SETTINGS[0] or tier == "deep" else seed_h)},
+        "settings": {(n, cfl, h): _setting_case(h, n, cfl) for n, cfl in SETTINGS for h in meshes((n, cfl))},
         "seeds": {(n, cfl, h, seed): _setting_case(h, n, cfl, layout="jittered", seed=seed)
                   for n, cfl in SETTINGS for h in seed_h for seed in seeds},
         "mpm_consistent": {h: mpm_case(h, mass="consistent") for h in consistent_h},

@@ -188,8 +188,8 @@ def test_the_reported_step_is_the_run_step_not_the_last_sliver():
 # ---------------------------------------------------------------- the plan: settings shown, seeds
 
 def test_the_calculated_acceleration_runs_at_four_eight_and_sixteen_per_cell_on_every_mesh():
-    """Deep tier: every eps and mesh of the source's table at 4, 8 and 16 per cell, and the seeds on
-    every mesh; full tier: every mesh but the finest at 8 and 16 per cell (16: at the seeds' eps)."""
+    """Deep tier: every eps and mesh of the source's table at 4, 8 and 16 per cell, with the full tier's
+    seeds; full tier: every mesh but the finest at 8 and 16 per cell (16: at the seeds' eps)."""
     deep, full = study._plan("deep"), study._plan("full")
     for n, m in study.CALCULATED.items():
         assert {(e, h) for s, mm, e, h in deep["table"] if (s, mm) == (study.DEFAULT, m)} == {
@@ -197,6 +197,7 @@ def test_the_calculated_acceleration_runs_at_four_eight_and_sixteen_per_cell_on_
         meshes = {h for s, mm, e, h in full["table"] if (s, mm, e) == (study.DEFAULT, m, study.EPS[0])}
         meshes |= {h for mm, e, h, layout, _ in full["seeds"] if mm == m and layout == "regular"}
         assert set(study.H[:4]) <= meshes, n
+    assert study.MESHES["deep"]["seeds"] == study.MESHES["full"]["seeds"]
     for tier, plan in (("deep", deep), ("full", full)):
         for m, hs in study.MESHES[tier]["seeds"].items():
             for h in hs:

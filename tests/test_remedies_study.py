@@ -11,21 +11,29 @@ from mpm_fem.measure.tables import load_tables
 from studies import remedies, sod
 
 
-def test_plan_runs_every_remedy_on_the_stated_meshes():
-    plan = remedies._plan("full")
-    assert {h for _, h in plan["sod"]} == set(remedies.SOD_H) and remedies.SOD_H[-1] == 0.00015625
+@pytest.mark.parametrize("tier", ["full", "deep"])
+def test_plan_runs_every_remedy_on_the_stated_meshes(tier):
+    plan = remedies._plan(tier)
     assert remedies.SOD_H == sod.H[:7]  # the convergence study's meshes to h = 0.00015625
-    assert set(plan["fv"]) == set(remedies.SOD_H)  # the FV reference on every mesh any remedy runs
+    meshes = set(remedies.SOD_H) if tier == "deep" else set(remedies.SOD_H[:6])
+    assert {h for _, h in plan["sod"]} == meshes
+    assert set(plan["fv"]) == meshes  # the FV reference on every mesh any remedy runs
     assert {n for n, _ in plan["burgers"]} == set(remedies.REMEDIES)
     sod_meshes = {n: {h for m, h in plan["sod"] if m == n} for n in remedies.REMEDIES}
     finest = {"MPM", "B-spline domain", "B-spline domain + Taylor + volume", "B-spline domain + XPIC(5)"}
-    for name in remedies.REMEDIES:  # every remedy to h = 0.0003125, the finest mesh for the four, fused
-        expected = set(remedies.SOD_H) if name in finest else set(remedies.SOD_H[:6])
+    for name in remedies.REMEDIES:  # every remedy to h = 0.0003125; in the deep tier the finest mesh for the four
+        expected = set(remedies.SOD_H) if name in finest and tier == "deep" else set(remedies.SOD_H[:6])
         assert sod_meshes[name] == expected, name
         assert supported(IdealGas(), Stages(**remedies.REMEDIES[name])) is None, name
     assert plan["sod"][("B-spline domain + XPIC(5)", 0.0003125)]["xpic"] == 5
     assert all(case["ppc"] == 16 and case["cfl"] == 0.05 for case in plan["sod"].values())
     assert all(case["ppc"] == 4 and case["acceleration"] == "calculated" for case in plan["burgers"].values())
+    assert all("kernel" not in case for part in ("sod", "burgers") for case in plan[part].values())  # fused
+
+
+def test_quick_plan_runs_the_numpy_step():
+    plan = remedies._plan("quick")
+    assert all(case["kernel"] == "numpy" for part in ("sod", "burgers") for case in plan[part].values())
 
 
 @pytest.mark.slow

@@ -138,3 +138,20 @@ def test_c14_compares_crossing_particles_with_moving_ones():
     assert judge("C14", made_up_tables())[0] == "confirmed"
     some = mutate(made_up_tables(), "sod/extrema", {"ppc": 4}, density_moving_ratio=1.5)
     assert judge("C14", some)[0] == "partly"
+
+
+def test_c11_quotes_the_drift_studys_mechanism_from_its_table(tables):
+    """C11's evidence ends with the drift study's sentence, formatted from ``drift/drift``: absent, it says
+    so; present, the sentence follows the table (a growth removed by a variant is named there)."""
+    from test_drift import MEASURED, _tables
+
+    from mpm_fem.measure.claims.drift import mechanism
+    from mpm_fem.measure.schema import DRIFT
+
+    verdict, without = judge("C11", {k: v for k, v in tables.items() if k != DRIFT.name})
+    assert "Mechanism (drift/drift): not measured" in without
+    drift = _tables(MEASURED)
+    verdict_with, evidence = judge("C11", {**tables, **drift})
+    assert verdict_with == verdict  # the mechanism is quoted, not judged
+    assert evidence.endswith(f"Mechanism (drift/drift): {mechanism(drift)}")
+    assert "V + dt int dv/dx" in evidence

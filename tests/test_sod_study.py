@@ -159,17 +159,19 @@ def test_one_set_of_settings_for_every_mesh():
 @pytest.mark.parametrize("tier", ["full", "deep"])
 def test_every_setting_runs_on_every_mesh_with_the_regular_and_five_jittered_layouts(tier):
     """4, 8 and 16 particles per cell at CFL 0.05 and 4 at the CLI's CFL, regular and jittered down to
-    h = 0.0003125, the study's own on every mesh (the deep tier: every setting on every mesh, the
-    seeds one mesh further); new extrema not counted on the jittered layouts."""
+    h = 0.0003125, the study's own on every mesh (the deep tier: 16 and 4 per cell at CFL 0.05 on every
+    mesh, the others one mesh further, the seeds where the full tier has them); new extrema not counted
+    on the jittered layouts."""
     plan = study._plan(tier)
     assert {(4, 0.05), (8, 0.05), (16, 0.05), (4, SodSettings.cfl)} == set(study.SETTINGS)
     assert SodSettings.cfl == 0.1 and len(study.SEEDS) >= 5
     meshes = study.H + (study.DEEP_H if tier == "deep" else ())
-    other = meshes if tier == "deep" else tuple(h for h in study.H if h >= 0.0003125)
-    assert set(plan["settings"]) == ({(n, c, h) for n, c in study.SETTINGS[1:] for h in other}
-                                     | {(16, 0.05, h) for h in meshes})
+    other = study.H if tier == "deep" else tuple(h for h in study.H if h >= 0.0003125)
+    every = {(16, 0.05), (4, 0.05)} if tier == "deep" else {(16, 0.05)}
+    assert set(plan["settings"]) == ({(n, c, h) for n, c in study.SETTINGS if (n, c) not in every for h in other}
+                                     | {(n, c, h) for n, c in every for h in meshes})
     seed_meshes = {h for (_, _, h, _) in plan["seeds"]}
-    assert min(seed_meshes) == (0.00015625 if tier == "deep" else 0.0003125) and max(seed_meshes) == study.H[0]
+    assert min(seed_meshes) == 0.0003125 and max(seed_meshes) == study.H[0]
     assert len(plan["seeds"]) == len(study.SETTINGS) * len(seed_meshes) * len(study.SEEDS)
     for (n, cfl, h, seed), case in plan["seeds"].items():
         assert (case["ppc"], case["cfl"], case["h"], case["seed"], case["layout"]) == (n, cfl, h, seed, "jittered")

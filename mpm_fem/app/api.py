@@ -45,12 +45,18 @@ class Run:
     result: Result = field(repr=False)
 
 
+def _simulated(problem, settings_type, progress: bool | None, yes_long: bool, settings: dict):
+    """The settings of ``problem`` (a module of :mod:`mpm_fem.problems`) checked for stability and cost,
+    and its run: ``(settings, result)``."""
+    s = settings_type(**settings)
+    problem.check_stable(s)
+    check_cost(problem.cost(s), yes_long)
+    return s, problem.simulate(s, progress=progress)
+
+
 def sod(progress: bool | None = False, yes_long: bool = False, **settings) -> Run:
     """Sod's shock tube (ideal gas, walls, ``T = 0.2``) with ``settings`` (:class:`SodSettings`)."""
-    s = _sod.SodSettings(**settings)
-    _sod.check_stable(s)
-    check_cost(_sod.cost(s), yes_long)
-    r = _sod.simulate(s, progress=progress)
+    s, r = _simulated(_sod, _sod.SodSettings, progress, yes_long, settings)
     P, g = r.particles, r.grid
     names = ("density", "velocity", "pressure")
     exact = {where: dict(zip(names, _sod.exact(s, x, r.t), strict=True))
@@ -61,10 +67,7 @@ def sod(progress: bool | None = False, yes_long: bool = False, **settings) -> Ru
 
 def burgers(progress: bool | None = False, yes_long: bool = False, **settings) -> Run:
     """Viscous Burgers on ``[0, 2]`` (``T = 0.5``) with ``settings`` (:class:`BurgersSettings`)."""
-    s = _burgers.BurgersSettings(**settings)
-    _burgers.check_stable(s)
-    check_cost(_burgers.cost(s), yes_long)
-    r = _burgers.simulate(s, progress=progress)
+    s, r = _simulated(_burgers, _burgers.BurgersSettings, progress, yes_long, settings)
     P, g = r.particles, r.grid
     v = s.exact.v
     exact = {"particles": {"velocity": v(P.x, r.t)}, "nodes": {"velocity": v(g.nodes, r.t)}}

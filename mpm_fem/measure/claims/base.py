@@ -39,7 +39,7 @@ STATEMENTS = {
     "C15": "FE + mass lumping is one of the four error sources",
     "E1": "error budget over every combination of the stages: the stages separate, and one dominates",
     "E2": "bases: point-mass P1 vs GIMP vs C1 B-spline",
-    "E3": "MPM, fixed-mesh FEM and a finite-volume reference side by side on the same mesh",
+    "E3": "on the same mesh MPM's error stays within a constant factor of the fixed-mesh FEM's",
     "E4": "one command regenerates every table from one code version, the current code's",
     "E5": "a remedy (particle-domain B-spline, stress reconstruction, volume reset, PIC/FLIP, XPIC) removes the MPM "
           "plateau",

@@ -14,9 +14,11 @@ from __future__ import annotations
 import math
 
 from mpm_fem.measure.claims.base import Tables, claim
+from mpm_fem.measure.claims.drift import mechanism
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
 from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, lumping_claim, ppc_claim
 from mpm_fem.measure.schema import (
+    DRIFT,
     SOD_CONVERGENCE,
     SOD_EXTREMA,
     SOD_MASS,
@@ -147,13 +149,15 @@ def _c11_setting(rows: list[dict], n: int, cfl: float, convergence: list[dict]) 
                   "per cell, their common verdict, partly when they differ")
 def _c11(t: Tables) -> tuple[str, str]:
     """The orders are paired by seed: each run of a layout on one mesh with the run of the same seed on
-    the next mesh, the regular layout being seed 0; the range over seeds holds the order of every layout."""
+    the next mesh, the regular layout being seed 0; the range over seeds holds the order of every layout.
+    The mechanism of the growth is the drift study's finding, quoted from its table (not judged here)."""
     rows = t[SEEDS]
     verdicts, lines = _per_setting(_c11_setting, rows, t[CONVERGENCE])
     density = [f"{_density_trend(rows, k, verdicts[k])} ({k[0]} ppc at CFL {k[1]:g})" for k in verdicts
                if _prescribed(k[0])]
     return headline(verdicts), (f"particle density at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell: "
-                                + ", ".join(density) + "; " + _settings_text(verdicts, lines))
+                                + ", ".join(density) + "; " + _settings_text(verdicts, lines)
+                                + f". Mechanism ({DRIFT.name}): {mechanism(t)}")
 
 
 def _density_trend(rows: list[dict], ppc_cfl: tuple, verdict: str) -> str:
