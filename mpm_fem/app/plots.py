@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -97,7 +98,33 @@ def panels(path, content: dict, xlabel: str, ylabel: str, title: str = "", ncols
     for ax in axes.ravel()[len(names):]:
         ax.set_visible(False)
     axes[0][0].legend(fontsize=6, markerscale=1.5)
-    save(fig, path, title)
+    wrapped = textwrap.fill(title, max(int(fig.get_size_inches()[0] * CHARACTERS_PER_INCH), 20)) if title else ""
+    fixed_margins(fig, wrapped.count("\n") + 1 if title else 0)
+    save(fig, path, wrapped, caption=title, layout=False)
+
+
+#: The margins of a grid of panels, inches: left (tick labels and the y label), right, bottom (tick
+#: labels and the x label), top (a panel title; each line of a figure title adds TITLE_MARGIN), between panels.
+MARGINS = dict(left=0.8, right=0.2, bottom=0.6, top=0.35, between_x=0.9, between_y=0.85)
+TITLE_MARGIN = 0.2
+#: A figure title (9 points) is wrapped at this many characters per inch of the figure's width.
+CHARACTERS_PER_INCH = 13
+
+
+def fixed_margins(fig, title_lines: int) -> None:
+    """Lay out ``fig``'s grid of panels with the fixed :data:`MARGINS` and room for a figure title of
+    ``title_lines`` lines: the layout ``tight_layout`` gives panels with short labels, without measuring
+    every tick label (which costs about half of the drawing time of a log-log figure)."""
+    width, height = fig.get_size_inches()
+    nrows, ncols = fig.axes[0].get_subplotspec().get_gridspec().get_geometry()
+    m = MARGINS
+    top = m["top"] + TITLE_MARGIN * title_lines + (0.1 if title_lines else 0.0)
+    # subplots_adjust's spaces are fractions of a panel's width (height): solve for the panel's size
+    panel_width = (width - m["left"] - m["right"] - (ncols - 1) * m["between_x"]) / ncols
+    panel_height = (height - m["bottom"] - top - (nrows - 1) * m["between_y"]) / nrows
+    fig.subplots_adjust(left=m["left"] / width, right=1 - m["right"] / width, bottom=m["bottom"] / height,
+                        top=1 - top / height, wspace=m["between_x"] / max(panel_width, 0.1),
+                        hspace=m["between_y"] / max(panel_height, 0.1))
 
 
 def stacked_shares(path, rows: list[dict], names, title: str = "", ylabel: str = "share", group: str = "method",
@@ -133,12 +160,14 @@ def stacked_shares(path, rows: list[dict], names, title: str = "", ylabel: str =
     record_caption(path, title)
 
 
-def save(fig, path, title: str = "", caption: str = "") -> None:
-    """Title, tight layout, PNG at the studies' resolution, the figure closed, and its one-line
-    ``caption`` (the title when not given) recorded beside it (:func:`record_caption`)."""
+def save(fig, path, title: str = "", caption: str = "", layout: bool = True) -> None:
+    """Title, tight layout (unless ``layout`` is false: the figure is laid out already), PNG at the
+    studies' resolution, the figure closed, and its one-line ``caption`` (the title when not given)
+    recorded beside it (:func:`record_caption`)."""
     if title:
         fig.suptitle(title, fontsize=9)
-    fig.tight_layout()
+    if layout:
+        fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     if caption or title:
