@@ -78,13 +78,18 @@ def test_every_embedded_figure_is_at_most_two_and_a_half_wide(committed):
 
 
 def test_every_anchor_and_link_resolves_inside_the_folder(committed):
+    """Every link is an anchor of the report, or a file of the folder (with, for another report, one
+    of its anchors: the deep tier's verdicts link into ``deep/REPORT.md``)."""
     anchors = set(re.findall(r'<a id="([^"]+)"></a>', committed))
     for target in re.findall(r"\]\(([^)]+)\)", committed):
         assert not target.startswith(("/", "..", "http", "figures/")), target
-        if target.startswith("#"):
-            assert target[1:] in anchors, target
-        else:
-            assert (FIGURES / target).exists(), target
+        path, _, anchor = target.partition("#")
+        if not path:
+            assert anchor in anchors, target
+            continue
+        assert (FIGURES / path).exists(), target
+        if anchor:
+            assert f'<a id="{anchor}"></a>' in (FIGURES / path).read_text(), target
 
 
 def test_no_garbled_cells(committed):
@@ -150,3 +155,18 @@ def test_a_key_number_is_cut_at_a_comma_to_fit_the_summary():
     cut = key_number(long)
     assert len(cut) <= KEY_LENGTH and cut.endswith(" ...") and long.startswith(cut[:-4])
     assert cut[:-4].split(", ")[-1].startswith("mesh")  # whole items only
+
+
+def test_a_folder_with_some_studies_has_a_section_for_every_claim():
+    """A tier run in part (the deep tier's folder): every claim the summary links to has its section, the
+    studies without tables saying so, their claims not measured."""
+    from mpm_fem.app.pages import PAGES
+    from mpm_fem.measure.tables import load_tables
+
+    tables = {name: rows for name, rows in load_tables(FIGURES).items() if not name.startswith("burgers/")}
+    text = render(tables, PAGES)
+    anchors = set(re.findall(r'<a id="([^"]+)"></a>', text))
+    assert {t[1:] for t in re.findall(r"\]\((#[^)]+)\)", text)} <= anchors
+    burgers = text.split('<a id="burgers"></a>')[1].split("<a id=")[0]
+    assert "No table of the study `burgers` in this folder" in burgers
+    assert '<a id="c13"></a>' in text and "**not measured**" in text.split('<a id="c13"></a>')[1].split("<a id=")[0]

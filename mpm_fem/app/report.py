@@ -160,6 +160,16 @@ def page_section(page: Page, tables: Tables, captions: dict) -> list[str]:
     return lines
 
 
+def missing_section(page: Page, tables: Tables) -> list[str]:
+    """A study with no table in the folder (a tier run in part): its claims, each not measured, so that
+    every claim of the summary has its section."""
+    lines = [f'<a id="{page.name}"></a>', "", f"## {page.title}", "",
+             f"No table of the study `{page.name}` in this folder: its claims are not measured here.", ""]
+    for c in claims_of(page.name):
+        lines += claim_section(c, tables)
+    return lines
+
+
 def appendix_section(page: Page, tables: Tables, captions: dict) -> list[str]:
     """A study's tables and every figure it drew."""
     lines = [f'<a id="appendix-{page.name}"></a>', "", f"## Appendix: {page.title}", ""]
@@ -252,8 +262,9 @@ def render(tables: Tables, pages, captions: dict[str, dict] | None = None, curre
             head += figure(study, file, captions[study])
     lines = head + caveats(tables, current)
     shown = [page for page in pages if any(t.startswith(page.name + "/") for t in tables)]
-    for page in shown:
-        lines += page_section(page, tables, captions.get(page.name, {}))
+    for page in pages:
+        lines += (page_section(page, tables, captions.get(page.name, {})) if page in shown
+                  else missing_section(page, tables))
     lines += reproduction_section(tables) + deep_section(deep)
     for page in shown:
         lines += appendix_section(page, tables, captions.get(page.name, {}))
