@@ -67,3 +67,79 @@ def test_a_file_that_does_not_parse_enters_by_its_bytes(tree):
     before = source_version(tree)
     broken.write_text("def f(:\n    # a comment\n")
     assert source_version(tree) != before
+
+
+# ------------------------------------------------------------------ the version a case runs through
+
+def _case_version(tree: Path, study: str, fn: str = "run_case") -> str:
+    version._model_version.cache_clear()
+    return version.case_source_version(tree / "studies" / f"{study}.py", fn, tree)
+
+
+def test_a_plan_edit_leaves_the_case_versions_and_changes_the_code_version(tree):
+    cases, code = {s: _case_version(tree, s) for s in ("sod", "remedies", "drift")}, source_version(tree)
+    _edit(tree / "studies/sod.py", "DEEP_H = (0.000078125,)", "DEEP_H = (0.000078125, 0.0000390625)")
+    _edit(tree / "studies/sod.py", "SEEDS = (1, 2, 3, 4, 5)", "SEEDS = (1, 2, 3)")
+    _edit(tree / "studies/sod.py", 'script_main(', 'script_main(  # a comment\n    ')  # the __main__ block
+    assert {s: _case_version(tree, s) for s in cases} == cases
+    assert source_version(tree) != code
+
+
+def test_a_constant_the_case_reads_changes_its_version_and_of_the_studies_importing_it(tree):
+    before = {s: _case_version(tree, s) for s in ("sod", "remedies", "drift", "burgers")}
+    # sod's FEM settings: sod's cases carry them (its plan copies them in), remedies' case reads them
+    _edit(tree / "studies/sod.py", "FEM = dict(cfl=0.3,", "FEM = dict(cfl=0.25,")
+    after = {s: _case_version(tree, s) for s in before}
+    assert after["remedies"] != before["remedies"]
+    assert after["sod"] == before["sod"] and after["drift"] == before["drift"] and after["burgers"] == before["burgers"]
+    _edit(tree / "studies/sod.py", "MOVING_FRACTION = 0.01", "MOVING_FRACTION = 0.02")  # through MOVING_SPEED
+    assert _case_version(tree, "sod") != after["sod"]
+    drift = _case_version(tree, "drift")
+    claims = tree / "mpm_fem/measure/claims/drift.py"
+    claims.write_text(claims.read_text() + "\nSTUDY = STUDY + ' '\n")  # a verdicts' constant drift's case reads
+    assert _case_version(tree, "drift") != drift
+
+
+def test_a_top_level_statement_that_changes_a_read_name_enters(tree):
+    before = _case_version(tree, "sod")
+    sod = tree / "studies/sod.py"
+    sod.write_text(sod.read_text() + "\nMPM.update(ppc=8)\n")
+    assert _case_version(tree, "sod") != before
+
+
+def test_an_edit_of_the_model_changes_every_case_version(tree):
+    before = {s: _case_version(tree, s) for s in ("sod", "burgers", "time")}
+    _edit(tree / "mpm_fem/core/norms.py", '"""', '"""', )  # a no-op first: the docstring is untouched
+    assert {s: _case_version(tree, s) for s in before} == before
+    norms = tree / "mpm_fem/core/norms.py"
+    norms.write_text(norms.read_text() + "\n_UNUSED = 1\n")
+    after = {s: _case_version(tree, s) for s in before}
+    assert all(after[s] != before[s] for s in before)
+
+
+def test_a_case_version_names_a_missing_function():
+    with pytest.raises(ValueError, match="no top-level 'nowhere'"):
+        version.case_source_version(ROOT / "studies/sod.py", "nowhere")
+
+
+def test_the_model_imports_nothing_outside_it():
+    """The case version leaves out studies/, the application, the verdicts and this module because the
+    model never imports them (the package's own lazy notebook entry points, mpm_fem/__init__.py, aside)."""
+    import ast
+    outside = tuple(p.rstrip("/").removesuffix(".py").replace("/", ".") for p in version.OUTSIDE_THE_MODEL)
+    for path in version.model_files():
+        if path == ROOT / "mpm_fem/__init__.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level else \
+                [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            assert not [n for n in names if n.startswith(outside)], (path, names)
+
+
+def test_the_sweeps_key_by_the_case_version(tmp_path):
+    from studies import sod
+    case = {"h": 0.01}
+    key = sweep.case_key(sod.run_case, case)
+    version.case_version.cache_clear()
+    assert sweep.fn_version(sod.run_case) == version.case_source_version(ROOT / "studies/sod.py", "run_case")
+    assert sweep.case_key(sod.run_case, case) == key

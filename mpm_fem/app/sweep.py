@@ -2,9 +2,11 @@
 
 ``run_cases(fn, cases)`` calls the module-level function ``fn(case) -> dict`` on every case (a
 JSON-able dict of settings). Results are cached under ``cache_dir`` by a key made of ``fn``'s
-qualified name, the case, and the version of the code that computes numbers
-(:func:`mpm_fem.measure.version.code_version`, re-exported here): a finished case is never
-recomputed while that code is unchanged, and a change to it recomputes everything. Each result is
+qualified name, the case, and the version of the code that case runs through
+(:func:`mpm_fem.measure.version.case_version`: the model and ``fn``'s closure in its module): a
+finished case is never recomputed while that code is unchanged, an edit of it recomputes every
+case, and an edit of a study's plan alone recomputes none. Each entry also records the version of
+all the code (:func:`mpm_fem.measure.version.code_version`, re-exported here). Each result is
 written atomically (temporary file + rename), so a sweep that is interrupted resumes where it
 stopped and never reads a half-written result.
 
@@ -34,16 +36,21 @@ from typing import Callable
 from tqdm.auto import tqdm
 
 from mpm_fem.app.output import write_json
-from mpm_fem.measure.version import code_version
+from mpm_fem.measure.version import case_version, code_version
 
 CaseFn = Callable[[dict], dict]
 
 
 def case_key(fn: CaseFn, case: dict) -> str:
-    """Cache key of ``fn(case)`` under the current code."""
-    text = json.dumps({"fn": f"{fn.__module__}.{fn.__qualname__}", "case": case, "code": code_version()},
+    """Cache key of ``fn(case)`` under the current code (:func:`fn_version`)."""
+    text = json.dumps({"fn": f"{fn.__module__}.{fn.__qualname__}", "case": case, "code": fn_version(fn)},
                       sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def fn_version(fn: CaseFn) -> str:
+    """:func:`~mpm_fem.measure.version.case_version` of ``fn``, found by its module's file."""
+    return case_version(sys.modules[fn.__module__].__file__, fn.__qualname__)
 
 
 def _load(path: Path) -> dict | None:
@@ -124,7 +131,8 @@ def run_cases(
     def finish(k: int, path: Path | None, result: dict) -> None:
         results[k] = result
         if path is not None:
-            write_json(path, {"case": cases[k], "code": code_version(), "result": result})
+            write_json(path, {"case": cases[k], "case_code": fn_version(fn), "code": code_version(),
+                              "result": result})
         reporter.update(cases[k])
 
     try:
