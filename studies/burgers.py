@@ -48,27 +48,23 @@ METHODS = {  # name: (label, solver, settings, the source's row it stands beside
 #: The jittered layouts' seeds (the regular layout is seed 0), and the settings run on them (C13's).
 SEEDS, SEEDED = (1, 2, 3, 4, 5), (*CALCULATED.values(), "mpm_exact_dt_h")
 _MORE = ("mpm_calculated_8", "mpm_calculated_16")  # on the default solution only
-# The meshes of each method, by tier: a calculated-acceleration run costs ~ ppc eps / h^3, so the
-# deep tier takes every method to every mesh of the source's table (with the full tier's seeds: more
-# seeds were the last of the deep tier's priorities and did not fit its budget); the full tier takes
-# every mesh for the rows compared with the source, all but the finest for 8 per cell and the
-# calculated acceleration's seeds, and 16 per cell to the third mesh (its regular layout one mesh
-# further at the seeds' eps: "headline", the meshes of the seeds' eps where they differ).
+# The meshes of each method, by tier: a calculated-acceleration run costs ~ ppc eps / h^3. The full
+# tier takes every mesh for the rows compared with the source, all but the finest for 8 per cell and
+# the calculated acceleration's seeds, and 16 per cell to the third mesh (its regular layout one mesh
+# further at the seeds' eps: "headline", the meshes of the seeds' eps where they differ). The deep
+# tier takes every method to every mesh of the source's table on the solution compared with the
+# source; the other solutions and the seeds stay at the full tier's meshes (what did not fit its
+# budget, in the order of value: docs/cluster.md).
 _SEEDS_FULL = {**{m: H[:4] for m in SEEDED}, "mpm_calculated_16": H[:3], "mpm_exact_dt_h": H}
-MESHES = {
-    "deep": {
-        "default": {m: H for m in METHODS},
-        "other": {m: H for m in METHODS if m not in _MORE},
-        "seeds": _SEEDS_FULL,
-    },
-    "full": {
-        "default": {**{m: H[:3] for m in METHODS}, "mpm_calculated": H, "mpm_calculated_8": H[:4], "mpm_exact_dt_h": H},
-        "headline": {"mpm_calculated_16": H[:4]},
-        "other": {**{m: H[:3] for m in METHODS if m not in _MORE}, "mpm_exact_dt_h": H,
-                  "fem_consistent": H[:2], "fem_lumped": H[:2]},
-        "seeds": _SEEDS_FULL,
-    },
+_FULL = {
+    "default": {**{m: H[:3] for m in METHODS}, "mpm_calculated": H, "mpm_calculated_8": H[:4], "mpm_exact_dt_h": H},
+    "headline": {"mpm_calculated_16": H[:4]},
+    "other": {**{m: H[:3] for m in METHODS if m not in _MORE}, "mpm_exact_dt_h": H,
+              "fem_consistent": H[:2], "fem_lumped": H[:2]},
+    "seeds": _SEEDS_FULL,
 }
+MESHES = {"deep": {"default": {m: H for m in METHODS}, "other": _FULL["other"], "seeds": _SEEDS_FULL},
+          "full": _FULL}
 _MPM = ("mpm_calculated", "mpm_exact")
 PPC, PPC_H, TIME_H, REFINE, PROFILE_H = (1, 2, 4, 8, 16, 32), (0.01, 0.0025), 0.005, (1, 4, 16), 0.01
 LUMPING_CFL = 0.3  # the consistent particle mass needs dt <= h^2/(6 eps): both masses run with CFL 0.3
