@@ -23,8 +23,10 @@ terms and Shapley values (:mod:`mpm_fem.measure.decomposition`) decompose ``v(al
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.00125 for every basis (four meshes give each basis's budget a trend, not
-only a change; the deep tier adds P1 at h = 0.000625: :data:`DEEP`); Burgers 0.04 ... 0.01. A Sod case
+Meshes: Sod h = 0.01 ... 0.00125 for P1 and GIMP, 0.01 ... 0.0025 for the two B-splines (three meshes
+or more give each basis's budget a trend, not only a change; a B-spline budget at 0.00125 costs
+three P1 ones, so the full tier leaves it to the deep tier, :data:`FINEST`), the deep tier adds those
+and P1 at h = 0.000625 (:data:`DEEP`); Burgers 0.04 ... 0.01. A Sod case
 is 16 runs, all on the fused step (:mod:`mpm_fem.fused`): the fourteen with an exact stage run its
 compiled particle passes around the numpy step's grid stage (:mod:`mpm_fem.exact_stages`). What each
 run cost is in ``runs.csv`` (``wall_s``); ``docs/performance.md`` has the measured costs.
@@ -66,15 +68,17 @@ BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}
 #: the deep tier's further budgets, (problem, h, basis): P1's Sod one mesh finer
-DEEP = (("sod", 0.000625, "mpm"),)
-FINEST = {}  # (problem, basis): the finest mesh of a basis whose budget stops above H's finest (none now)
+DEEP = (("sod", 0.000625, "mpm"), ("sod", 0.00125, "bspline"), ("sod", 0.00125, "bspline_gimp"))
+#: (problem, basis): the finest mesh of the full tier's budget of a basis that stops above H's finest
+FINEST = {("sod", "bspline"): 0.0025, ("sod", "bspline_gimp"): 0.0025}
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
 QUICK = {"h": {"sod": (0.02,), "burgers": (0.04, 0.02)}, "bases": ("mpm",), "bases_h": ()}
 GAP = "all MPM - all exact"
-#: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring)
-ROUNDOFF = ("sod", "mpm")
+#: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring), on
+#: the full tier on the meshes of ROUNDOFF_H (the numpy step at h = 0.00125 would be its longest case)
+ROUNDOFF, ROUNDOFF_H = ("sod", "mpm"), H["sod"][:3]
 COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:green", "time": "tab:red"}
 
 
@@ -84,11 +88,12 @@ def plan(tier: str) -> dict:
     quick = tier == "quick"
     hs, bases = (QUICK["h"], QUICK["bases"]) if quick else (H, BUDGET_BASES)
     keys = [(p, h, b) for p, meshes in hs.items() for h in meshes for b in bases if h >= FINEST.get((p, b), 0)]
-    keys += list(DEEP) if tier == "deep" else []
+    keys += [k for k in DEEP if k not in keys] if tier == "deep" else []
     budget = {(p, h, b): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K} for p, h, b in keys}
     e2 = {(h, b): {"kind": "bases", "h": h, "basis": b}
           for h in (QUICK["bases_h"] if quick else BASES_H) for b in BASES}
-    roundoff = {key: {**case, "kernel": "numpy"} for key, case in budget.items() if key[::2] == ROUNDOFF}
+    roundoff = {key: {**case, "kernel": "numpy"} for key, case in budget.items()
+                if key[::2] == ROUNDOFF and (tier != "full" or key[1] in ROUNDOFF_H)}
     return {"budget": budget, "bases": e2, "roundoff": roundoff}
 
 

@@ -88,3 +88,22 @@ def test_a_killed_sweep_resumes_without_recomputing_finished_cases(tmp_path):
     # every case cached before the kill is reused; only the others (and at most the one killed mid-run) run
     assert len(ran_after) == len(cases) - finished, (finished, ran_after)
     assert not set(ran_after) & set(ran_before[:finished])
+
+
+def cube(case):
+    with open(case["trace"], "a") as f:
+        f.write(f"c{case['n']}\n")
+    return {"n": case["n"], "cube": case["n"] ** 3}
+
+
+def test_tasks_of_two_functions_share_one_pool_each_cached_in_its_folder(tmp_path):
+    from mpm_fem.app.sweep import Task, fn_version, run_tasks
+    trace = tmp_path / "trace"
+    tasks = [Task(square if n % 2 else cube, {"n": n, "trace": str(trace)}, tmp_path / ("sq" if n % 2 else "cu"))
+             for n in range(6)]
+    out = run_tasks(tasks, jobs=2, progress=False)
+    assert out == [{"n": n, "square": n * n} if n % 2 else {"n": n, "cube": n ** 3} for n in range(6)]
+    assert len(list((tmp_path / "sq").glob("*.json"))) == len(list((tmp_path / "cu").glob("*.json"))) == 3
+    stored = json.loads(tasks[1].path.read_text())
+    assert tasks[1].path.parent == tmp_path / "sq" and stored["case_code"] == fn_version(square)
+    assert run_tasks(tasks, jobs=2, progress=False) == out and len(trace.read_text().split()) == 6  # all cached

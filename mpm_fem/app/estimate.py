@@ -11,6 +11,9 @@ A study opts in by naming three things (module attributes of ``studies/<name>.py
 workers the wall time is at least the total over ``J`` and at least the largest single case (the
 critical path): :meth:`Estimate.wall`. The estimate is a model fitted to one machine; the progress
 line of each sweep reports the real progress.
+
+:func:`tasks` gives the same cases as sweep tasks with their estimated seconds, so that
+``reproduce`` runs every study's cases in one pool, the longest first (:func:`mpm_fem.app.sweep.run_tasks`).
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from __future__ import annotations
 import importlib
 from dataclasses import dataclass
 
-from mpm_fem.app.sweep import case_key
+from mpm_fem.app.sweep import Task
 
 
 @dataclass(frozen=True)
@@ -35,9 +38,9 @@ class Estimate:
         return max(self.seconds / max(workers, 1), self.longest)
 
 
-def estimate(name: str, options) -> Estimate | None:
-    """The :class:`Estimate` of study ``name`` at ``options.tier`` with ``options``' cache; ``None`` if
-    the study does not state its cost model."""
+def tasks(name: str, options) -> list[tuple[float, Task]] | None:
+    """The cases of study ``name`` at ``options.tier``, once each, as ``(estimated CPU seconds, task)``
+    with ``options``' cache; ``None`` if the study does not state its cost model."""
     module = importlib.import_module(f"studies.{name}")
     plan, cost, rate = (getattr(module, a, None) for a in ("PLAN", "COST", "SECONDS_PER_COST"))
     if plan is None or cost is None or rate is None:
@@ -47,9 +50,17 @@ def estimate(name: str, options) -> Estimate | None:
         for case in group.values():
             unique.setdefault(repr(sorted(case.items())), case)
     cache = options.cache_dir(name)
-    todo = [c for c in unique.values() if not (cache / f"{case_key(module.run_case, c)}.json").exists()]
-    seconds = [rate * cost(c) for c in todo]
-    return Estimate(len(unique), len(unique) - len(todo), sum(seconds), max(seconds, default=0.0))
+    return [(rate * cost(c), Task(module.run_case, c, cache)) for c in unique.values()]
+
+
+def estimate(name: str, options) -> Estimate | None:
+    """The :class:`Estimate` of study ``name`` at ``options.tier`` with ``options``' cache; ``None`` if
+    the study does not state its cost model."""
+    found = tasks(name, options)
+    if found is None:
+        return None
+    seconds = [s for s, task in found if not task.path.exists()]
+    return Estimate(len(found), len(found) - len(seconds), sum(seconds), max(seconds, default=0.0))
 
 
 def describe(estimates: dict[str, Estimate | None], workers: int) -> str:

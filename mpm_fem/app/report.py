@@ -304,14 +304,19 @@ def write_report(out: Path, pages: list[Page] | None = None) -> Path:
 
 
 def reproduce(options) -> Path:
-    """Run every study with ``options`` (:class:`mpm_fem.app.study.StudyOptions`), then write the report."""
-    from mpm_fem.app.estimate import describe, estimate
+    """Run every study with ``options`` (:class:`mpm_fem.app.study.StudyOptions`), then write the report.
+    The cases of all studies run first, in one pool and the longest first (so no worker idles at the
+    end of a study while another has cases left); each study then reads its cases from the cache."""
+    from mpm_fem.app.estimate import describe, estimate, tasks
     from mpm_fem.app.study import STUDIES, run_study
-    from mpm_fem.app.sweep import default_jobs
+    from mpm_fem.app.sweep import default_jobs, run_tasks
 
     if options.progress is not False:
         workers = options.jobs or default_jobs()
         print(describe({name: estimate(name, options) for name in STUDIES}, workers), file=sys.stderr, flush=True)
+    planned = sorted((t for name in STUDIES for t in tasks(name, options) or ()), key=lambda t: -t[0])
+    run_tasks([task for _, task in planned], jobs=options.jobs, desc=f"reproduce --{options.tier}",
+              scheduler=options.scheduler, progress=options.progress)
     for name in STUDIES:
         run_study(name, options)
     return write_report(options.out)

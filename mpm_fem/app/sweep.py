@@ -30,6 +30,7 @@ import sys
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
@@ -79,12 +80,12 @@ def _worker_init(parent: int) -> None:
     threading.Thread(target=_watch_parent, args=(parent,), daemon=True, name="watch-parent").start()
 
 
-def _run_pool(fn, cases, todo, jobs: int, finish) -> None:
-    """``fn`` over ``todo`` in ``jobs`` worker processes. If the parent is interrupted (Ctrl-C) or
+def _run_pool(tasks, todo, jobs: int, finish) -> None:
+    """The tasks of ``todo`` in ``jobs`` worker processes. If the parent is interrupted (Ctrl-C) or
     fails, the workers are ended at once instead of finishing their cases."""
     pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),))
     try:
-        futures = {pool.submit(fn, cases[k]): (k, path) for k, path in todo}
+        futures = {pool.submit(tasks[k].fn, tasks[k].case): (k, path) for k, path in todo}
         for future in as_completed(futures):
             k, path = futures[future]
             finish(k, path, future.result())
@@ -111,46 +112,71 @@ def run_cases(
     progress: bool | None = None,
 ) -> list[dict]:
     """``[fn(case) for case in cases]``, in parallel, cached; results in the order of ``cases``."""
+    return run_tasks([Task(fn, case, cache_dir) for case in cases], jobs, desc, scheduler, progress)
+
+
+@dataclass(frozen=True)
+class Task:
+    """One case of a sweep: ``fn(case)``, its result cached in ``cache_dir`` (``None``: not cached)."""
+
+    fn: CaseFn
+    case: dict
+    cache_dir: str | os.PathLike | None = None
+
+    @property
+    def path(self) -> Path | None:
+        return None if self.cache_dir is None else Path(self.cache_dir) / f"{case_key(self.fn, self.case)}.json"
+
+
+def run_tasks(
+    tasks: list[Task],
+    jobs: int | None = None,
+    desc: str = "cases",
+    scheduler: str | None = None,
+    progress: bool | None = None,
+) -> list[dict]:
+    """``[t.fn(t.case) for t in tasks]``, in parallel, each cached in its task's folder; results in the
+    order of ``tasks``, which is also the order they start in. Tasks of several functions (several
+    studies) share one pool, so no worker idles at the end of one study while another has cases left."""
     if jobs is not None and jobs < 1:
         raise ValueError(f"jobs must be >= 1, got {jobs}")
     jobs = jobs or default_jobs()
-    cache = Path(cache_dir) if cache_dir is not None else None
-    if cache is not None:
-        cache.mkdir(parents=True, exist_ok=True)
-    results: list[dict | None] = [None] * len(cases)
+    for folder in {Path(t.cache_dir) for t in tasks if t.cache_dir is not None}:
+        folder.mkdir(parents=True, exist_ok=True)
+    results: list[dict | None] = [None] * len(tasks)
     todo = []
-    for k, case in enumerate(cases):
-        path = cache / f"{case_key(fn, case)}.json" if cache is not None else None
+    for k, task in enumerate(tasks):
+        path = task.path
         cached = _load(path) if path is not None and path.exists() else None
         if cached is not None:
             results[k] = cached
         else:
             todo.append((k, path))
-    reporter = _Progress(len(cases), len(cases) - len(todo), desc, progress)
+    reporter = _Progress(len(tasks), len(tasks) - len(todo), desc, progress)
 
     def finish(k: int, path: Path | None, result: dict) -> None:
         results[k] = result
         if path is not None:
-            write_json(path, {"case": cases[k], "case_code": fn_version(fn), "code": code_version(),
+            write_json(path, {"case": tasks[k].case, "case_code": fn_version(tasks[k].fn), "code": code_version(),
                               "result": result})
-        reporter.update(cases[k])
+        reporter.update(tasks[k].case)
 
     try:
         if not todo:
             pass
         elif scheduler is not None:
-            _run_dask(fn, cases, todo, scheduler, finish)
+            _run_dask(tasks, todo, scheduler, finish)
         elif jobs == 1 or len(todo) == 1:
             for k, path in todo:
-                finish(k, path, fn(cases[k]))
+                finish(k, path, tasks[k].fn(tasks[k].case))
         else:
-            _run_pool(fn, cases, todo, min(jobs, len(todo)), finish)
+            _run_pool(tasks, todo, min(jobs, len(todo)), finish)
     finally:
         reporter.close()
     return results  # type: ignore[return-value]
 
 
-def _run_dask(fn, cases, todo, scheduler, finish) -> None:
+def _run_dask(tasks, todo, scheduler, finish) -> None:
     try:
         from dask.distributed import Client
         from dask.distributed import as_completed as dask_completed
@@ -164,7 +190,7 @@ def _run_dask(fn, cases, todo, scheduler, finish) -> None:
     with client:
         futures = {}
         for k, path in todo:
-            futures[client.submit(fn, cases[k], pure=False, key=f"case-{k}-{time.time_ns()}")] = (k, path)
+            futures[client.submit(tasks[k].fn, tasks[k].case, pure=False, key=f"case-{k}-{time.time_ns()}")] = (k, path)
         for future in dask_completed(list(futures)):
             k, path = futures[future]
             finish(k, path, future.result())
