@@ -76,8 +76,9 @@ REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
 QUICK = {"h": {"sod": (0.02,), "burgers": (0.04, 0.02)}, "bases": ("mpm",), "bases_h": ()}
 GAP = "all MPM - all exact"
-#: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring), on
-#: the full tier on the meshes of ROUNDOFF_H (the numpy step at h = 0.00125 would be its longest case)
+#: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring): the
+#: full tier on the meshes of ROUNDOFF_H (the numpy step at h = 0.00125 would be its longest case), the
+#: deep tier on every mesh, the quick tier on none (it would be 40 % of the quick budget's cost)
 ROUNDOFF, ROUNDOFF_H = ("sod", "mpm"), H["sod"][:3]
 COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:green", "time": "tab:red"}
 
@@ -93,7 +94,7 @@ def plan(tier: str) -> dict:
     e2 = {(h, b): {"kind": "bases", "h": h, "basis": b}
           for h in (QUICK["bases_h"] if quick else BASES_H) for b in BASES}
     roundoff = {key: {**case, "kernel": "numpy"} for key, case in budget.items()
-                if key[::2] == ROUNDOFF and (tier != "full" or key[1] in ROUNDOFF_H)}
+                if key[::2] == ROUNDOFF and not quick and (tier == "deep" or key[1] in ROUNDOFF_H)}
     return {"budget": budget, "bases": e2, "roundoff": roundoff}
 
 

@@ -77,7 +77,10 @@ SEEDS = (1, 2, 3, 4, 5)
 SEED_H = (0.00125, 0.000625)
 SEEDED = (STUDY, "grid volume")
 DEEP_SEEDED = ("V + dt int dv/dx",)
-QUICK = dict(H=(0.01, 0.005), SEED_H=(0.01, 0.005), SEEDS=SEEDS[:2], SEEDED=(STUDY,))
+#: The quick tier's cases run on the numpy step (the same steps bit for bit, mpm_fem.core.solve.run): on
+#: its two coarsest meshes they cost less than compiling the fused variants they need (the grid volume's
+#: alone: 34 CPU-s, docs/performance.md)
+QUICK = dict(H=(0.02, 0.01), SEED_H=(0.02, 0.01), SEEDS=SEEDS[:2], SEEDED=(STUDY,), kernel="numpy")
 
 
 def _settings(case: dict) -> sod.SodSettings:
@@ -139,12 +142,13 @@ def _plan(tier: str) -> dict:
     plan = {(h, n, "regular", 0): case(h, n) for n in c["variants"] for h in c["h"]}
     plan.update({(h, n, "jittered", s): case(h, n, "jittered", s) for n in j["variants"] for s in j["seeds"]
                  for h in j["h"]})
-    return {"drift": plan}
+    kernel = QUICK["kernel"] if tier == "quick" else None
+    return {"drift": {k: {**c, "kernel": kernel} if kernel else c for k, c in plan.items()}}
 
 
 def run(options: StudyOptions) -> None:
     got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)["drift"]
-    rows, folder = table(got), options.folder(NAME)
+    rows, folder = table(got, QUICK["kernel"] if options.tier == "quick" else None), options.folder(NAME)
     config = _config(options.tier)
     publish(folder, {DRIFT: rows}, {"mpm": MPM, "tier": options.tier, **config,
                                     "changes": {n: VARIANTS[n] or "none" for n in config["variants"]},
@@ -152,10 +156,10 @@ def run(options: StudyOptions) -> None:
     figure(folder, rows)
 
 
-def table(got: dict) -> list[dict]:
+def table(got: dict, kernel: str | None = None) -> list[dict]:
     """The rows of ``drift.csv`` from ``{(h, variant, layout, seed): result}``: by variant, layout and
     seed, then by decreasing h; orders between successive meshes of one series, the ratio to the study
-    settings on the same mesh and layout."""
+    settings on the same mesh and layout; ``kernel``: the step every case ran on (default: each case's own)."""
     rows = []
     series = dict.fromkeys((n, layout, seed) for n in VARIANTS for (_, v, layout, seed) in sorted(got, key=_order)
                            if v == n)
@@ -166,7 +170,8 @@ def table(got: dict) -> list[dict]:
         for h, r in runs:
             row = {"h": h, "variant": name, "layout": layout, "seed": seed,
                    "change": str(VARIANTS[name]) if VARIANTS[name] else "none",
-                   "kernel": case(h, name, layout, seed)["kernel"], "ok": r["ok"], "steps": r.get("steps", "")}
+                   "kernel": kernel or case(h, name, layout, seed)["kernel"], "ok": r["ok"],
+                   "steps": r.get("steps", "")}
             if r["ok"]:
                 base = got.get((h, STUDY, layout, seed), {})
                 row.update(particles_L1=r["particles_L1"], nodes_L1=r["nodes_L1"], volume_drift=r["volume_drift"],

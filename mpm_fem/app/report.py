@@ -305,8 +305,9 @@ def write_report(out: Path, pages: list[Page] | None = None) -> Path:
 
 def reproduce(options) -> Path:
     """Run every study with ``options`` (:class:`mpm_fem.app.study.StudyOptions`), then write the report.
-    The cases of all studies run first, in one pool and the longest first (so no worker idles at the
-    end of a study while another has cases left); each study then reads its cases from the cache."""
+    The cases of all studies run in one pool, the longest first (so no worker idles at the end of a
+    study while another has cases left); as soon as the last case of a study is in, this process
+    writes that study's tables and figures from the cache while the workers go on with the others."""
     from mpm_fem.app.estimate import describe, estimate, tasks
     from mpm_fem.app.study import STUDIES, run_study
     from mpm_fem.app.sweep import default_jobs, run_tasks
@@ -314,11 +315,24 @@ def reproduce(options) -> Path:
     if options.progress is not False:
         workers = options.jobs or default_jobs()
         print(describe({name: estimate(name, options) for name in STUDIES}, workers), file=sys.stderr, flush=True)
-    planned = sorted((t for name in STUDIES for t in tasks(name, options) or ()), key=lambda t: -t[0])
-    run_tasks([task for _, task in planned], jobs=options.jobs, desc=f"reproduce --{options.tier}",
-              scheduler=options.scheduler, progress=options.progress)
-    for name in STUDIES:
+    planned = sorted(((s, name, t) for name in STUDIES for s, t in tasks(name, options) or ()), key=lambda p: -p[0])
+    left = {name: sum(1 for _, n, _ in planned if n == name) for name in STUDIES}
+    published = []
+
+    def publish(name: str) -> None:
+        published.append(name)
         run_study(name, options)
+
+    def done(k: int) -> None:
+        name = planned[k][1]
+        left[name] -= 1
+        if left[name] == 0:
+            publish(name)
+
+    run_tasks([t for _, _, t in planned], jobs=options.jobs, desc=f"reproduce --{options.tier}",
+              scheduler=options.scheduler, progress=options.progress, done=done)
+    for name in (n for n in STUDIES if n not in published):  # a study without a cost model, or no case
+        publish(name)
     return write_report(options.out)
 
 

@@ -49,6 +49,14 @@ def case_key(fn: CaseFn, case: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
+def timed(fn: CaseFn, case: dict) -> tuple[dict, float, float]:
+    """``(fn(case), CPU seconds, wall seconds)`` of the process that runs it: every cache entry records
+    what its case cost (``cpu_s``, ``wall_s``), the measurements the studies' cost models are fitted to."""
+    cpu, wall = time.process_time(), time.perf_counter()
+    result = fn(case)
+    return result, time.process_time() - cpu, time.perf_counter() - wall
+
+
 def fn_version(fn: CaseFn) -> str:
     """:func:`~mpm_fem.measure.version.case_version` of ``fn``, found by its module's file."""
     return case_version(sys.modules[fn.__module__].__file__, fn.__qualname__)
@@ -85,7 +93,7 @@ def _run_pool(tasks, todo, jobs: int, finish) -> None:
     fails, the workers are ended at once instead of finishing their cases."""
     pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),))
     try:
-        futures = {pool.submit(tasks[k].fn, tasks[k].case): (k, path) for k, path in todo}
+        futures = {pool.submit(timed, tasks[k].fn, tasks[k].case): (k, path) for k, path in todo}
         for future in as_completed(futures):
             k, path = futures[future]
             finish(k, path, future.result())
@@ -134,10 +142,13 @@ def run_tasks(
     desc: str = "cases",
     scheduler: str | None = None,
     progress: bool | None = None,
+    done: Callable[[int], None] | None = None,
 ) -> list[dict]:
     """``[t.fn(t.case) for t in tasks]``, in parallel, each cached in its task's folder; results in the
     order of ``tasks``, which is also the order they start in. Tasks of several functions (several
-    studies) share one pool, so no worker idles at the end of one study while another has cases left."""
+    studies) share one pool, so no worker idles at the end of one study while another has cases left.
+    ``done(k)`` is called in this process once task ``k``'s result is in (cached ones first), while the
+    workers go on with the others."""
     if jobs is not None and jobs < 1:
         raise ValueError(f"jobs must be >= 1, got {jobs}")
     jobs = jobs or default_jobs()
@@ -153,13 +164,19 @@ def run_tasks(
         else:
             todo.append((k, path))
     reporter = _Progress(len(tasks), len(tasks) - len(todo), desc, progress)
+    running = {k for k, _ in todo}
+    for k in (k for k in range(len(tasks)) if k not in running and done is not None):
+        done(k)
 
-    def finish(k: int, path: Path | None, result: dict) -> None:
+    def finish(k: int, path: Path | None, run: tuple[dict, float, float]) -> None:
+        result, cpu_s, wall_s = run
         results[k] = result
         if path is not None:
             write_json(path, {"case": tasks[k].case, "case_code": fn_version(tasks[k].fn), "code": code_version(),
-                              "result": result})
+                              "cpu_s": round(cpu_s, 3), "wall_s": round(wall_s, 3), "result": result})
         reporter.update(tasks[k].case)
+        if done is not None:
+            done(k)
 
     try:
         if not todo:
@@ -168,7 +185,7 @@ def run_tasks(
             _run_dask(tasks, todo, scheduler, finish)
         elif jobs == 1 or len(todo) == 1:
             for k, path in todo:
-                finish(k, path, tasks[k].fn(tasks[k].case))
+                finish(k, path, timed(tasks[k].fn, tasks[k].case))
         else:
             _run_pool(tasks, todo, min(jobs, len(todo)), finish)
     finally:
@@ -190,7 +207,8 @@ def _run_dask(tasks, todo, scheduler, finish) -> None:
     with client:
         futures = {}
         for k, path in todo:
-            futures[client.submit(tasks[k].fn, tasks[k].case, pure=False, key=f"case-{k}-{time.time_ns()}")] = (k, path)
+            future = client.submit(timed, tasks[k].fn, tasks[k].case, pure=False, key=f"case-{k}-{time.time_ns()}")
+            futures[future] = (k, path)
         for future in dask_completed(list(futures)):
             k, path = futures[future]
             finish(k, path, future.result())
