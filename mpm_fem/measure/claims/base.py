@@ -17,6 +17,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 VERDICTS = ("confirmed", "partly", "differs", "refuted", "not measured")
+#: The verdicts by name, so that a criterion returns a name, never a typed word
+CONFIRMED, PARTLY, DIFFERS, REFUTED, NOT_MEASURED = VERDICTS
 Tables = Mapping[str, list[dict]]
 Criterion = Callable[[Tables], "tuple[str, str]"]
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import Criterion, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Tables, claim
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
 from mpm_fem.measure.decomposition import decompose
 from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF, BUDGET_SUBSETS
@@ -166,8 +166,8 @@ def _e2(t: Tables) -> tuple[str, str]:
     if "mpm" not in last or len(last) < 2:
         return "not measured", "fewer than two meshes or no point-mass row"
     p1, smooth = last["mpm"]["particles_L1"], {b: v["particles_L1"] for b, v in last.items() if b != "mpm"}
-    verdict = ("differs" if p1 >= FLOOR_ORDER else "confirmed" if max(smooth.values()) > CONVERGING_ORDER
-               else "partly" if max(smooth.values()) > p1 else "refuted")
+    verdict = (DIFFERS if p1 >= FLOOR_ORDER else CONFIRMED if max(smooth.values()) > CONVERGING_ORDER
+               else PARTLY if max(smooth.values()) > p1 else REFUTED)
     return verdict, ("last-refinement order of the particle density L1: "
                      + ", ".join(f"{b} {v['particles_L1']:.2f}" for b, v in last.items())
                      + "; nodes " + ", ".join(f"{b} {v['nodes_L1']:.2f}" for b, v in last.items())

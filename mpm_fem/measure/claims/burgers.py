@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, Tables, claim
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span
 from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, lumping_claim, ppc_claim
 from mpm_fem.measure.schema import BURGERS_DIAGNOSIS, BURGERS_LUMPING, BURGERS_ORDERS, BURGERS_PPC
@@ -67,8 +67,8 @@ def _interval(o: dict, runs: bool = False) -> str:
 
 
 def _pair_verdict(*sides: str) -> str:
-    return "confirmed" if all(s == "above" for s in sides) else "differs" if all(s == "below" for s in sides) else (
-        "partly")
+    return CONFIRMED if all(s == "above" for s in sides) else DIFFERS if all(s == "below" for s in sides) else (
+        PARTLY)
 
 
 @claim("C13", source="first order with exact and with calculated acceleration", tables=(BURGERS_ORDERS.name,),
@@ -86,7 +86,7 @@ def _c13(t: Tables) -> tuple[str, str]:
     calc = {n: c13_order(rows, m) for n, m in C13_CALCULATED.items()}
     verdicts = {n: _pair_verdict(exact["side"], o["side"]) for n, o in calc.items()}
     head = [verdicts[n] for n in _SOURCE_PPC]
-    verdict = head[0] if len(set(head)) == 1 and head[0] != "partly" else "partly"
+    verdict = head[0] if len(set(head)) == 1 and head[0] != PARTLY else PARTLY
     lines = [f"the source's {'-'.join(map(str, _SOURCE_PPC))} per cell: calculated a "
              + ", ".join(f"{n} per cell {_interval(calc[n])}" for n in _SOURCE_PPC)
              + f", exact a (dt ~ h) {_interval(exact)}"]

@@ -3,7 +3,7 @@ errors (``projection/orders``, ``projection/bounds``, ``projection/d2_constant``
 
 from __future__ import annotations
 
-from mpm_fem.measure.claims.base import Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Tables, claim
 from mpm_fem.measure.claims.rows import count_verdict, num, select, span
 from mpm_fem.measure.schema import PROJECTION_BOUNDS, PROJECTION_D2_CONSTANT, PROJECTION_ORDERS
 from mpm_fem.measure.source import D2_C, PROJECTION_BANDS, band_text
@@ -66,7 +66,7 @@ def _c4(t: Tables) -> tuple[str, str]:
     ratio = min(num(r, "min_ratio") for r in t[PROJECTION_BOUNDS.name])
     cs = [num(r, "C") for r in t[PROJECTION_D2_CONSTANT.name] if r["layout"] in ("jittered", "random")]
     inside = all(D2_C[0] <= c <= D2_C[1] for c in cs)
-    verdict = "refuted" if ratio < 1 else ("confirmed" if inside else "partly")
+    verdict = REFUTED if ratio < 1 else (CONFIRMED if inside else PARTLY)
     return verdict, (f"smallest bound/error {ratio:.3g}; fitted C (jittered, random) {span(cs, '.3g')}, "
                      f"source [{D2_C[0]:.3g}, {D2_C[1]:.3g}]")
 

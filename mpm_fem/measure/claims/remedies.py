@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Tables, claim
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
 from mpm_fem.measure.schema import BUDGET_SHAPLEY, REMEDIES_ERRORS, SETTINGS
 from mpm_fem.measure.tables import setting
@@ -158,7 +158,7 @@ def _e5(t: Tables) -> tuple[str, str]:
     removers = [f"{n} ({sc['max_fv_ratio_nodes_L1']:.2f}x / {sc['max_fv_ratio_particles_L1']:.2f}x FV)"
                 for _, n, sc, *_ in scored if sc["removes_plateau"]]
     if s["removes_plateau"] and fv and b_ok:
-        return "confirmed", "meets the goal: " + text
+        return CONFIRMED, "meets the goal: " + text
     if removers:
-        return "partly", text + f"; the Sod plateau is removed by {', '.join(removers)}"
-    return "refuted", f"closest: {text}; no remedy converges as the FV reference does on every Sod mesh"
+        return PARTLY, text + f"; the Sod plateau is removed by {', '.join(removers)}"
+    return REFUTED, f"closest: {text}; no remedy converges as the FV reference does on every Sod mesh"

@@ -5,7 +5,7 @@
 from __future__ import annotations
 
 from mpm_fem.measure import version
-from mpm_fem.measure.claims.base import CLAIMS, Tables, claim
+from mpm_fem.measure.claims.base import CLAIMS, CONFIRMED, PARTLY, REFUTED, Tables, claim
 from mpm_fem.measure.schema import BUILT, VERSIONS
 
 
@@ -31,7 +31,7 @@ def _e4(t: Tables) -> tuple[str, str]:
     other = [r["table"] for r in rows if r["code"] != main]
     needed = {name for c in CLAIMS for name in c.tables if name not in BUILT}
     missing = sorted(needed - {r["table"] for r in rows})
-    verdict = "refuted" if other else ("partly" if missing or main != current else "confirmed")
+    verdict = REFUTED if other else (PARTLY if missing or main != current else CONFIRMED)
     head = (f"{len(rows) - len(other)} of {len(rows)} tables from code {main}, the current code"
             if main == current else lag_text(main, current) + f" ({len(rows) - len(other)} of {len(rows)} tables)")
     return verdict, (head + (f"; other versions: {', '.join(other)}" if other else "")

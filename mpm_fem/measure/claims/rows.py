@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
+from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED
+
 #: The study's one convergence threshold: an observed order at or above CONVERGING_ORDER counts as
 #: converging, one below FLOOR_ORDER as a floor (the error no longer falls with h). Every claim that
 #: reads an order uses these two, and counts an order only when its interval over seeds lies on one side.
@@ -43,11 +45,11 @@ def span(values, fmt: str = ".2f") -> str:
     return lo if lo == hi else f"{lo}..{hi}"
 
 
-def count_verdict(hits: int, total: int, none: str = "refuted") -> str:
+def count_verdict(hits: int, total: int, none: str = REFUTED) -> str:
     """``confirmed`` when every case holds, ``partly`` when some do, ``none`` when no case does."""
     if total == 0:
         return "not measured"
-    return "confirmed" if hits == total else ("partly" if hits else none)
+    return CONFIRMED if hits == total else (PARTLY if hits else none)
 
 
 def saturation(rows: list[dict], key: str, ppc: str = "ppc", within: float = 0.05) -> int:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from mpm_fem.measure.claims.base import DIFFERS, REFUTED
 from mpm_fem.measure.claims.rows import count_verdict, saturation, span
 from mpm_fem.measure.source import OPTIMAL_PPC
 
@@ -21,7 +22,7 @@ def ppc_claim(groups: dict[str, list[dict]], keys: tuple[str, ...]) -> tuple[str
     found = {f"{g}, {k.split('_')[0]}": saturation(rows, k, within=SATURATION)
              for g, rows in groups.items() for k in keys}
     hits = sum(OPTIMAL_PPC[0] <= n <= OPTIMAL_PPC[1] for n in found.values())
-    return count_verdict(hits, len(found), "differs"), (
+    return count_verdict(hits, len(found), DIFFERS), (
         f"N_p within {SATURATION:.0%} of the smallest error: " + "; ".join(f"{g}: {n}" for g, n in found.items()))
 
 
@@ -49,7 +50,7 @@ def lumping_claim(ratios: dict[str, dict[str, float]], judged: tuple[str, ...]) 
     on some judged case, ``refuted`` when it is neutral on all."""
     cases = [x for m in judged for x in ratios.get(m, {}).values() if math.isfinite(x)]
     hits = sum(x < LUMPING_BAND for x in cases)
-    verdict = count_verdict(hits, len(cases), "differs" if any(x > 1 / LUMPING_BAND for x in cases) else "refuted")
+    verdict = count_verdict(hits, len(cases), DIFFERS if any(x > 1 / LUMPING_BAND for x in cases) else REFUTED)
 
     def text(m: str) -> str:
         r = ratios[m]

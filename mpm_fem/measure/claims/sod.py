@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Tables, claim
 from mpm_fem.measure.claims.drift import mechanism
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
 from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, lumping_claim, ppc_claim
@@ -74,7 +74,7 @@ def headline(verdicts: dict[tuple, str]) -> str:
     measured = set(found) - {"not measured"}
     if not measured:
         return "not measured"
-    return found[0] if len(set(found)) == 1 else "partly"
+    return found[0] if len(set(found)) == 1 else PARTLY
 
 
 def _per_setting(criterion, rows: list[dict], *more) -> tuple[dict, dict]:
@@ -127,8 +127,8 @@ def _c11_setting(rows: list[dict], n: int, cfl: float, convergence: list[dict]) 
     if meshes < FLOOR_MESHES:
         return "not measured", f"{meshes} meshes with {MIN_RUNS} runs, the trend needs {FLOOR_MESHES}"
     judged = [trends[name][0] for name in C11_JUDGED]
-    verdict = ("confirmed" if all(t in ("diverges", "stops converging") for t in judged)
-               else "refuted" if all(t == "converges" for t in judged) else "partly")
+    verdict = (CONFIRMED if all(t in ("diverges", "stops converging") for t in judged)
+               else REFUTED if all(t == "converges" for t in judged) else PARTLY)
     text = ", ".join(f"{name} {found} (orders {_orders_text(orders)})" for name, (found, orders) in trends.items())
     compared = [r for r in select(convergence, ppc=n, cfl=cfl) if r.get("ratio_nodes_L1", "") != ""][-1:]
     if compared:
@@ -188,7 +188,7 @@ def _c12_setting(rows: list[dict], n: int, cfl: float) -> tuple[str, str]:
     waves = [sum(num(r, f"share_{k}") for k in WAVE_REGIONS) for r in rows]
     smooth = [num(r, "share_2") for r in rows]
     hits = sum(w >= WAVE_SHARE for w in waves)
-    return count_verdict(hits, len(rows), "differs"), (
+    return count_verdict(hits, len(rows), DIFFERS), (
         f"waves carry {waves[-1]:.0%} of the nodal L1 at h = {rows[-1]['h']} ({waves[0]:.0%} at h = {rows[0]['h']}), "
         f"the smooth region {smooth[0]:.0%} -> {smooth[-1]:.0%}, above {WAVE_SHARE:.0%} on {hits} of {len(rows)} "
         "meshes")
@@ -263,8 +263,8 @@ def _e3_setting(rows: list[dict], n: int, cfl: float, convergence: list[dict]) -
                  else "FEM's grows" if g.below(1 / E3_FACTOR) else "undecided")
         found.append(which)
         parts.append(f"{where} x{g.text()} ({which})")
-    verdict = ("confirmed" if all(w == "constant" for w in found)
-               else "refuted" if all(w.endswith("grows") for w in found) else "partly")
+    verdict = (CONFIRMED if all(w == "constant" for w in found)
+               else REFUTED if all(w.endswith("grows") for w in found) else PARTLY)
     return verdict, ", ".join(parts) + f" from h = {coarse:g} to {fine:g}"
 
 

@@ -3,7 +3,7 @@ node crossing), from ``time/*``."""
 
 from __future__ import annotations
 
-from mpm_fem.measure.claims.base import Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Tables, claim
 from mpm_fem.measure.claims.rows import count_verdict, num, select, span
 from mpm_fem.measure.schema import TIME_CROSSING_SUMMARY, TIME_LOCAL_ERROR, TIME_ORDER
 
@@ -50,7 +50,7 @@ def _c2(t: Tables) -> tuple[str, str]:
         return "not measured", "no point-mass row with the exact acceleration"
     matches = num(p1[0], "max_ratio_error") <= CROSSING_TOLERANCE
     no_jump = bool(smooth) and all(v <= NO_JUMP for v in smooth.values())
-    return ("confirmed" if matches and no_jump else "partly" if matches else "refuted"), (
+    return (CONFIRMED if matches and no_jump else PARTLY if matches else REFUTED), (
         f"P1, exact acceleration: measured/predicted median {num(p1[0], 'median_ratio'):.3f}, worst deviation "
         f"{num(p1[0], 'max_ratio_error'):.3f} over {p1[0]['crossings']} crossings; C1 bases |measured|/P1 formula "
         + ", ".join(f"{b} {v:.3f}" for b, v in smooth.items()))
