@@ -32,6 +32,30 @@ def test_the_finest_meshes_are_deep_only():
     assert 0.000078125 not in {c["h"] for c in sod._plan("full")["mpm"].values()}
     assert ("sod", 0.000625, "mpm") in budget.plan("deep")["budget"]
     assert ("sod", 0.000625, "mpm") not in budget.plan("full")["budget"]
+    for basis in ("bspline", "bspline_gimp"):  # a B-spline budget at 0.00125 costs three P1 ones
+        assert ("sod", 0.00125, basis) in budget.plan("deep")["budget"]
+        assert ("sod", 0.00125, basis) not in budget.plan("full")["budget"]
+        assert ("sod", 0.0025, basis) in budget.plan("full")["budget"]
+    assert ("sod", 0.00125, "gimp") in budget.plan("full")["budget"]
+
+
+def test_the_roundoff_rerun_is_deep_on_every_mesh_full_on_the_coarser_quick_never():
+    budget = importlib.import_module("studies.budget")
+    meshes = {tier: sorted(h for _, h, _ in budget.plan(tier)["roundoff"]) for tier in ("quick", "full", "deep")}
+    assert meshes["quick"] == [] and meshes["full"] == sorted(budget.ROUNDOFF_H)
+    assert meshes["deep"] == sorted(set(budget.H["sod"]) | {0.000625})
+    assert all(c["kernel"] == "numpy" for c in budget.plan("deep")["roundoff"].values())
+
+
+def test_the_quick_tier_compiles_no_remedy_and_no_second_basis():
+    """What each fused variant costs to compile is in docs/performance.md: the quick tier runs the drift
+    and remedies studies on the numpy step and the time study on P1 alone."""
+    drift, remedies, time = (importlib.import_module(f"studies.{n}") for n in ("drift", "remedies", "time"))
+    assert {c["kernel"] for c in drift._plan("quick")["drift"].values()} == {"numpy"}
+    assert {c["kernel"] for c in drift._plan("full")["drift"].values()} == {"fused", "numpy"}
+    mpm = [c for g in ("sod", "burgers") for c in remedies._plan("quick")[g].values()]
+    assert len(mpm) == 24 and {c["kernel"] for c in mpm} == {"numpy"}
+    assert {c["basis"] for c in time.plan("quick")["time"].values()} == {"mpm"}
 
 
 def test_a_study_runs_one_tier():

@@ -1,0 +1,42 @@
+"""``reproduce`` runs every study's cases in one pool, the longest first, and writes a study's tables
+as soon as its last case is in (fake studies: the pool and the order, not the numerics)."""
+
+from __future__ import annotations
+
+from mpm_fem.app import estimate, report, study
+from mpm_fem.app.study import StudyOptions
+from mpm_fem.app.sweep import Task
+
+
+def square(case):
+    with open(case["trace"], "a") as f:
+        f.write(f"{case['n']}\n")
+    return {"square": case["n"] ** 2}
+
+
+def test_each_study_is_written_once_after_its_last_case_and_the_longest_cases_start_first(tmp_path, monkeypatch):
+    trace = tmp_path / "trace"
+    cost = {"a": (3.0, 1.0), "b": (2.0,), "c": ()}  # estimated seconds of each study's cases; c has none
+
+    def tasks(name, options):
+        return [(s, Task(square, {"n": int(10 * s) + ord(name), "trace": str(trace)}, tmp_path / name))
+                for s in cost[name]]
+
+    written = []
+
+    def run_study(name, options):
+        cached = {p.name for p in (tmp_path / name).glob("*.json")} if (tmp_path / name).exists() else set()
+        written.append((name, len(cached)))
+        return name
+
+    monkeypatch.setattr(study, "STUDIES", tuple(cost))
+    monkeypatch.setattr(study, "run_study", run_study)
+    monkeypatch.setattr(estimate, "tasks", tasks)
+    monkeypatch.setattr(report, "write_report", lambda out: out)
+    report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))
+    started = [int(n) for n in trace.read_text().split()]
+    assert started == [30 + ord("a"), 20 + ord("b"), 10 + ord("a")]  # the longest first, across studies
+    assert written == [("b", 1), ("a", 2), ("c", 0)]  # each once, with all its cases in; c (no case) last
+    written.clear()
+    report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))  # all cached: every study at once
+    assert sorted(written) == [("a", 2), ("b", 1), ("c", 0)] and len(trace.read_text().split()) == 3
