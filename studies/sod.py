@@ -59,7 +59,7 @@ DEEP_SETTINGS = (SETTINGS[0], (4, MPM["cfl"]))
 MOVING_FRACTION = 0.01
 _GAS = sod.SodSettings()
 MOVING_SPEED = MOVING_FRACTION * min((_GAS.gamma * p / rho) ** 0.5 for rho, _, p in (_GAS.left, _GAS.right))
-QUICK = dict(H=H[:3], PPC_H=(0.01,), CONSISTENT_H=H[:1], PLATEAU_H=(), SEED_H=H[:3], SEEDS=SEEDS[:2])
+QUICK = dict(H=H[:3], PPC_H=(0.01,), CONSISTENT_H=H[:1], PLATEAU_H=(), SEED_H=H[:3])  # E3 needs MIN_RUNS = 6 runs a mesh
 
 
 def run_case(case: dict) -> dict:
