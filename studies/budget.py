@@ -23,10 +23,10 @@ terms and Shapley values (:mod:`mpm_fem.measure.decomposition`) decompose ``v(al
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.00125 for P1 and GIMP, 0.01 ... 0.0025 for the two B-splines (three meshes
-or more give each basis's budget a trend, not only a change; a B-spline budget at 0.00125 costs
-three P1 ones, so the full tier leaves it to the deep tier, :data:`FINEST`), the deep tier adds those
-and P1 at h = 0.000625 (:data:`DEEP`); Burgers 0.04 ... 0.01. A Sod case
+Meshes: Sod h = 0.01 ... 0.00125 for P1, 0.01 ... 0.0025 for GIMP and the two B-splines (three meshes
+or more give each basis's budget a trend, not only a change; a budget of theirs at 0.00125 costs 1.4
+(GIMP) to 3 (B-splines) P1 ones, so the full tier leaves it to the deep tier, :data:`FINEST`), the
+deep tier adds those and P1 at h = 0.000625 (:data:`DEEP`); Burgers 0.04 ... 0.01. A Sod case
 is 16 runs, all on the fused step (:mod:`mpm_fem.fused`): the fourteen with an exact stage run its
 compiled particle passes around the numpy step's grid stage (:mod:`mpm_fem.exact_stages`). What each
 run cost is in ``runs.csv`` (``wall_s``); ``docs/performance.md`` has the measured costs.
@@ -68,18 +68,19 @@ BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}
 #: the deep tier's further budgets, (problem, h, basis): P1's Sod one mesh finer
-DEEP = (("sod", 0.000625, "mpm"), ("sod", 0.00125, "bspline"), ("sod", 0.00125, "bspline_gimp"))
+DEEP = (("sod", 0.000625, "mpm"), ("sod", 0.00125, "gimp"), ("sod", 0.00125, "bspline"),
+        ("sod", 0.00125, "bspline_gimp"))
 #: (problem, basis): the finest mesh of the full tier's budget of a basis that stops above H's finest
-FINEST = {("sod", "bspline"): 0.0025, ("sod", "bspline_gimp"): 0.0025}
+FINEST = {("sod", "gimp"): 0.0025, ("sod", "bspline"): 0.0025, ("sod", "bspline_gimp"): 0.0025}
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
 QUICK = {"h": {"sod": (0.02,), "burgers": (0.04, 0.02)}, "bases": ("mpm",), "bases_h": ()}
 GAP = "all MPM - all exact"
 #: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring): the
-#: full tier on the meshes of ROUNDOFF_H (the numpy step at h = 0.00125 would be its longest case), the
+#: full tier on the meshes of ROUNDOFF_H (at h = 0.0025 the numpy step costs 1.7 P1 budgets there), the
 #: deep tier on every mesh, the quick tier on none (it would be 40 % of the quick budget's cost)
-ROUNDOFF, ROUNDOFF_H = ("sod", "mpm"), H["sod"][:3]
+ROUNDOFF, ROUNDOFF_H = ("sod", "mpm"), H["sod"][:2]
 COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:green", "time": "tab:red"}
 
 
@@ -99,8 +100,8 @@ def plan(tier: str) -> dict:
 
 
 #: CPU time of a case relative to P1's (the four exact-stage runs of the docstring, fused, Sod, h = 0.005)
-STEP_COST = {"mpm": 1.0, "gimp": 1.1, "bspline": 1.6, "bspline_gimp": 1.6}
-NUMPY_STEP_COST = 1.5  # a roundoff.csv case (the numpy step) against the same case fused
+STEP_COST = {"mpm": 1.0, "gimp": 1.4, "bspline": 2.4, "bspline_gimp": 2.5}  # measured: the cases' cpu_s
+NUMPY_STEP_COST = 1.7  # a roundoff.csv case (the numpy step) against the same case fused
 
 
 def cost(case: dict) -> float:
@@ -311,8 +312,8 @@ def fields_figure(path: Path, problem: str, fields: dict) -> None:
 
 
 #: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`cost`, from the full
-#: tier's run on the 2-core machine (2026-11-25: 807 s wall on 2 workers for 2.9e9 units).
-PLAN, COST, SECONDS_PER_COST = plan, cost, 5.5e-7
+#: tier's cases on the 2-core machine (2026-11-26, from-scratch run: CHANGES.md).
+PLAN, COST, SECONDS_PER_COST = plan, cost, 7.6e-7
 
 if __name__ == "__main__":
     sys.exit(script_main(NAME))

@@ -301,8 +301,8 @@ def _profiles(path, got) -> None:
 
 
 #: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`_cost`, from the full
-#: tier's run on the 2-core machine (2026-11-25: 171 s wall on 2 workers for 8.4e9 units).
-PLAN, COST, SECONDS_PER_COST = _plan, _cost, 4.1e-8
+#: tier's cases on the 2-core machine (2026-11-26, from-scratch run: CHANGES.md).
+PLAN, COST, SECONDS_PER_COST = _plan, _cost, 9.0e-8
 
 if __name__ == "__main__":
     sys.exit(script_main(NAME))

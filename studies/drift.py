@@ -236,9 +236,9 @@ def figure(folder, rows: list[dict]) -> None:
     plots.save(fig, folder / "drift.png", CAPTION)
 
 
-#: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`_cost` (the Sod
-#: study's model, 2026-11-25: one run of 5.2e10 units took 1,202 s on the per-step path).
-PLAN, COST, SECONDS_PER_COST = _plan, _cost, 2.3e-8
+#: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`_cost`, from the full
+#: tier's cases on the 2-core machine (2026-11-26, from-scratch run: CHANGES.md).
+PLAN, COST, SECONDS_PER_COST = _plan, _cost, 1.6e-8
 
 if __name__ == "__main__":
     sys.exit(script_main(NAME))

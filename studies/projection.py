@@ -290,10 +290,10 @@ def figures(folder: Path, t: dict, results: list) -> None:
 
 
 #: The cost model of :mod:`mpm_fem.app.estimate`: a case is a fraction of a second (the full tier,
-#: 648 cases, took about 18 CPU-s on the 2-core machine on 2026-11-25).
+#: 648 cases, took 27.3 CPU-s on the 2-core machine in a from-scratch run on 2026-11-26).
 PLAN = lambda tier: {"cases": {k: c for k, c in enumerate(cases(StudyOptions(quick=tier == "quick")))}}  # noqa: E731
 COST = lambda case: 1.0  # noqa: E731
-SECONDS_PER_COST = 18.0 / 648
+SECONDS_PER_COST = 27.3 / 648
 run_case = case
 
 if __name__ == "__main__":

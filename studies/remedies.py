@@ -257,8 +257,8 @@ def _cost_figure(folder: Path, cost) -> None:
 
 
 #: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`_cost`, from the full
-#: tier's run on the 2-core machine (2026-11-25: 803 s wall on 2 workers for 4.0e11 units).
-PLAN, COST, SECONDS_PER_COST = _plan, _cost, 4.1e-9
+#: tier's cases on the 2-core machine (2026-11-26, from-scratch run: CHANGES.md).
+PLAN, COST, SECONDS_PER_COST = _plan, _cost, 1.0e-8
 
 if __name__ == "__main__":
     sys.exit(script_main(NAME))

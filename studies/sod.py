@@ -269,9 +269,9 @@ def _profiles(folder, got) -> None:
             f"Sod at T = {T}, h = {h:g}: MPM (top) and fixed-mesh FEM (bottom) on the same mesh")
 
 
-#: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`_cost` (2026-11-25: the
-#: run at h = 0.000078125, 16 per cell, CFL 0.05, 5.2e10 units, took 1,202 s on the per-step path).
-PLAN, COST, SECONDS_PER_COST = _plan, _cost, 2.3e-8
+#: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`_cost`, from the full
+#: tier's cases on the 2-core machine (2026-11-26, from-scratch run: CHANGES.md).
+PLAN, COST, SECONDS_PER_COST = _plan, _cost, 2.0e-8
 
 if __name__ == "__main__":
     sys.exit(script_main(NAME))

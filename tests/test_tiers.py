@@ -36,7 +36,9 @@ def test_the_finest_meshes_are_deep_only():
         assert ("sod", 0.00125, basis) in budget.plan("deep")["budget"]
         assert ("sod", 0.00125, basis) not in budget.plan("full")["budget"]
         assert ("sod", 0.0025, basis) in budget.plan("full")["budget"]
-    assert ("sod", 0.00125, "gimp") in budget.plan("full")["budget"]
+    assert ("sod", 0.00125, "mpm") in budget.plan("full")["budget"]
+    assert ("sod", 0.00125, "gimp") in budget.plan("deep")["budget"]
+    assert ("sod", 0.00125, "gimp") not in budget.plan("full")["budget"]
 
 
 def test_the_roundoff_rerun_is_deep_on_every_mesh_full_on_the_coarser_quick_never():
