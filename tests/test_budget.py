@@ -259,11 +259,12 @@ def test_the_roundoff_table_compares_the_two_arithmetics():
     change in percentage points; E1's evidence names the largest change per mesh."""
     from mpm_fem.measure.claims import _roundoff_text
     from mpm_fem.measure.decomposition import share_changes
-    from studies.budget import ROUNDOFF, plan
+    from studies.budget import ROUNDOFF, ROUNDOFF_H, plan
 
     cases = plan("full")["roundoff"]
     assert cases and all(key[::2] == ROUNDOFF and case["kernel"] == "numpy" for key, case in cases.items())
-    assert set(cases) == {k for k in plan("full")["budget"] if k[::2] == ROUNDOFF}
+    assert set(cases) == {k for k in plan("full")["budget"] if k[::2] == ROUNDOFF and k[1] in ROUNDOFF_H}
+    assert set(plan("deep")["roundoff"]) == {k for k in plan("deep")["budget"] if k[::2] == ROUNDOFF}
     key = {"problem": "sod", "h": 0.01, "basis": "mpm", "norm": "particles"}
     fused = [{**key, "stage": "mass", "share": -0.5, "mpm_error": 2.0, "exact_error": 1.0},
              {**key, "stage": "time", "share": 0.25, "mpm_error": 2.0, "exact_error": 1.0},
