@@ -128,7 +128,8 @@ def closure(tree: ast.Module, name: str) -> list[ast.stmt]:
     module's order: ``name``'s own, then every statement binding or changing a name that an included
     statement mentions, to a fixed point. Over-inclusive (a name counts wherever it appears), so a
     change the function can see is never left out; a name reached only through ``globals()`` or
-    ``getattr(module, ...)`` would be, and the studies' case functions use neither."""
+    ``getattr(module, ...)``, or changed by a function called at import time, would be; the studies'
+    case functions use none of these."""
     needed, included = {name}, [False] * len(tree.body)
     changed = True
     while changed:
