@@ -22,8 +22,9 @@ def lag_text(stamp: str, current: str) -> str:
                   "claim reads exists -> confirmed; one version that is not the current code's (the figures lag "
                   "the code) or a table missing -> partly; tables from several code versions -> refuted")
 def _e4(t: Tables) -> tuple[str, str]:
-    """The stamp of each table is the version of the code that wrote it, computed as the sweeps compute
-    the key of their case cache; a change to a docstring, a comment, the report or the plots leaves it."""
+    """The stamp of each table is the version of all the code that wrote it (the case cache is keyed by
+    the narrower version of the code a case runs through, :func:`mpm_fem.measure.version.case_version`);
+    a change to a docstring, a comment, the report or the plots leaves it."""
     rows = t[VERSIONS.name]
     codes = [r["code"] for r in rows]
     main = max(set(codes), key=codes.count)
