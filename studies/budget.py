@@ -75,7 +75,7 @@ FINEST = {("sod", "gimp"): 0.0025, ("sod", "bspline"): 0.0025, ("sod", "bspline_
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
-QUICK = {"h": {"sod": (0.02,), "burgers": (0.04, 0.02)}, "bases": ("mpm",), "bases_h": ()}
+QUICK = {"h": {"sod": (0.02,), "burgers": (0.04,)}, "bases": ("mpm",), "bases_h": ()}
 GAP = "all MPM - all exact"
 #: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring): the
 #: full tier on the meshes of ROUNDOFF_H (at h = 0.0025 the numpy step costs 1.7 P1 budgets there), the

@@ -297,7 +297,7 @@ def _aspects(folder) -> dict:
 
 
 def test_no_figure_is_wider_than_two_and_a_half_times_its_height(written, tmp_path):
-    """Full tier (five eps: a grid) and quick tier (two eps: one row of two)."""
+    """Full tier (five eps: a grid) and quick tier (one eps)."""
     study.run(_FakeRuns(out=tmp_path, quick=True))
     for aspects in (_aspects(written), _aspects(tmp_path / study.NAME)):
         assert {"convergence.png", "seeds.png", "solutions.png"} <= set(aspects)

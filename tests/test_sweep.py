@@ -107,3 +107,53 @@ def test_tasks_of_two_functions_share_one_pool_each_cached_in_its_folder(tmp_pat
     stored = json.loads(tasks[1].path.read_text())
     assert tasks[1].path.parent == tmp_path / "sq" and stored["case_code"] == fn_version(square)
     assert run_tasks(tasks, jobs=2, progress=False) == out and len(trace.read_text().split()) == 6  # all cached
+
+
+def slow_square(case):
+    """:func:`square` that takes 0.2 s, so that the cases of a pool overlap."""
+    import time
+
+    with open(case["trace"], "a") as f:
+        f.write(f"{case['n']}\n")
+    time.sleep(0.2)
+    return {"n": case["n"], "square": case["n"] ** 2}
+
+
+def note(trace, text):
+    """A follow-up's body: ``text`` and the process that ran it, into ``trace``."""
+    import os
+
+    with open(trace, "a") as f:
+        f.write(f"{text}:{os.getpid()}\n")
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_follow_up_runs_in_a_worker_ahead_of_the_waiting_cases_or_here_without_a_pool(tmp_path, jobs):
+    """``done(k)`` may return a function for the pool: with two workers it runs in a worker before the
+    cases still waiting start (at most jobs + 1 cases are handed to the pool at a time); with one job,
+    here, at once. A cached case's follow-up runs too (before the pool's cases)."""
+    import functools
+    import os
+
+    from mpm_fem.app.sweep import Task, run_tasks
+
+    trace = tmp_path / "trace"
+    tasks = [Task(slow_square, {"n": n, "trace": str(trace)}, tmp_path / "cache") for n in range(8)]
+    run_tasks(tasks[7:], jobs=1, progress=False)  # the last case is cached
+    trace.write_text("")
+    follow = {0: "after0", 7: "after7"}
+    out = run_tasks(tasks, jobs=jobs, progress=False,
+                    done=lambda k: functools.partial(note, trace, follow[k]) if k in follow else None)
+    assert out == [{"n": n, "square": n * n} for n in range(8)]
+    lines = trace.read_text().split()
+    notes = {line.split(":")[0]: int(line.split(":")[1]) for line in lines if ":" in line}
+    assert set(notes) == {"after0", "after7"}
+    cases = [line for line in lines if ":" not in line]
+    assert sorted(cases, key=int) == [str(n) for n in range(7)]  # the cached one did not run again
+    assert lines.index(f"after7:{notes['after7']}") < lines.index("1")  # ahead of the cases (beside case 0)
+    if jobs == 1:
+        assert set(notes.values()) == {os.getpid()} and lines.index(f"after0:{os.getpid()}") == lines.index("0") + 1
+    else:
+        assert os.getpid() not in notes.values()
+        # when case 0 ends, cases 1 and 2 are already handed to the pool; 3 .. 6 wait behind the follow-up
+        assert lines.index(f"after0:{notes['after0']}") < lines.index("4")

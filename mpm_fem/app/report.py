@@ -17,6 +17,8 @@ import argparse
 import json
 import math
 import sys
+from dataclasses import replace
+from functools import partial
 from pathlib import Path
 
 from mpm_fem.app.output import write_atomic
@@ -219,7 +221,9 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
     """What a reader must know before the numbers: the tier, the study's settings that differ from the
     source's, and whether the figures lag the code (``current``: the code version now, if known)."""
     out = ["## Caveats", ""]
-    out.append("- These tables come from `mpm-fem reproduce --quick`: a subset of the meshes of each study."
+    out.append("- These tables come from `mpm-fem reproduce --quick`: a subset of the meshes of each study. A "
+               "verdict judged on the finest mesh a study has can differ from the full record's "
+               "(`mpm-fem reproduce --full`), which reaches finer meshes."
                if is_quick(tables) else "- These tables come from `mpm-fem reproduce --full`.")
     written = code_version(tables)
     rows = tables.get("versions", [])
@@ -306,8 +310,9 @@ def write_report(out: Path, pages: list[Page] | None = None) -> Path:
 def reproduce(options) -> Path:
     """Run every study with ``options`` (:class:`mpm_fem.app.study.StudyOptions`), then write the report.
     The cases of all studies run in one pool, the longest first (so no worker idles at the end of a
-    study while another has cases left); as soon as the last case of a study is in, this process
-    writes that study's tables and figures from the cache while the workers go on with the others."""
+    study while another has cases left); as soon as the last case of a study is in, a worker writes
+    that study's tables and figures from the cache, ahead of the cases still waiting (this process
+    does, with one job or a Dask scheduler: :func:`mpm_fem.app.sweep.run_tasks`)."""
     from mpm_fem.app.estimate import describe, estimate, tasks
     from mpm_fem.app.study import STUDIES, run_study
     from mpm_fem.app.sweep import default_jobs, run_tasks
@@ -318,21 +323,21 @@ def reproduce(options) -> Path:
     planned = sorted(((s, name, t) for name in STUDIES for s, t in tasks(name, options) or ()), key=lambda p: -p[0])
     left = {name: sum(1 for _, n, _ in planned if n == name) for name in STUDIES}
     published = []
+    # a study's tables and figures, in a worker: every case is in the cache by then, so it runs none
+    writer = replace(options, jobs=1, progress=False)
 
-    def publish(name: str) -> None:
-        published.append(name)
-        run_study(name, options)
-
-    def done(k: int) -> None:
+    def done(k: int):
         name = planned[k][1]
         left[name] -= 1
         if left[name] == 0:
-            publish(name)
+            published.append(name)
+            return partial(run_study, name, writer)
+        return None
 
     run_tasks([t for _, _, t in planned], jobs=options.jobs, desc=f"reproduce --{options.tier}",
               scheduler=options.scheduler, progress=options.progress, done=done)
     for name in (n for n in STUDIES if n not in published):  # a study without a cost model, or no case
-        publish(name)
+        run_study(name, options)
     return write_report(options.out)
 
 

@@ -29,7 +29,8 @@ import signal
 import sys
 import threading
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections import deque
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -88,15 +89,33 @@ def _worker_init(parent: int) -> None:
     threading.Thread(target=_watch_parent, args=(parent,), daemon=True, name="watch-parent").start()
 
 
-def _run_pool(tasks, todo, jobs: int, finish) -> None:
-    """The tasks of ``todo`` in ``jobs`` worker processes. If the parent is interrupted (Ctrl-C) or
-    fails, the workers are ended at once instead of finishing their cases."""
+def _run_pool(tasks, todo, jobs: int, finish, followups=()) -> None:
+    """The tasks of ``todo`` in ``jobs`` worker processes, started in their order and at most ``jobs + 1``
+    at a time, so that a follow-up (a function of no arguments: ``followups``, and what ``finish``
+    returns) starts ahead of the tasks still waiting. If the parent is interrupted (Ctrl-C) or fails,
+    the workers are ended at once instead of finishing their cases."""
     pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),))
+    waiting, ahead, running = deque(todo), deque(followups), {}
+
+    def start() -> None:
+        while len(running) <= jobs and (ahead or waiting):
+            if ahead:
+                running[pool.submit(ahead.popleft())] = None
+            else:
+                k, path = waiting.popleft()
+                running[pool.submit(timed, tasks[k].fn, tasks[k].case)] = (k, path)
+
     try:
-        futures = {pool.submit(timed, tasks[k].fn, tasks[k].case): (k, path) for k, path in todo}
-        for future in as_completed(futures):
-            k, path = futures[future]
-            finish(k, path, future.result())
+        start()
+        while running:
+            finished, _ = wait(running, return_when=FIRST_COMPLETED)
+            for future in finished:
+                item = running.pop(future)
+                result = future.result()
+                then = finish(*item, result) if item is not None else None
+                if then is not None:
+                    ahead.append(then)
+            start()
     except BaseException:
         workers = list(getattr(pool, "_processes", {}).values())  # no public handle on the workers
         pool.shutdown(wait=False, cancel_futures=True)
@@ -142,13 +161,16 @@ def run_tasks(
     desc: str = "cases",
     scheduler: str | None = None,
     progress: bool | None = None,
-    done: Callable[[int], None] | None = None,
+    done: Callable[[int], Callable[[], object] | None] | None = None,
 ) -> list[dict]:
     """``[t.fn(t.case) for t in tasks]``, in parallel, each cached in its task's folder; results in the
     order of ``tasks``, which is also the order they start in. Tasks of several functions (several
     studies) share one pool, so no worker idles at the end of one study while another has cases left.
     ``done(k)`` is called in this process once task ``k``'s result is in (cached ones first), while the
-    workers go on with the others."""
+    workers go on with the others. It may return a follow-up, a picklable function of no arguments
+    (a study's tables and figures once its last case is in): a worker of the pool runs it ahead of the
+    cases not yet started; without a pool (one job) or on a Dask cluster (whose workers need not share
+    this file system) this process runs it at once."""
     if jobs is not None and jobs < 1:
         raise ValueError(f"jobs must be >= 1, got {jobs}")
     jobs = jobs or default_jobs()
@@ -163,31 +185,42 @@ def run_tasks(
             results[k] = cached
         else:
             todo.append((k, path))
+    pooled = scheduler is None and jobs > 1
     reporter = _Progress(len(tasks), len(tasks) - len(todo), desc, progress)
-    running = {k for k, _ in todo}
-    for k in (k for k in range(len(tasks)) if k not in running and done is not None):
-        done(k)
 
-    def finish(k: int, path: Path | None, run: tuple[dict, float, float]) -> None:
+    def follow(k: int):
+        """``done(k)``'s follow-up, for the pool to run; run here when there is no pool."""
+        then = done(k) if done is not None else None
+        if then is not None and not pooled:
+            then()
+            return None
+        return then
+
+    running = {k for k, _ in todo}
+    followups = [f for f in (follow(k) for k in range(len(tasks)) if k not in running) if f is not None]
+
+    def finish(k: int, path: Path | None, run: tuple[dict, float, float]):
         result, cpu_s, wall_s = run
         results[k] = result
         if path is not None:
             write_json(path, {"case": tasks[k].case, "case_code": fn_version(tasks[k].fn), "code": code_version(),
                               "cpu_s": round(cpu_s, 3), "wall_s": round(wall_s, 3), "result": result})
         reporter.update(tasks[k].case)
-        if done is not None:
-            done(k)
+        return follow(k)
 
     try:
-        if not todo:
-            pass
-        elif scheduler is not None:
-            _run_dask(tasks, todo, scheduler, finish)
-        elif jobs == 1 or len(todo) == 1:
-            for k, path in todo:
-                finish(k, path, timed(tasks[k].fn, tasks[k].case))
+        if scheduler is not None:
+            if todo:
+                _run_dask(tasks, todo, scheduler, finish)
+        elif pooled and len(todo) + len(followups) > 1:
+            _run_pool(tasks, todo, min(jobs, len(todo) + len(followups)), finish, followups)
         else:
-            _run_pool(tasks, todo, min(jobs, len(todo)), finish)
+            for then in followups:
+                then()
+            for k, path in todo:
+                then = finish(k, path, timed(tasks[k].fn, tasks[k].case))
+                if then is not None:
+                    then()
     finally:
         reporter.close()
     return results  # type: ignore[return-value]

@@ -60,7 +60,13 @@ def _without_docstrings(tree: ast.AST) -> ast.AST:
 def file_text(path: Path) -> bytes:
     """What a file contributes to the version: its syntax tree without docstrings, or its bytes
     when it does not parse."""
-    source = Path(path).read_bytes()
+    return _source_text(Path(path).read_bytes())
+
+
+@lru_cache(maxsize=None)
+def _source_text(source: bytes) -> bytes:
+    """:func:`file_text` of a file holding ``source``, parsed once per content (the code's version and
+    the cases' versions read the same files)."""
     try:
         return ast.dump(_without_docstrings(ast.parse(source))).encode()
     except (SyntaxError, ValueError):
@@ -89,6 +95,8 @@ def model_files(root: Path = ROOT) -> list[Path]:
     return [p for p in versioned_files(root) if not p.relative_to(root).as_posix().startswith(OUTSIDE_THE_MODEL)]
 
 
+#: The test of a module's ``if __name__ == "__main__":`` block, as :func:`ast.dump` writes it.
+_MAIN_TEST = ast.dump(ast.parse('__name__ == "__main__"').body[0].value)
 _DEFINITIONS = (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
 _BINDINGS = (ast.Assign, ast.AnnAssign, ast.AugAssign, ast.Import, ast.ImportFrom)
 
@@ -118,7 +126,7 @@ def _binds(stmt: ast.stmt) -> set[str]:
         return set().union(*map(_target_names, stmt.targets))
     if isinstance(stmt, (ast.AnnAssign, ast.AugAssign)):
         return _target_names(stmt.target)
-    if isinstance(stmt, ast.If) and ast.dump(stmt.test) == ast.dump(ast.parse('__name__ == "__main__"').body[0].value):
+    if isinstance(stmt, ast.If) and ast.dump(stmt.test) == _MAIN_TEST:
         return set()
     return _names(stmt)
 
