@@ -109,16 +109,6 @@ def test_tasks_of_two_functions_share_one_pool_each_cached_in_its_folder(tmp_pat
     assert run_tasks(tasks, jobs=2, progress=False) == out and len(trace.read_text().split()) == 6  # all cached
 
 
-def slow_square(case):
-    """:func:`square` that takes 0.2 s, so that the cases of a pool overlap."""
-    import time
-
-    with open(case["trace"], "a") as f:
-        f.write(f"{case['n']}\n")
-    time.sleep(0.2)
-    return {"n": case["n"], "square": case["n"] ** 2}
-
-
 def note(trace, text):
     """A follow-up's body: ``text`` and the process that ran it, into ``trace``."""
     import os
@@ -138,7 +128,7 @@ def test_a_follow_up_runs_in_a_worker_ahead_of_the_waiting_cases_or_here_without
     from mpm_fem.app.sweep import Task, run_tasks
 
     trace = tmp_path / "trace"
-    tasks = [Task(slow_square, {"n": n, "trace": str(trace)}, tmp_path / "cache") for n in range(8)]
+    tasks = [Task(slow_square, {"n": n, "trace": str(trace), "sleep": 0.2}, tmp_path / "cache") for n in range(8)]
     run_tasks(tasks[7:], jobs=1, progress=False)  # the last case is cached
     trace.write_text("")
     follow = {0: "after0", 7: "after7"}
