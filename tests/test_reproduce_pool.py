@@ -40,3 +40,39 @@ def test_each_study_is_written_once_after_its_last_case_and_the_longest_cases_st
     written.clear()
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))  # all cached: every study at once
     assert sorted(written) == [("a", 2), ("b", 1), ("c", 0)] and len(trace.read_text().split()) == 3
+
+
+def write_study(name, options):
+    """A study's tables and figures, faked: which study, how many of its cases were cached, which process."""
+    import os
+
+    folder = options.out / name
+    cached = len(list(folder.glob("*.json"))) if folder.exists() else 0
+    with open(options.out / "written", "a") as f:
+        f.write(f"{name} {cached} {os.getpid()} {options.jobs}\n")
+    return name
+
+
+def test_with_two_workers_a_worker_writes_each_study_once_its_cases_are_in(tmp_path, monkeypatch):
+    """The pool's follow-ups (:func:`mpm_fem.app.sweep.run_tasks`): each study is written once, by a worker
+    (not this process), with every case of it in the cache, and with one job (it runs no case then)."""
+    import os
+
+    trace = tmp_path / "trace"
+    cost = {"a": (3.0, 1.0, 0.5), "b": (2.0,), "c": ()}
+
+    def tasks(name, options):
+        return [(s, Task(square, {"n": int(10 * s) + ord(name), "trace": str(trace)}, tmp_path / name))
+                for s in cost[name]]
+
+    monkeypatch.setattr(study, "STUDIES", tuple(cost))
+    monkeypatch.setattr(study, "run_study", write_study)
+    monkeypatch.setattr(estimate, "tasks", tasks)
+    monkeypatch.setattr(report, "write_report", lambda out: out)
+    report.reproduce(StudyOptions(out=tmp_path, jobs=2, progress=False))
+    written = [line.split() for line in (tmp_path / "written").read_text().splitlines()]
+    by_study = {name: (int(cached), int(pid), jobs) for name, cached, pid, jobs in written}
+    assert sorted(name for name, *_ in written) == ["a", "b", "c"]  # each once
+    assert by_study["a"][0] == 3 and by_study["b"][0] == 1  # after all its cases
+    assert by_study["a"][1] != os.getpid() and by_study["b"][1] != os.getpid()  # in a worker
+    assert by_study["a"][2] == by_study["b"][2] == "1"  # it would run a missing case itself, not start a pool
