@@ -147,3 +147,19 @@ def test_a_follow_up_runs_in_a_worker_ahead_of_the_waiting_cases_or_here_without
         assert os.getpid() not in notes.values()
         # when case 0 ends, cases 1 and 2 are already handed to the pool; 3 .. 6 wait behind the follow-up
         assert lines.index(f"after0:{notes['after0']}") < lines.index("4")
+
+
+def test_off_a_terminal_a_progress_line_comes_every_tenth_of_the_cases_or_every_plain_every_seconds(
+        tmp_path, capsys, monkeypatch):
+    """40 cases: a line at 4, 8, ... (every 10 %); with PLAIN_EVERY = 0, a line for every case."""
+    from mpm_fem.app import sweep
+
+    cases = [{"n": n, "trace": str(tmp_path / "trace")} for n in range(40)]
+    monkeypatch.setattr(sweep.sys.stderr, "isatty", lambda: False, raising=False)
+    run_cases(square, cases, jobs=1, progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0] == "[cases] 40 of 40 cases to run (0 cached)"
+    assert [line.split()[1] for line in lines[1:]] == [f"{k}/40" for k in range(4, 41, 4)]
+    monkeypatch.setattr(sweep, "PLAIN_EVERY", 0.0)
+    run_cases(square, cases, jobs=1, progress=True)
+    assert [line.split()[1] for line in capsys.readouterr().err.splitlines()[1:]] == [f"{k}/40" for k in range(1, 41)]

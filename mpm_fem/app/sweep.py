@@ -247,12 +247,18 @@ def _run_dask(tasks, todo, scheduler, finish) -> None:
             finish(k, path, future.result())
 
 
+#: Off a terminal, a progress line every ~10 % of the cases, or at the first case to end after this
+#: many seconds without a line (the longest cases run first, so the first 10 % can take most of a run).
+PLAIN_EVERY = 60.0
+
+
 class _Progress:
-    """A tqdm bar on a terminal; on other streams a plain line per case (every ~10 %)."""
+    """A tqdm bar on a terminal; on other streams a plain line every ~10 % of the cases or every
+    :data:`PLAIN_EVERY` seconds, whichever comes first."""
 
     def __init__(self, total: int, done: int, desc: str, progress: bool | None):
         self.total, self.done, self.desc = total, done, desc
-        self.start = time.perf_counter()
+        self.start = self.last = time.perf_counter()
         tty = sys.stderr.isatty()
         self.enabled = progress if progress is not None else True
         self.bar = tqdm(total=total, initial=done, desc=desc, leave=False) if (self.enabled and tty) else None
@@ -265,9 +271,12 @@ class _Progress:
         self.done += 1
         if self.bar is not None:
             self.bar.update(1)
-        elif self.plain and (self.done % self.step == 0 or self.done == self.total):
-            elapsed = time.perf_counter() - self.start
-            print(f"[{self.desc}] {self.done}/{self.total} done, {elapsed:.0f} s", file=sys.stderr, flush=True)
+        elif self.plain:
+            now = time.perf_counter()
+            if self.done % self.step == 0 or self.done == self.total or now - self.last >= PLAIN_EVERY:
+                self.last = now
+                print(f"[{self.desc}] {self.done}/{self.total} done, {now - self.start:.0f} s", file=sys.stderr,
+                      flush=True)
 
     def close(self) -> None:
         if self.bar is not None:
