@@ -75,6 +75,7 @@ FINEST = {("sod", "gimp"): 0.0025, ("sod", "bspline"): 0.0025, ("sod", "bspline_
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure
+#: the quick tier: P1 on one coarse mesh a problem (E1 is judged on the finest mesh of each basis)
 QUICK = {"h": {"sod": (0.02,), "burgers": (0.04,)}, "bases": ("mpm",), "bases_h": ()}
 GAP = "all MPM - all exact"
 #: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring): the
