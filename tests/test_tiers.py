@@ -107,3 +107,20 @@ def test_the_estimate_counts_the_cached_cases_and_grows_with_the_tier(tmp_path):
     line = describe({"budget": again, "other": None}, 2)
     assert "budget: 49 of 50 cases to run" in line.replace(f"{again.cases - 1} of {again.cases}", "49 of 50")
     assert "other: no cost model" in line
+
+
+def test_the_quick_reproduction_leaves_out_the_plateau_studies_and_says_so(tmp_path, monkeypatch):
+    """Remedies and drift ask about Sod's plateau, below the quick meshes: the quick ``reproduce`` runs
+    neither (``mpm-fem study NAME --quick`` still does), the full and deep ones run every study."""
+    from mpm_fem.app import report, study
+
+    assert study.reproduced("quick") == ("projection", "sod", "burgers", "budget", "time")
+    assert study.reproduced("full") == study.reproduced("deep") == study.STUDIES
+    started = []
+    monkeypatch.setattr(study, "run_study", lambda name, options: started.append(name))
+    monkeypatch.setattr(report, "write_report", lambda out: out)
+    monkeypatch.setattr("mpm_fem.app.estimate.tasks", lambda name, options: [])
+    report.reproduce(StudyOptions(quick=True, out=tmp_path, jobs=1, progress=False))
+    assert started == list(study.reproduced("quick"))
+    text = "\n".join(report.caveats({"versions": [{"table": "sod/convergence", "code": "x", "quick": "True"}]}, "x"))
+    assert "leaves out the studies remedies and drift" in text
