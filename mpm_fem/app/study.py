@@ -141,7 +141,8 @@ def add_tier_options(parser: argparse.ArgumentParser, default: str) -> None:
     """``--quick | --full | --deep``, into ``args.tier`` (``default`` when none is given)."""
     size = parser.add_mutually_exclusive_group()
     size.add_argument("--quick", dest="tier", action="store_const", const="quick",
-                      help="the subset of meshes of the quick reproduction (about a minute on 2 cores)")
+                      help="the subset of meshes of the quick reproduction (about a minute on 2 cores; "
+                           "reproduce leaves out the remedies and drift studies there)")
     size.add_argument("--full", dest="tier", action="store_const", const="full",
                       help="every table of the committed record, figures/ (about 45 min on 2 cores)")
     size.add_argument("--deep", dest="tier", action="store_const", const="deep",
