@@ -18,7 +18,8 @@ statements and the source's tables, with the corrections made to them, are in ``
 
 from __future__ import annotations
 
-from mpm_fem.measure.claims.base import CLAIMS, STATEMENTS, VERDICTS, Claim, Criterion, Tables, claim, claims_of
+from mpm_fem.measure.claims.base import (
+    CLAIMS, STATEMENTS, VERDICTS, Claim, Criterion, Finding, Tables, claim, claims_of)
 from mpm_fem.measure.claims.rows import count_verdict, num, saturation, select, span, successive_orders
 
 # the per-study modules, in the order their claims are registered (CLAIMS keeps that order)
@@ -39,7 +40,7 @@ from mpm_fem.measure.claims.remedies import (
 # isort: on
 
 __all__ = [
-    "VERDICTS", "STATEMENTS", "Tables", "Criterion", "Claim", "CLAIMS", "claim", "claims_of",
+    "VERDICTS", "STATEMENTS", "Tables", "Criterion", "Claim", "Finding", "CLAIMS", "claim", "claims_of",
     "num", "select", "span", "count_verdict", "saturation", "successive_orders",
     "BAND_TOLERANCE", "JUDGED_LAYOUTS", "ORDERS",
     "SATURATION", "LUMPING_BAND", "lumping_sign",

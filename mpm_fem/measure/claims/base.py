@@ -20,7 +20,7 @@ VERDICTS = ("confirmed", "partly", "differs", "refuted", "not measured")
 #: The verdicts by name, so that a criterion returns a name, never a typed word
 CONFIRMED, PARTLY, DIFFERS, REFUTED, NOT_MEASURED = VERDICTS
 Tables = Mapping[str, list[dict]]
-Criterion = Callable[[Tables], "tuple[str, str]"]
+Criterion = Callable[[Tables], "tuple[str, str] | Finding"]
 
 #: Every claim of the source (C) and every extension (E), in the order the report lists them.
 STATEMENTS = {
@@ -49,6 +49,20 @@ STATEMENTS = {
 
 
 @dataclass(frozen=True)
+class Finding:
+    """What a criterion found: its ``verdict`` (one of :data:`VERDICTS`), the ``evidence`` (one line
+    formatted from the numbers, its first clause the key number of the summary), a ``sentence`` in
+    plain words for the abstract and the results (formatted from the same numbers by a template, no
+    verdict word pasted in; empty when the criterion has none) and a small evidence ``table`` (rows
+    of ``{column: value}``, e.g. one row per setting and one column per quantity; empty when none)."""
+
+    verdict: str
+    evidence: str
+    sentence: str = ""
+    table: tuple[dict, ...] = ()
+
+
+@dataclass(frozen=True)
 class Claim:
     """One claim: ``id`` (``"C5"``), the ``source``'s number or band, the ``tables`` it reads, the
     ``thresholds`` of its verdicts in words, its ``criterion``, the ``study`` whose section shows it,
@@ -72,15 +86,23 @@ class Claim:
     def label(self) -> str:
         return f"{self.id} ({self.problem})" if self.problem else self.id
 
-    def verdict(self, tables: Tables) -> tuple[str, str]:
-        """``(verdict, evidence)``; ``not measured`` when a table it reads is missing or empty."""
+    def finding(self, tables: Tables) -> Finding:
+        """The criterion's :class:`Finding`; ``not measured`` when a table it reads is missing or empty.
+        A criterion may return a :class:`Finding` or a ``(verdict, evidence)`` pair."""
         missing = [name for name in self.tables if not tables.get(name)]
         if missing:
-            return "not measured", "no table " + ", ".join(f"`{m}.csv`" for m in missing)
-        verdict, evidence = self.criterion(tables)
-        if verdict not in VERDICTS:
-            raise ValueError(f"claim {self.label}: verdict {verdict!r} is not one of {VERDICTS}")
-        return verdict, evidence
+            return Finding(NOT_MEASURED, "no table " + ", ".join(f"`{m}.csv`" for m in missing))
+        found = self.criterion(tables)
+        if not isinstance(found, Finding):
+            found = Finding(*found)
+        if found.verdict not in VERDICTS:
+            raise ValueError(f"claim {self.label}: verdict {found.verdict!r} is not one of {VERDICTS}")
+        return found
+
+    def verdict(self, tables: Tables) -> tuple[str, str]:
+        """``(verdict, evidence)`` of :meth:`finding`."""
+        found = self.finding(tables)
+        return found.verdict, found.evidence
 
 
 CLAIMS: list[Claim] = []
