@@ -19,7 +19,16 @@ statements and the source's tables, with the corrections made to them, are in ``
 from __future__ import annotations
 
 from mpm_fem.measure.claims.base import (
-    CLAIMS, STATEMENTS, VERDICTS, Claim, Criterion, Finding, Tables, claim, claims_of)
+    CLAIMS,
+    STATEMENTS,
+    VERDICTS,
+    Claim,
+    Criterion,
+    Finding,
+    Tables,
+    claim,
+    claims_of,
+)
 from mpm_fem.measure.claims.rows import count_verdict, num, saturation, select, span, successive_orders
 
 # the per-study modules, in the order their claims are registered (CLAIMS keeps that order)
