@@ -84,9 +84,11 @@ def source_version(root: Path = ROOT) -> str:
 
 
 #: What a case cannot run through (paths from the root; a folder ends with "/"): the studies' plans
-#: and tables, the application layer, the verdicts and this module. The model imports none of them
+#: and tables, the application layer, the verdicts, the tables' declarations and their reader (which
+#: name and read columns, computing none) and this module. The model imports none of them
 #: (tests/test_layers.py); the case function's own module enters by its :func:`closure`.
-OUTSIDE_THE_MODEL = ("studies/", "mpm_fem/app/", "mpm_fem/measure/claims/", "mpm_fem/measure/version.py")
+OUTSIDE_THE_MODEL = ("studies/", "mpm_fem/app/", "mpm_fem/measure/claims/", "mpm_fem/measure/schema.py",
+                     "mpm_fem/measure/tables.py", "mpm_fem/measure/version.py")
 
 
 def model_files(root: Path = ROOT) -> list[Path]:
