@@ -128,7 +128,7 @@ def words_of_paragraphs(markdown: str) -> list[tuple[int, str]]:
         if not block or not _is_prose(block):
             continue
         items = re.split(r"\n(?=- )", block) if block.startswith("- ") else [block]
-        found += [(word_count(item), " ".join(item.split()[:8])) for item in items]
+        found += [(word_count(item.removeprefix("- ")), " ".join(item.split()[:8])) for item in items]
     return found
 
 

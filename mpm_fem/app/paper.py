@@ -176,7 +176,7 @@ def identification_sentence(tables: Tables) -> str:
 
 
 def identification_section(tables: Tables) -> list[str]:
-    lines = ["### 2.2 The source's unstated settings", ""]
+    lines = ["### The source's unstated settings", ""]
     if not any(tables.get(name) for name in identification.IDENTIFICATION.values()):
         return lines + prose(
             "The slides leave particles per cell, the time step, the norm and the exact solution of Burgers unsaid. "
@@ -211,7 +211,7 @@ def abstract(tables: Tables, found: Found) -> list[str]:
 
 def introduction(found: Found) -> list[str]:
     n_claims = sum(cid.startswith("C") for cid in STATEMENTS)
-    return ["## 1 Introduction", "", *prose(
+    return ["## Introduction", "", *prose(
         "Where does the error of the material point method come from? Tran and Berzins' error analysis of explicit "
         "one-dimensional MPM (slides) names four sources (projection, finite elements with mass lumping, "
         "interpolation and time integration), bounds the particle quadrature, and shows on Sod's shock tube that "
@@ -225,13 +225,13 @@ def introduction(found: Found) -> list[str]:
 
 def method(tables: Tables, caveats: list[str]) -> list[str]:
     """The problems and settings, the source-matching settings, the rule book, the seeds, the record."""
-    lines = ["## 2 Method", "", *prose(
+    lines = ["## Method", "", *prose(
         "Each study runs its cases, writes its tables with the settings in a JSON file beside each, and draws "
         "its figures; this report only reads them. A claim's verdict is a function of the numbers in these "
         "tables, by the rules below."),
-        "### 2.1 Problems and settings", "", *settings_table(tables)]
+        "### Problems and settings", "", *settings_table(tables)]
     lines += identification_section(tables)
-    lines += ["### 2.3 Verdicts and the rule book", "", *prose(
+    lines += ["### Verdicts and the rule book", "", *prose(
         "Each verdict word has one meaning. The thresholds every criterion reads are in one rule book "
         "(`mpm_fem/measure/claims/rules.py`); each claim's rule in words is in Appendix A."), *markdown_table(
         [{"verdict": v, "meaning": m} for v, m in VERDICT_MEANING.items()]), ""]
@@ -241,7 +241,7 @@ def method(tables: Tables, caveats: list[str]) -> list[str]:
     else:
         lines += prose("The rule book holds no threshold yet: each criterion still reads its own constants, which "
                        "Appendix A states beside each claim's rule.")
-    return lines + ["### 2.4 Seeds", "", *prose(seeds_text(tables)), "### 2.5 The record", "", *caveats, ""]
+    return lines + ["### Seeds", "", *prose(seeds_text(tables)), "### The record", "", *caveats, ""]
 
 
 def evidence(f: Finding) -> list[str]:
@@ -277,17 +277,18 @@ def verdict_counts(found: Found) -> str:
         verdicts = [f.verdict for c, f in found.values() if c.id.startswith(kind)]
         return ", ".join(f"{verdicts.count(v)} {v}" for v in dict.fromkeys(verdicts))
     return (f"The verdicts on the source's claims: {counted('C')}; on the extensions: {counted('E')}. "
-            "Tables 1 and 2 list them with each finding's key number; the subsections give each claim's evidence.")
+            "The two tables below list them with each finding's key number, the source's claims first; the "
+            "subsections give each claim's evidence.")
 
 
 def results(tables: Tables, found: Found, pages: list[Page], captions: dict, summary) -> list[str]:
     """Every claim in the order of its study's page: the studies without a table say so."""
-    lines = ["## 3 Results", "", *prose(verdict_counts(found)), "*Table 1: the source's claims.*", "",
-             *summary("C"), "", "*Table 2: the extensions.*", "", *summary("E"), ""]
+    lines = ["## Results", "", *prose(verdict_counts(found)), "*The source's claims.*", "",
+             *summary("C"), "", "*The extensions.*", "", *summary("E"), ""]
     shown = [p for p in [*pages, REPRODUCTION] if claims_of(p.name)]
-    for k, page in enumerate(shown, start=1):
+    for page in shown:
         present = any(tables.get(t) for c in claims_of(page.name) for t in c.tables)
-        lines += [f'<a id="{page.name}"></a>', "", f"### 3.{k} {page.title}", "",
+        lines += [f'<a id="{page.name}"></a>', "", f"### {page.title}", "",
                   *prose(page.caption if present else
                          f"No table of the study `{page.name}` in this folder: its claims are not measured here.")]
         for c in claims_of(page.name):
@@ -300,7 +301,7 @@ def results(tables: Tables, found: Found, pages: list[Page], captions: dict, sum
 
 def discrepancies(found: Found) -> list[str]:
     """Each claim whose verdict departs from the source's statement: what was measured and why."""
-    lines = ["### 4.1 Where the measurements depart from the source", ""]
+    lines = ["### Where the measurements depart from the source", ""]
     departing = [(c, f) for c, f in found.values() if f.verdict in DEPARTS]
     if not departing:
         return lines + prose("Every measured claim holds at the source's settings.")
@@ -334,7 +335,7 @@ def _drift_rows(rows: list[dict]) -> list[dict]:
 
 def drift_section(tables: Tables, captions: dict) -> list[str]:
     """The drift study as a section: what each variant changes, its order and drift, the mechanism."""
-    lines = ['<a id="drift"></a>', "", "### 4.2 What makes Sod's particle error grow: the drift study", ""]
+    lines = ['<a id="drift"></a>', "", "### What makes Sod's particle error grow: the drift study", ""]
     rows = tables.get("drift/drift", [])
     if not rows:
         return lines + prose("The drift study's table (`drift/drift.csv`) is not in this folder: the mechanism of "
@@ -353,7 +354,7 @@ def drift_section(tables: Tables, captions: dict) -> list[str]:
 
 def deep_changes(found: Found, deep_found: Found | None) -> list[str]:
     """One sentence per verdict that moves between the full and the deep tier's tables."""
-    lines = ["### 4.3 What the deep tier changes", ""]
+    lines = ["### What the deep tier changes", ""]
     if deep_found is None:
         return lines + prose("`deep/` holds no tables: `mpm-fem reproduce --deep` runs the finest meshes and the "
                              "long sweeps into it, and this section then says which verdicts move.")
@@ -368,7 +369,7 @@ def deep_changes(found: Found, deep_found: Found | None) -> list[str]:
 
 
 def discussion(tables: Tables, found: Found, captions: dict, deep_found: Found | None) -> list[str]:
-    return ["## 4 Discussion", "", *prose(
+    return ["## Discussion", "", *prose(
         "Each claim whose measured behaviour departs from the source's statement, with what the study measured "
         "about why; then the drift study, which measures the mechanism of the growth of Sod's particle error, and "
         "what the deep tier's finer meshes change."), *discrepancies(found),
@@ -379,7 +380,25 @@ def conclusions(found: Found) -> list[str]:
     """Five to eight findings, each with its number."""
     chosen = [found[label] for label in CONCLUSIONS if label in found and found[label][1].verdict != "not measured"]
     items = [said(c, f) for c, f in chosen[:MAX_CONCLUSIONS]]
-    return ["## 5 Conclusions", "", *(bullets(items) if items else prose("No claim is measured in this folder."))]
+    return ["## Conclusions", "", *(bullets(items) if items else prose("No claim is measured in this folder."))]
+
+
+def numbered(lines: list[str]) -> list[str]:
+    """``lines`` with the sections after the abstract and before the appendices numbered: ``## Method``
+    becomes ``## 2 Method``, its ``### Seeds`` ``### 2.4 Seeds``."""
+    out, section, sub, body = [], 0, 0, False
+    for line in lines:
+        if line.startswith("## "):
+            if line.startswith("## Appendix") or line == "## Abstract":
+                body = False
+            else:
+                section, sub, body = section + 1, 0, True
+                line = f"## {section} {line[3:]}"
+        elif line.startswith("### ") and body:
+            sub += 1
+            line = f"### {section}.{sub} {line[4:]}"
+        out.append(line)
+    return out
 
 
 def abstract_sentences(text: str) -> list[str]:

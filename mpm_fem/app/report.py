@@ -206,7 +206,7 @@ def render(tables: Tables, pages, captions: dict[str, dict] | None = None, curre
     for page in shown:
         lines += appendix_section(next(letters), page, tables, captions.get(page.name, {}))
     lines += stamps_appendix(next(letters), tables) + deep_appendix(next(letters), deep, deep_found)
-    return "\n".join(lines)
+    return "\n".join(paper.numbered(lines))
 
 
 # ----------------------------------------------------------------------------- the command
