@@ -80,9 +80,22 @@ def _listed(value: str) -> str:
     return ", ".join(map(str, items))
 
 
+def _and(items: list) -> str:
+    """``[a, b, c]`` -> ``"a, b and c"``."""
+    items = [str(i) for i in items]
+    return ", ".join(items[:-1]) + " and " + items[-1] if len(items) > 1 else "".join(items)
+
+
 def sod_settings(tables: Tables) -> str:
-    """The Sod convergence study's particles per cell and CFL numbers, in words ("" when not recorded)."""
-    return _listed(_study_setting(tables, "sod", "runs.ppc_cfl"))
+    """The Sod convergence study's particles per cell and CFL numbers, in words ("" when not recorded):
+    ``"16, 8 and 4 particles per cell at CFL 0.05 and 4 at CFL 0.1"``."""
+    try:
+        pairs = json.loads(_study_setting(tables, "sod", "runs.ppc_cfl"))
+        by_cfl = {cfl: [ppc for ppc, c in pairs if c == cfl] for _, cfl in pairs}
+    except (ValueError, TypeError):
+        return ""
+    return _and([f"{_and(ppc)}{' particles per cell' if k == 0 else ''} at CFL {cfl}"
+                 for k, (cfl, ppc) in enumerate(by_cfl.items())])
 
 
 def burgers_settings(tables: Tables) -> str:
@@ -96,7 +109,8 @@ def burgers_settings(tables: Tables) -> str:
     solution = _study_setting(tables, "burgers", "default_solution")
     if not ppc:
         return ""
-    return f"{', '.join(map(str, ppc))} particles per cell" + (f" with the {solution} solution" if solution else "")
+    return (f"{_and(ppc)} particles per cell with the calculated acceleration"
+            + (f" and the {solution} solution" if solution else ""))
 
 
 #: The settings the Method section prints: (problem, study, key, what it is, why this value).
@@ -254,12 +268,11 @@ def evidence(f: Finding) -> list[str]:
 
 def claim_section(c: Claim, f: Finding, figure_lines: list[str] = (), appendix: str = "") -> list[str]:
     """A claim in the results: statement, verdict, its sentence, one figure, the evidence, the links."""
-    meaning = VERDICT_MEANING.get(f.verdict, "")
     tables = ", ".join(f"[{t}.csv]({t}.csv)" for t in c.tables if "/" in t)
     links = (f"Tables: {tables}. " if tables else "") + f"Rule and reasons: [Appendix A](#rule-{anchor_of(c.label)})" \
         + (f"; all of the study's tables: [appendix](#{appendix})." if appendix else ".")
     return [f'<a id="{anchor_of(c.label)}"></a>', "", f"#### {c.label}: {c.statement}", "",
-            f"**{f.verdict}**" + (f": {meaning}." if meaning else "") + f" Source: {c.source}.", "",
+            f"**{f.verdict}**. Source: {c.source}.", "",
             *([f.sentence.strip(), ""] if f.sentence else []), *figure_lines, *evidence(f), links, ""]
 
 

@@ -110,7 +110,8 @@ def rules_appendix(found: Found) -> list[str]:
     """Appendix A: each claim's source, verdict rule in words and the reason its criterion gives."""
     lines = ['<a id="appendix-rules"></a>', "", "## Appendix A: the verdict rule of each claim", "",
              "Each claim's rule in words, as its criterion applies it, and the reason the criterion gives.", ""]
-    for c, _ in found.values():
+    order = list(STATEMENTS)
+    for c, _ in sorted(found.values(), key=lambda cf: (order.index(cf[0].id), cf[0].problem)):
         items = [f"Source: {c.source}.", f"Verdict rule: {c.thresholds}."]
         lines += [f'<a id="rule-{anchor(c)}"></a>', "", f"#### {c.label}: {c.statement}", "",
                   *bullets(items + ([f"Why: {c.explanation}"] if c.explanation else []))]
