@@ -323,3 +323,28 @@ def test_the_source_matching_settings_are_stated_when_identified(tables):
     assert "Sod table" in said and "ppc 16" in said and "misfit 0.07" in said
     assert "| sod | L1 | 16 | 0.05 |" in "\n".join(identification_section(identified))
     assert "are not in this folder" in "\n".join(identification_section(tables))
+
+
+def test_a_finding_with_a_sentence_and_a_table_is_said_in_words(tables):
+    """Where a criterion writes a plain sentence and a small table, the abstract and the conclusions say the
+    sentence, the results show the table, and Appendix A keeps the whole evidence line."""
+    from dataclasses import replace
+
+    from mpm_fem.app.pages import PAGES
+    from mpm_fem.measure.claims import CLAIMS, Finding
+
+    sentence = "At 8 particles per cell the particle density error grows from the second refinement on."
+    found = Finding("differs", "orders 0.18, -0.24; the rest", sentence, ({"ppc": "8", "last order": "-0.52"},))
+    k = next(k for k, c in enumerate(CLAIMS) if c.label == "C11")
+    original = CLAIMS[k]
+    CLAIMS[k] = replace(original, criterion=lambda t: found)
+    try:
+        text = render(tables, PAGES)
+    finally:
+        CLAIMS[k] = original
+    head = text.split("## 1 Introduction")[0]
+    assert sentence.rstrip(".") + " (C11)." in head
+    section = text.split('<a id="c11"></a>')[1].split("<a id=")[0]
+    assert "| ppc | last order |" in section and "| 8 | -0.52 |" in section
+    assert sentence.rstrip(".") + " (C11)." in text.split("## 5 Conclusions")[1].split("## Appendix")[0]
+    assert "The evidence in full: orders 0.18, -0.24; the rest." in text.split('<a id="rule-c11"></a>')[1]

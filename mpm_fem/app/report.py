@@ -109,12 +109,15 @@ def appendix_section(letter: str, page: Page, tables: Tables, captions: dict) ->
 def rules_appendix(found: Found) -> list[str]:
     """Appendix A: each claim's source, verdict rule in words and the reason its criterion gives."""
     lines = ['<a id="appendix-rules"></a>', "", "## Appendix A: the verdict rule of each claim", "",
-             "Each claim's rule in words, as its criterion applies it, and the reason the criterion gives.", ""]
+             "Each claim's rule in words, as its criterion applies it, the reason the criterion gives, and the "
+             "evidence in full where the results show it as a table.", ""]
     order = list(STATEMENTS)
-    for c, _ in sorted(found.values(), key=lambda cf: (order.index(cf[0].id), cf[0].problem)):
+    for c, f in sorted(found.values(), key=lambda cf: (order.index(cf[0].id), cf[0].problem)):
         items = [f"Source: {c.source}.", f"Verdict rule: {c.thresholds}."]
-        lines += [f'<a id="rule-{anchor(c)}"></a>', "", f"#### {c.label}: {c.statement}", "",
-                  *bullets(items + ([f"Why: {c.explanation}"] if c.explanation else []))]
+        items += [f"Why: {c.explanation}"] if c.explanation else []
+        # the results show a finding's small table; its whole evidence line stays readable here
+        items += [f"The evidence in full: {f.evidence}."] if f.table else []
+        lines += [f'<a id="rule-{anchor(c)}"></a>', "", f"#### {c.label}: {c.statement}", "", *bullets(items)]
     return lines
 
 
