@@ -30,6 +30,8 @@ CONCLUSIONS = ("C11", "C13", "C12", "C15 (sod)", "E1 (sod)", "E1 (burgers)", "E3
 MAX_CONCLUSIONS = 8
 #: Verdicts that depart from the source's statement: the discussion takes each in turn.
 DEPARTS = ("partly", "differs", "refuted")
+#: Where the discussion measures a discrepancy's mechanism in a section of its own.
+MEASURED_ELSEWHERE = {"C11": "[The drift study](#drift) below measures what makes the particle error grow."}
 #: The results' section of the claims on the record itself (E4): they read the tables' stamps.
 REPRODUCTION = Page("reproduce", "Reproduction", "Every table carries the version of the code that wrote it; one "
                     "command regenerates them all. Each table's stamp is in the appendix.")
@@ -50,13 +52,14 @@ def key_text(f: Finding) -> str:
     return f.sentence.strip() or first_clause(f)
 
 
-def said(c: Claim, f: Finding) -> str:
-    """The finding in one sentence with the claim's label: its plain sentence, or the statement and
-    the evidence's first clause."""
+def said(c: Claim, f: Finding, link: bool = False) -> str:
+    """The finding in one sentence with the claim's label (a link to its results when ``link``): its
+    plain sentence, or the statement and the evidence's first clause."""
+    label = f"[{c.label}](#{anchor_of(c.label)})" if link else c.label
     if f.sentence:
-        return f"{f.sentence.strip().rstrip('.')} ({c.label})."
+        return f"{f.sentence.strip().rstrip('.')} ({label})."
     statement = c.statement[0].upper() + c.statement[1:]
-    return f"{statement} ({c.label}): {first_clause(f)}."
+    return f"{statement} ({label}): {first_clause(f)}."
 
 
 # ----------------------------------------------------------------------------- settings
@@ -120,12 +123,15 @@ SETTINGS = (
      "the source's range of particles per cell and one setting above it; the slides state no time step"),
     ("Sod", "sod", "runs.jittered_meshes", "meshes h", "the meshes of the source's table"),
     ("Sod", "sod", "mpm.mass", "mass matrix", "the slides' lumped mass"),
-    ("Sod", "sod", "mpm.scheme", "update", "the slides' update, stress last"),
+    ("Sod", "sod", "mpm.scheme", "update", "the slides' explicit step: the particles updated from the new grid "
+     "velocity"),
     ("Sod", "sod", "mpm.basis", "basis", "the slides' point-mass linear hats"),
     ("Sod", "sod", "fv.scheme", "reference beside MPM", "a converging method on the same mesh"),
     ("Burgers", "burgers", "T", "final time", "the slides' final time"),
-    ("Burgers", "burgers", "default_solution", "exact solution", "the solution chosen by the norms table"),
-    ("Burgers", "burgers", "compared_norm", "error compared with the source", "the slides' norm"),
+    ("Burgers", "burgers", "default_solution", "exact solution",
+     "the slides name none: the one whose error depends least on eps, as the source's does (the norms table)"),
+    ("Burgers", "burgers", "compared_norm", "error compared with the source",
+     "the slides name none: chosen with the solution by the norms table"),
     ("Projection", "projection", "h", "meshes h", "halving, to fit an order over many meshes"),
     ("Projection", "projection", "N_p", "particles per cell", "around the source's range"),
     ("Projection", "projection", "layouts", "particle layouts", "every layout a run produces"),
@@ -315,11 +321,14 @@ def results(tables: Tables, found: Found, pages: list[Page], captions: dict, sum
 def discrepancies(found: Found) -> list[str]:
     """Each claim whose verdict departs from the source's statement: what was measured and why."""
     lines = ["### Where the measurements depart from the source", ""]
-    departing = [(c, f) for c, f in found.values() if f.verdict in DEPARTS]
+    order = list(STATEMENTS)
+    departing = sorted(((c, f) for c, f in found.values() if f.verdict in DEPARTS and c.study != REPRODUCTION.name),
+                       key=lambda cf: (order.index(cf[0].id), cf[0].problem))
     if not departing:
         return lines + prose("Every measured claim holds at the source's settings.")
     for c, f in departing:
-        lines += prose(" ".join(s for s in (said(c, f), c.explanation) if s))
+        lines += prose(" ".join(s for s in (said(c, f, link=True), c.explanation, MEASURED_ELSEWHERE.get(c.id, ""))
+                                if s))
     return lines
 
 
