@@ -188,7 +188,7 @@ PAGES = (
          "the successive orders.",
          views=(
              View("drift/drift", "Per variant and mesh, regular layout: errors, volume drift and orders", (
-                 "variant", "change", "h", "particles_L1", "nodes_L1", "volume_drift", "order_particles_L1",
+                 "variant", "h", "particles_L1", "nodes_L1", "volume_drift", "order_particles_L1",
                  "order_nodes_L1", "particles_vs_study"), {"layout": "regular"}, "drift.png"),
              View("drift/drift", "The jittered layouts, one row per seed and mesh", (
                  "variant", "seed", "h", "particles_L1", "nodes_L1", "volume_drift", "order_particles_L1"),
