@@ -205,6 +205,11 @@ def test_the_sections_of_a_paper_come_in_order(rendered):
     assert at == sorted(at), "sections out of order"
 
 
+def test_the_introduction_is_one_paragraph(rendered):
+    block = rendered.split("## 1 Introduction\n")[1].split("\n## ")[0]
+    assert len([p for p in block.split("\n\n") if p.strip()]) == 1, block
+
+
 def test_no_paragraph_is_over_the_limit_and_no_heading_is_empty(rendered):
     from mpm_fem.app.markdown import MAX_WORDS, headings_without_content, words_of_paragraphs
 

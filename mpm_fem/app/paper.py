@@ -233,14 +233,14 @@ def introduction(found: Found) -> list[str]:
     n_claims = sum(cid.startswith("C") for cid in STATEMENTS)
     return ["## Introduction", "", *prose(
         "Where does the error of the material point method come from? Tran and Berzins' error analysis of explicit "
-        "one-dimensional MPM (slides) names four sources (projection, finite elements with mass lumping, "
-        "interpolation and time integration), bounds the particle quadrature, and shows on Sod's shock tube that "
-        "the density error stops converging as the mesh is refined, and on viscous Burgers that both "
-        f"accelerations converge at first order. We restate the slides as {n_claims} claims, measure each on "
-        "tables the code regenerates from one command, and judge it by a rule written down before the "
-        f"verdict. The study adds {len(STATEMENTS) - n_claims} extensions: an error budget over every "
-        "combination of the stages, other bases, MPM beside fixed-mesh FEM on the same mesh, the record's "
-        "reproducibility, remedies for the stagnation, and a study of what makes Sod's particle error grow.")]
+        "one-dimensional MPM names four sources (projection, finite elements with mass lumping, interpolation, time "
+        "integration) and shows that on Sod's shock tube the density error stops "
+        "converging as the mesh is refined while on viscous Burgers both accelerations converge at first order. "
+        f"We restate the slides as {n_claims} claims, measure each on tables that one command regenerates, and "
+        f"judge it by a written rule. The study adds {len(STATEMENTS) - n_claims} extensions: an "
+        "error budget over every combination of the stages, smoother bases, MPM beside fixed-mesh FEM on one mesh, "
+        "the record's reproducibility, remedies for the stagnation, and the mechanism of Sod's growing particle "
+        "error.")]
 
 
 def method(tables: Tables, caveats: list[str]) -> list[str]:
@@ -294,7 +294,7 @@ def verdict_counts(found: Found) -> str:
     """How many of the source's claims and of the extensions got each verdict, in words."""
     def counted(kind: str) -> str:
         verdicts = [f.verdict for c, f in found.values() if c.id.startswith(kind)]
-        return ", ".join(f"{verdicts.count(v)} {v}" for v in dict.fromkeys(verdicts))
+        return ", ".join(f"{verdicts.count(v)} {v}" for v in VERDICT_MEANING if v in verdicts)
     return (f"The verdicts on the source's claims: {counted('C')}; on the extensions: {counted('E')}. "
             "The two tables below list them with each finding's key number, the source's claims first; the "
             "subsections give each claim's evidence.")

@@ -171,7 +171,7 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
     elif current is not None and behind:
         out.append(f"- **Part of the figures lag the code**: {len(rows) - sum(r['code'] != current for r in rows)} "
                    f"of {len(rows)} tables come from the current code ({current}); the studies "
-                   f"{', '.join(behind)} still hold tables of an older code (Appendix, E4); "
+                   f"{', '.join(behind)} still hold tables of an older code ([the stamps](#appendix-stamps), E4); "
                    "`mpm-fem reproduce --full` regenerates them.")
     elif current is not None:
         out.append(f"- The tables were written by the current code ({written}).")
