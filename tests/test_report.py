@@ -1,6 +1,9 @@
 """The report is only ever generated: rendering the committed tables gives the committed REPORT.md
 byte for byte; every claim is listed; anchors and links resolve inside the figures folder; every
-table row has as many cells as its header."""
+table row has as many cells as its header. It reads as a paper: the sections in order, no paragraph
+over the limit, no heading without content, an abstract of four to six plain sentences that follow
+the tables, five to eight conclusions with their numbers (the structure is asserted on a fresh
+rendering of the committed tables, ``rendered``)."""
 
 from __future__ import annotations
 
@@ -24,6 +27,19 @@ def committed():
     return (FIGURES / "REPORT.md").read_text()
 
 
+@pytest.fixture(scope="module")
+def rendered():
+    """``REPORT.md`` rendered now from the committed tables (in a copy of the folder)."""
+    with tempfile.TemporaryDirectory() as folder:
+        shutil.copytree(FIGURES, folder, dirs_exist_ok=True, ignore=shutil.ignore_patterns(".cache"))
+        return write_report(Path(folder)).read_text()
+
+
+@pytest.fixture(scope="module")
+def tables():
+    return load_tables(FIGURES)
+
+
 def test_the_committed_report_is_the_rendering_of_the_committed_tables(committed):
     with tempfile.TemporaryDirectory() as folder:
         shutil.copytree(FIGURES, folder, dirs_exist_ok=True, ignore=shutil.ignore_patterns(".cache"))
@@ -31,9 +47,9 @@ def test_the_committed_report_is_the_rendering_of_the_committed_tables(committed
     assert rendered == committed, "figures/REPORT.md differs from `python -m mpm_fem.app.report --out figures`"
 
 
-def test_the_header_names_the_code_version_of_the_tables(committed):
+def test_the_header_names_the_code_version_of_the_tables(rendered):
     codes = {r["code"] for r in load_tables(FIGURES)["versions"]}
-    assert any(f"code version {c}" in committed.splitlines()[2] for c in codes)
+    assert any(f"code version {c}" in rendered.splitlines()[2] for c in codes)
 
 
 def test_the_first_screen_says_when_the_figures_lag_the_code():
@@ -45,23 +61,22 @@ def test_the_first_screen_says_when_the_figures_lag_the_code():
     first = "\n".join(render(lagging, [], current=now).splitlines()[:60])
     lag = f"**The figures lag the code**: the tables were written by code version 0123456789ab, the code is now {now}"
     assert lag in first
-    assert "lag" not in render(current, [], current=now).split("## Caveats")[1].split("<a id=")[0]
+    assert "lag" not in render(current, [], current=now).split("### 2.5 The record")[1].split("## 3 Results")[0]
 
 
-def test_every_claim_is_in_the_summary(committed):
-    summary = committed.split("## The source's claims")[1].split("<a id=")[0]
+def test_every_claim_is_in_the_summary(rendered):
+    summary = rendered.split("## 3 Results")[1].split("<a id=")[0]
     for cid in STATEMENTS:
         assert re.search(rf"^\| \[?{cid}[\] (|]", summary, re.M), cid
 
 
-def test_the_first_screen_holds_the_abstract_the_two_verdict_tables_and_two_figures(committed):
-    first = "\n".join(committed.splitlines()[:60])
-    for heading in ("## Abstract", "## The source's claims", "## Extensions"):
-        assert heading in first, heading
+def test_the_first_screen_holds_the_abstract_and_the_two_key_figures(rendered):
+    first = "\n".join(rendered.splitlines()[:40])
+    assert "## Abstract" in first
     assert first.count("![") >= 2, "the two key figures"
 
 
-def test_every_embedded_figure_is_at_most_two_and_a_half_wide(committed):
+def test_every_embedded_figure_is_at_most_two_and_a_half_wide(rendered):
     import matplotlib.image as image
 
     from mpm_fem.app.plots import MAX_ASPECT
@@ -70,18 +85,18 @@ def test_every_embedded_figure_is_at_most_two_and_a_half_wide(committed):
     from mpm_fem.measure.version import code_version
 
     current = {r["table"].split("/")[0] for r in load_tables(FIGURES)["versions"] if r["code"] == code_version()}
-    for target in re.findall(r"!\[[^]]*\]\(([^)]+)\)", committed):
+    for target in re.findall(r"!\[[^]]*\]\(([^)]+)\)", rendered):
         if target.split("/")[0] not in current:
             continue
         height, width = image.imread(FIGURES / target).shape[:2]
         assert width <= MAX_ASPECT * height * 1.01, (target, width, height)
 
 
-def test_every_anchor_and_link_resolves_inside_the_folder(committed):
+def test_every_anchor_and_link_resolves_inside_the_folder(rendered):
     """Every link is an anchor of the report, or a file of the folder (with, for another report, one
     of its anchors: the deep tier's verdicts link into ``deep/REPORT.md``)."""
-    anchors = set(re.findall(r'<a id="([^"]+)"></a>', committed))
-    for target in re.findall(r"\]\(([^)]+)\)", committed):
+    anchors = set(re.findall(r'<a id="([^"]+)"></a>', rendered))
+    for target in re.findall(r"\]\(([^)]+)\)", rendered):
         assert not target.startswith(("/", "..", "http", "figures/")), target
         path, _, anchor = target.partition("#")
         if not path:
@@ -92,8 +107,8 @@ def test_every_anchor_and_link_resolves_inside_the_folder(committed):
             assert f'<a id="{anchor}"></a>' in (FIGURES / path).read_text(), target
 
 
-def test_no_garbled_cells(committed):
-    lines = committed.splitlines()
+def test_no_garbled_cells(rendered):
+    lines = rendered.splitlines()
     for k, line in enumerate(lines):
         if line.startswith("|---"):
             width = lines[k - 1].count("|")
@@ -147,14 +162,18 @@ def test_the_grid_of_panels_keeps_every_figure_at_most_two_and_a_half_wide():
     assert grid_shape(4, (4.2, 3.6)) == (2, 2) and grid_shape(2, (4.2, 3.8)) == (1, 2)
 
 
-def test_a_key_number_is_cut_at_a_comma_to_fit_the_summary():
-    from mpm_fem.app.report import KEY_LENGTH, key_number
+def test_the_key_number_is_the_sentence_or_the_whole_first_clause(tables):
+    """The summary (and the README's results in brief) never cuts a key number: the finding's sentence, or
+    the evidence's first clause whole, cut at no semicolon inside parentheses."""
+    from mpm_fem.app.paper import key_text
+    from mpm_fem.app.report import results_in_brief
+    from mpm_fem.measure.claims import Finding
 
-    assert key_number("order 0.95; the rest") == "order 0.95"
-    long = ", ".join(f"mesh {k}: order 0.{k}" for k in range(20))
-    cut = key_number(long)
-    assert len(cut) <= KEY_LENGTH and cut.endswith(" ...") and long.startswith(cut[:-4])
-    assert cut[:-4].split(", ")[-1].startswith("mesh")  # whole items only
+    assert key_text(Finding("partly", "order 0.95 (8 ppc; CFL 0.05); the rest")) == "order 0.95 (8 ppc; CFL 0.05)"
+    assert key_text(Finding("partly", "order 0.95; the rest", "The order is 0.95.")) == "The order is 0.95."
+    brief = results_in_brief(tables)
+    assert "..." not in brief
+    assert "diverges (8 ppc at CFL 0.05), diverges (4 ppc at CFL 0.05)" in brief  # C11's first clause, whole
 
 
 def test_a_folder_with_some_studies_has_a_section_for_every_claim():
@@ -170,3 +189,167 @@ def test_a_folder_with_some_studies_has_a_section_for_every_claim():
     burgers = text.split('<a id="burgers"></a>')[1].split("<a id=")[0]
     assert "No table of the study `burgers` in this folder" in burgers
     assert '<a id="c13"></a>' in text and "**not measured**" in text.split('<a id="c13"></a>')[1].split("<a id=")[0]
+
+
+# ----------------------------------------------------------------------------- the report as a paper
+
+SECTIONS = ("## Abstract", "## 1 Introduction", "## 2 Method", "### 2.1 Problems and settings",
+            "### 2.3 Verdicts and the rule book", "### 2.4 Seeds", "## 3 Results", "## 4 Discussion",
+            "### 4.2 What makes Sod's particle error grow: the drift study", "### 4.3 What the deep tier changes",
+            "## 5 Conclusions", "## Appendix A: the verdict rule of each claim")
+
+
+def test_the_sections_of_a_paper_come_in_order(rendered):
+    at = [rendered.find("\n" + s + "\n") for s in SECTIONS]
+    assert all(k > 0 for k in at), [s for s, k in zip(SECTIONS, at, strict=True) if k <= 0]
+    assert at == sorted(at), "sections out of order"
+
+
+def test_the_introduction_is_one_paragraph(rendered):
+    block = rendered.split("## 1 Introduction\n")[1].split("\n## ")[0]
+    assert len([p for p in block.split("\n\n") if p.strip()]) == 1, block
+
+
+def test_no_paragraph_is_over_the_limit_and_no_heading_is_empty(rendered):
+    from mpm_fem.app.markdown import MAX_WORDS, headings_without_content, words_of_paragraphs
+
+    long = [(n, start) for n, start in words_of_paragraphs(rendered) if n > MAX_WORDS]
+    assert not long, long
+    assert not headings_without_content(rendered), headings_without_content(rendered)
+
+
+def test_the_checks_find_a_long_paragraph_and_an_empty_heading():
+    from mpm_fem.app.markdown import MAX_WORDS, headings_without_content, words_of_paragraphs
+
+    text = "## A\n\n### B\n\nshort.\n\n" + "word " * (MAX_WORDS + 1) + "\n\n- item one\n- item two\n\n## C\n"
+    assert [n for n, _ in words_of_paragraphs(text)] == [1, MAX_WORDS + 1, 2, 2]
+    assert headings_without_content(text) == ["## A", "## C"]
+
+
+def test_long_prose_is_cut_into_paragraphs_of_whole_sentences():
+    from mpm_fem.app.markdown import MAX_WORDS, paragraphs, split_outside
+
+    text = " ".join(f"Sentence {k} has the order 0.{k} (on mesh {k}; seed {k})." for k in range(60))
+    cut = paragraphs(text)
+    assert len(cut) > 1 and all(len(p.split()) <= MAX_WORDS for p in cut)
+    assert " ".join(cut) == text
+    one = "; ".join(f"clause {k} with the order 0.{k}" for k in range(60))
+    assert all(len(p.split()) <= MAX_WORDS for p in paragraphs(one)) and len(paragraphs(one)) > 1
+    assert split_outside("a (b; c); d") == ["a (b; c)", "d"]
+
+
+def test_the_abstract_is_four_to_six_plain_sentences(rendered):
+    from mpm_fem.app.paper import abstract_sentences
+
+    found = abstract_sentences(rendered)
+    assert 4 <= len(found) <= 6, found
+    body = " ".join(found)
+    assert "..." not in body and "**" not in body
+    assert not re.search(r"\bis (confirmed|partly|refuted|differs)\b", body), body
+
+
+def test_a_perturbed_table_changes_the_abstract(tables):
+    """C11 judged on a particle error that converges at first order: the abstract's sentence about it changes."""
+    from mpm_fem.app.paper import abstract, judge, said
+    from mpm_fem.measure.claims import select
+
+    converging = {**tables, "sod/seeds": [dict(r) for r in tables["sod/seeds"]]}
+    for r in select(converging["sod/seeds"], ok="True"):
+        r["particles_L1"] = r["energy_L1"] = repr(1.2 * float(r["h"]))
+    before, after = judge(tables), judge(converging)
+    assert before["C11"][1].verdict != after["C11"][1].verdict
+    text, changed = "\n".join(abstract(tables, before)), "\n".join(abstract(converging, after))
+    assert text != changed
+    assert said(*before["C11"]) in text and said(*after["C11"]) in changed
+    assert said(*before["C11"]) != said(*after["C11"])
+
+
+def test_the_conclusions_are_five_to_eight_findings_with_their_numbers(rendered):
+    block = rendered.split("## 5 Conclusions")[1].split("\n## ")[0]
+    items = [line for line in block.splitlines() if line.startswith("- ")]
+    assert 5 <= len(items) <= 8, items
+    assert all(re.search(r"\d", item) for item in items), items
+
+
+def test_the_rule_book_and_the_verdict_words_are_printed_in_the_method(tables, monkeypatch):
+    from mpm_fem.app import paper
+    from mpm_fem.measure.claims.rules import RULES, VERDICT_MEANING, Rule
+
+    monkeypatch.setitem(RULES, "TEST_FLOOR", Rule("TEST_FLOOR", 0.5, "an order below it is a floor",
+                                                  "the study's", ("C11",)))
+    method = "\n".join(paper.method(tables, []))
+    assert "| TEST_FLOOR | 0.5 | an order below it is a floor | the study's | C11 |" in method
+    for word, meaning in VERDICT_MEANING.items():
+        assert f"| {word} | {meaning} |" in method
+
+
+def test_a_finding_shows_its_table_or_its_evidence_as_a_list():
+    from mpm_fem.app.paper import evidence
+    from mpm_fem.measure.claims import Finding
+
+    assert evidence(Finding("partly", "a (b; c); d")) == ["- a (b; c)", "- d", ""]
+    table = evidence(Finding("partly", "e", "s", ({"ppc": "8", "order": "0.5"}, {"ppc": "16", "order": "0.9"})))
+    assert table[:3] == ["| ppc | order |", "|---|---|", "| 8 | 0.5 |"]
+
+
+def test_the_drift_study_is_a_section_of_the_discussion(rendered):
+    section = rendered.split("### 4.2 What makes Sod's particle error grow")[1].split("### 4.3")[0]
+    assert "| study settings | regular |" in section and "volume drift" in section
+    assert "drift/drift.png" in section
+
+
+def test_the_deep_tier_says_which_verdicts_move(tables):
+    from dataclasses import replace
+
+    from mpm_fem.app.paper import deep_changes, judge
+
+    found = judge(tables)
+    assert "No verdict moves" in "\n".join(deep_changes(found, found))
+    c, f = found["C12"]
+    moved = {**found, "C12": (c, replace(f, verdict="confirmed" if f.verdict != "confirmed" else "partly"))}
+    text = "\n".join(deep_changes(found, moved))
+    assert "C12" in text and f"from *{f.verdict}*" in text and "No verdict moves" not in text
+    assert "holds no tables" in "\n".join(deep_changes(found, None))
+
+
+def test_the_stamps_and_the_deep_verdicts_are_in_the_appendices(rendered):
+    body, appendices = rendered.split("## Appendix A:")
+    assert "| budget/bases |" not in body and "| budget/bases |" in appendices
+    assert "## Appendix" in appendices.split('<a id="deep"></a>')[1]
+
+
+def test_the_source_matching_settings_are_stated_when_identified(tables):
+    from mpm_fem.app.paper import abstract, identification_section, judge
+
+    rows = [{"source_row": "L1", "ppc": "16", "cfl": "0.05", "misfit": "0.07", "rank": "1", "matching": "True"},
+            {"source_row": "L1", "ppc": "8", "cfl": "0.05", "misfit": "0.9", "rank": "2", "matching": "False"}]
+    identified = {**tables, "identification/sod": rows}
+    said = "\n".join(abstract(identified, judge(tables)))
+    assert "Sod table" in said and "ppc 16" in said and "misfit 0.07" in said
+    assert "| sod | L1 | 16 | 0.05 |" in "\n".join(identification_section(identified))
+    assert "are not in this folder" in "\n".join(identification_section(tables))
+
+
+def test_a_finding_with_a_sentence_and_a_table_is_said_in_words(tables):
+    """Where a criterion writes a plain sentence and a small table, the abstract and the conclusions say the
+    sentence, the results show the table, and Appendix A keeps the whole evidence line."""
+    from dataclasses import replace
+
+    from mpm_fem.app.pages import PAGES
+    from mpm_fem.measure.claims import CLAIMS, Finding
+
+    sentence = "At 8 particles per cell the particle density error grows from the second refinement on."
+    found = Finding("differs", "orders 0.18, -0.24; the rest", sentence, ({"ppc": "8", "last order": "-0.52"},))
+    k = next(k for k, c in enumerate(CLAIMS) if c.label == "C11")
+    original = CLAIMS[k]
+    CLAIMS[k] = replace(original, criterion=lambda t: found)
+    try:
+        text = render(tables, PAGES)
+    finally:
+        CLAIMS[k] = original
+    head = text.split("## 1 Introduction")[0]
+    assert sentence.rstrip(".") + " (C11)." in head
+    section = text.split('<a id="c11"></a>')[1].split("<a id=")[0]
+    assert "| ppc | last order |" in section and "| 8 | -0.52 |" in section
+    assert sentence.rstrip(".") + " (C11)." in text.split("## 5 Conclusions")[1].split("## Appendix")[0]
+    assert "The evidence in full: orders 0.18, -0.24; the rest." in text.split('<a id="rule-c11"></a>')[1]

@@ -180,4 +180,18 @@ PAGES = (
                   "shared machine; no verdict uses wall time)", ("method", "h", "density_L1", "particles_L1", "work",
                                                                  "wall_s"), {}, "cost.png"),
          )),
+    Page("drift", "What makes Sod's particle error grow (C11's mechanism)",
+         "Sod with the study's MPM settings and variants that each change one thing: the form of the density update, "
+         "the quadrature of the volume rate, the time step, the particles per cell and the volume reset against the "
+         "grid, on the regular layout and, for some variants, on jittered layouts. Per variant and mesh: the "
+         "particle and nodal density L1 errors, the volume drift (the particles' total volume minus the tube's) and "
+         "the successive orders.",
+         views=(
+             View("drift/drift", "Per variant and mesh, regular layout: errors, volume drift and orders", (
+                 "variant", "h", "particles_L1", "nodes_L1", "volume_drift", "order_particles_L1",
+                 "order_nodes_L1", "particles_vs_study"), {"layout": "regular"}, "drift.png"),
+             View("drift/drift", "The jittered layouts, one row per seed and mesh", (
+                 "variant", "seed", "h", "particles_L1", "nodes_L1", "volume_drift", "order_particles_L1"),
+                  {"layout": "jittered"}),
+         )),
 )

@@ -1,31 +1,34 @@
 """``REPORT.md``, rendered from the claims (:mod:`mpm_fem.measure.claims`) and the tables, never typed.
 
-The report reads as a paper. Its first screen: the title, an abstract formatted from the verdicts
-and their key numbers, the verdict table split into the source's claims and the extensions, the
-two figures that carry the study, and the caveats (the settings that differ from the source's, the
-tier, whether the figures lag the code). Then one section per study with one subsection per claim
-(statement, source, verdict, one figure, the evidence and the rule), then the deep tier's verdicts
-when ``<out>/deep/`` holds tables, then the appendices: each study's tables and figures
-(:class:`~mpm_fem.app.pages.Page`, :data:`mpm_fem.app.pages.PAGES`), linked from its claims. Every
-number comes from the tables it was rendered from, so rendering the committed tables again gives
-the same bytes: ``python -m mpm_fem.app.report [--out figures]``.
+The report reads as a paper (:mod:`mpm_fem.app.paper` writes its body). Its first screen: the
+title, a warning when the figures lag the code, the abstract and the two figures that carry the
+study. Then the introduction, the method (settings, the source-matching settings, the rule book,
+the seeds, the record's caveats), the results (the verdict tables, then one subsection per claim),
+the discussion (each discrepancy, the drift study, what the deep tier changes) and the
+conclusions. The appendices: each claim's verdict rule, each study's tables and figures
+(:class:`~mpm_fem.app.pages.Page`, :data:`mpm_fem.app.pages.PAGES`), the code version of each
+table (E4) and the deep tier's verdicts when ``<out>/deep/`` holds tables. Every number comes from
+the tables it was rendered from, so rendering the committed tables again gives the same bytes:
+``python -m mpm_fem.app.report [--out figures]``.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
 
+from mpm_fem.app import paper
+from mpm_fem.app.markdown import anchor_of, bullets, cell, figure, markdown_table  # noqa: F401  (cell: interface)
 from mpm_fem.app.output import write_atomic
 from mpm_fem.app.pages import PAGES, Page, View  # noqa: F401  (View: part of this module's interface)
+from mpm_fem.app.paper import Found, judge, key_text
 from mpm_fem.app.plots import CAPTIONS
 from mpm_fem.app.study import QUICK_LEAVES_OUT
-from mpm_fem.measure.claims import CLAIMS, STATEMENTS, Claim, claims_of, select
+from mpm_fem.measure.claims import STATEMENTS, Claim, select
 from mpm_fem.measure.tables import Tables, load_tables
 from mpm_fem.measure.version import code_version as current_code
 
@@ -34,51 +37,7 @@ TITLE = "# mpm-fem: where does the error of MPM come from?"
 MAX_ROWS = 40
 
 
-# ----------------------------------------------------------------------------- Markdown
-
-def cell(value) -> str:
-    """One table cell: numbers to four significant digits, text with its pipes escaped."""
-    text = str(value).strip()
-    try:
-        number = float(text)
-    except ValueError:
-        return text.replace("|", "\\|").replace("\n", " ")
-    if not math.isfinite(number):
-        return ""
-    if text.lstrip("-").isdigit():
-        return text
-    return format(number, ".4g")
-
-
-def markdown_table(rows: list[dict], columns: tuple[str, ...] | list[str] = ()) -> list[str]:
-    """A Markdown table of ``rows`` in ``columns`` (every column of the first row when empty)."""
-    columns = list(columns) or list(rows[0])
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    return lines + ["| " + " | ".join(cell(r.get(c, "")) for c in columns) + " |" for r in rows]
-
-
-def anchor(claim: Claim) -> str:
-    return claim.label.lower().replace(" (", "-").replace(")", "")
-
-
-#: The longest key number of the summary; the whole evidence is in the claim's section.
-KEY_LENGTH = 80
-
-
-def key_number(evidence: str, limit: int = KEY_LENGTH) -> str:
-    """The summary's key number: the first clause of the evidence, cut after its last comma-separated
-    item that fits ``limit`` characters (then ending in " ...")."""
-    first = evidence.split(";")[0].strip()
-    if len(first) <= limit:
-        return first
-    items, kept = first.split(", "), ""
-    for item in items:
-        longer = f"{kept}, {item}" if kept else item
-        if len(longer) > limit - 4:
-            break
-        kept = longer
-    return f"{kept or first[: limit - 4]} ..."
-
+# ----------------------------------------------------------------------------- tables and appendices
 
 def code_version(tables: Tables) -> str:
     """The code version most tables were written by (E4 names any other)."""
@@ -90,48 +49,25 @@ def is_quick(tables: Tables) -> bool:
     return any(r["quick"] == "True" for r in tables.get("versions", []))
 
 
-# ----------------------------------------------------------------------------- sections
+def anchor(claim: Claim) -> str:
+    return anchor_of(claim.label)
 
-def summary(tables: Tables, link: str = "", kind: str = "") -> list[str]:
-    """The one-screen summary: every claim, its verdict, key number and section (``link`` prefixes
-    the anchors, e.g. ``figures/REPORT.md`` from the README); ``kind`` ``"C"`` (the source's claims)
-    or ``"E"`` (the extensions) keeps those only."""
+
+def summary(found: Found, link: str = "", kind: str = "") -> list[str]:
+    """The verdict table: every claim, its verdict, key number (the finding's sentence, or its evidence's
+    first clause, whole) and section (``link`` prefixes the anchors, e.g. ``figures/REPORT.md`` from the
+    README); ``kind`` ``"C"`` (the source's claims) or ``"E"`` (the extensions) keeps those only."""
     lines = ["| claim | statement | verdict | key number |", "|---|---|---|---|"]
     for cid, statement in STATEMENTS.items():
         if not cid.startswith(kind):
             continue
-        found = sorted((c for c in CLAIMS if c.id == cid), key=lambda c: c.problem)
-        if not found:
+        listed = sorted(((c, f) for c, f in found.values() if c.id == cid), key=lambda cf: cf[0].problem)
+        if not listed:
             lines.append(f"| {cid} | {statement} | not measured | no criterion registered |")
-        for c in found:
-            verdict, evidence = c.verdict(tables)
-            lines.append(f"| [{c.label}]({link}#{anchor(c)}) | {cell(statement)} | **{verdict}** | "
-                         f"{cell(key_number(evidence))} |")
+        for c, f in listed:
+            lines.append(f"| [{c.label}]({link}#{anchor(c)}) | {cell(statement)} | **{f.verdict}** | "
+                         f"{cell(key_text(f))} |")
     return lines
-
-
-def claim_section(c: Claim, tables: Tables, figure_lines: list[str] = (), appendix: str = "") -> list[str]:
-    """A claim: statement, verdict, its figure, the evidence, the source and the rule, the tables."""
-    verdict, evidence = c.verdict(tables)
-    lines = [f'<a id="{anchor(c)}"></a>', "", f"### {c.label}: {c.statement}", "", f"**{verdict}**", "",
-             *figure_lines, f"{evidence}.", "",
-             f"- Source: {c.source}.", f"- Verdict rule: {c.thresholds}.",
-             "- Tables: " + ", ".join(f"[{t}.csv]({t}.csv)" for t in c.tables if "/" in t)
-             + (f" ([appendix](#{appendix}))." if appendix else ".")]
-    return lines + ([f"- Why: {c.explanation}", ""] if c.explanation else [""])
-
-
-def claim_figure(c: Claim, page: Page | None, captions: dict) -> list[str]:
-    """The first figure of the page's views of a table the claim reads (none if no view has one)."""
-    for v in page.views if page else ():
-        if v.figure and v.table in c.tables and v.figure in captions:
-            return figure(page.name, v.figure, captions)
-    return []
-
-
-def figure(page: str, file: str, captions: dict) -> list[str]:
-    caption = captions.get(file, file)
-    return [f"![{caption}]({page}/{file})", "", f"*{caption}*", ""]
 
 
 def captions_of(folder: Path) -> dict[str, str]:
@@ -155,27 +91,10 @@ def view_section(page: Page, v: View, tables: Tables, captions: dict) -> list[st
     return lines + ([""] + ([f"{more} more rows in [{v.table}.csv]({v.table}.csv)."] if more > 0 else []) + [""])
 
 
-def page_section(page: Page, tables: Tables, captions: dict) -> list[str]:
-    """A study's claims, each with its figure, linking to the study's appendix."""
-    lines = [f'<a id="{page.name}"></a>', "", f"## {page.title}", "", page.caption, ""]
-    for c in claims_of(page.name):
-        lines += claim_section(c, tables, claim_figure(c, page, captions), f"appendix-{page.name}")
-    return lines
-
-
-def missing_section(page: Page, tables: Tables) -> list[str]:
-    """A study with no table in the folder (a tier run in part): its claims, each not measured, so that
-    every claim of the summary has its section."""
-    lines = [f'<a id="{page.name}"></a>', "", f"## {page.title}", "",
-             f"No table of the study `{page.name}` in this folder: its claims are not measured here.", ""]
-    for c in claims_of(page.name):
-        lines += claim_section(c, tables)
-    return lines
-
-
-def appendix_section(page: Page, tables: Tables, captions: dict) -> list[str]:
+def appendix_section(letter: str, page: Page, tables: Tables, captions: dict) -> list[str]:
     """A study's tables and every figure it drew."""
-    lines = [f'<a id="appendix-{page.name}"></a>', "", f"## Appendix: {page.title}", ""]
+    lines = [f'<a id="appendix-{page.name}"></a>', "", f"## Appendix {letter}: {page.title}", "",
+             f"The tables and figures of the study `{page.name}`, with the settings of each in the JSON beside it.", ""]
     for v in page.views:
         lines += view_section(page, v, tables, captions)
     shown = {v.figure for v in page.views}
@@ -187,41 +106,58 @@ def appendix_section(page: Page, tables: Tables, captions: dict) -> list[str]:
                     + ", ".join(f"[{t.split('/')[1]}.csv]({t}.csv)" for t in own) + ".", ""]
 
 
-def reproduction_section(tables: Tables) -> list[str]:
-    lines = ['<a id="reproduce"></a>', "", "## Reproduction", ""]
-    for c in claims_of("reproduce"):
-        lines += claim_section(c, tables)
-    return lines + markdown_table(tables.get("versions", []), ("table", "code", "quick")) + [""]
+def rules_appendix(found: Found) -> list[str]:
+    """Appendix A: each claim's source, verdict rule in words and the reason its criterion gives."""
+    lines = ['<a id="appendix-rules"></a>', "", "## Appendix A: the verdict rule of each claim", "",
+             "Each claim's rule in words, as its criterion applies it, the reason the criterion gives, and the "
+             "evidence in full where the results show it as a table.", ""]
+    order = list(STATEMENTS)
+    for c, f in sorted(found.values(), key=lambda cf: (order.index(cf[0].id), cf[0].problem)):
+        items = [f"Source: {c.source}.", f"Verdict rule: {c.thresholds}."]
+        items += [f"Why: {c.explanation}"] if c.explanation else []
+        # the results show a finding's small table; its whole evidence line stays readable here
+        items += [f"The evidence in full: {f.evidence}."] if f.table else []
+        lines += [f'<a id="rule-{anchor(c)}"></a>', "", f"#### {c.label}: {c.statement}", "", *bullets(items)]
+    return lines
+
+
+def stamps_appendix(letter: str, tables: Tables) -> list[str]:
+    """The code version each table was written by (E4's evidence)."""
+    rows = tables.get("versions", [])
+    lines = ['<a id="appendix-stamps"></a>', "", f"## Appendix {letter}: the code version of each table", ""]
+    if not rows:
+        return lines + ["No table in this folder.", ""]
+    return lines + [f"The stamp of each of the {len(rows)} tables (E4).", "",
+                    *markdown_table(rows, ("table", "code", "quick")), ""]
+
+
+def deep_appendix(letter: str, deep: Tables | None, deep_found: Found | None) -> list[str]:
+    """The deep tier's verdict table (``figures/deep/``), or a line saying it holds no tables."""
+    lines = ['<a id="deep"></a>', "", f"## Appendix {letter}: the deep tier's verdicts", ""]
+    if deep_found is None:
+        return lines + ["`deep/` holds no tables: `mpm-fem reproduce --deep` runs the finest meshes and the long "
+                        "sweeps into it, and this appendix then shows their verdicts.", ""]
+    return lines + [f"Verdicts on the deep tier's tables (code version {code_version(deep)}, "
+                    f"[deep/REPORT.md](deep/REPORT.md)):", "", *summary(deep_found, "deep/REPORT.md"), ""]
 
 
 #: The two figures that carry the study, shown on the first screen when the report's folder has them.
 KEY_FIGURES = ("sod/convergence.png", "burgers/convergence.png")
-#: The claims the abstract reports, in this order, with what each says in words.
-ABSTRACT = (("C11", "Sod's shock tube"), ("C13", "viscous Burgers"), ("E1", "the error budget"),
-            ("E3", "MPM against fixed-mesh FEM on the same mesh"))
 
 
-def abstract(tables: Tables) -> list[str]:
-    """Three to five sentences formatted from the verdicts and their key numbers."""
-    found = {}
-    for c in CLAIMS:
-        found.setdefault(c.id, []).append((c, *c.verdict(tables)))
-    source = [v for cid, vs in found.items() if cid.startswith("C") for _, v, _ in vs]
-    counts = {v: source.count(v) for v in dict.fromkeys(source)}
-    lines = [f"We judge {len(source)} verdicts on the source's claims and "
-             f"{sum(len(vs) for cid, vs in found.items() if cid.startswith('E'))} on the extensions, each "
-             "computed from the tables below: " + ", ".join(f"{n} {v}" for v, n in counts.items()) + "."]
-    for cid, words in ABSTRACT:
-        for c, verdict, evidence in found.get(cid, []):
-            lines.append(f"On {words}{f' ({c.problem})' if c.problem else ''}, {c.id} is **{verdict}**: "
-                         f"{key_number(evidence, 2 * KEY_LENGTH)}.")
-    return [" ".join(lines), ""]
+def lag_note(tables: Tables, current: str | None) -> list[str]:
+    """The first screen's warning when the tables were written by another code version than ``current``."""
+    written = code_version(tables)
+    if current is None or current == written:
+        return []
+    return [f"**The figures lag the code**: the tables were written by code version {written}, the code is now "
+            f"{current}; `mpm-fem reproduce --full` regenerates them.", ""]
 
 
 def caveats(tables: Tables, current: str | None) -> list[str]:
-    """What a reader must know before the numbers: the tier, the study's settings that differ from the
-    source's, and whether the figures lag the code (``current``: the code version now, if known)."""
-    out = ["## Caveats", ""]
+    """What a reader must know before the numbers, as a list: the tier, the study's settings that differ
+    from the source's, and whether the figures lag the code (``current``: the code version now, if known)."""
+    out = []
     out.append("- These tables come from `mpm-fem reproduce --quick`: a subset of the meshes of each study. A "
                "verdict judged on the finest mesh a study has can differ from the full record's "
                "(`mpm-fem reproduce --full`), which reaches finer meshes. The quick tier leaves out the studies "
@@ -231,22 +167,21 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
     rows = tables.get("versions", [])
     behind = sorted({r["table"].split("/")[0] for r in rows if r["code"] != current})
     if current is not None and current != written:
-        out.append(f"- **The figures lag the code**: the tables were written by code version {written}, the code "
-                   f"is now {current}; `mpm-fem reproduce --full` regenerates them.")
+        out.append("- " + lag_note(tables, current)[0])
     elif current is not None and behind:
         out.append(f"- **Part of the figures lag the code**: {len(rows) - sum(r['code'] != current for r in rows)} "
                    f"of {len(rows)} tables come from the current code ({current}); the studies "
-                   f"{', '.join(behind)} still hold tables of an older code (the versions table, E4); "
+                   f"{', '.join(behind)} still hold tables of an older code ([the stamps](#appendix-stamps), E4); "
                    "`mpm-fem reproduce --full` regenerates them.")
     elif current is not None:
         out.append(f"- The tables were written by the current code ({written}).")
     setting = {r["key"]: r["value"] for r in tables.get("settings", []) if r["table"] == "sod/convergence"}
     if "mpm.ppc" in setting:
-        out.append(f"- Sod's convergence study runs {setting['mpm.ppc']} particles per cell at CFL "
-                   f"{setting.get('mpm.cfl', '?')} (`sod/convergence.json`); the source prescribes 4-8 per cell and "
-                   "states no time step: the claims on Sod state their verdict per setting where the tables hold "
-                   "several.")
-    return out + [""]
+        out.append(f"- The studies that run Sod at one setting (the error budget, the bases, the remedies, the drift "
+                   f"study) use {setting['mpm.ppc']} particles per cell at CFL {setting.get('mpm.cfl', '?')} "
+                   "(`sod/convergence.json`); the source prescribes 4-8 per cell and states no time step, and the "
+                   "claims on Sod state their verdict per setting where the tables hold several.")
+    return out
 
 
 def render(tables: Tables, pages, captions: dict[str, dict] | None = None, current: str | None = None,
@@ -255,36 +190,27 @@ def render(tables: Tables, pages, captions: dict[str, dict] | None = None, curre
     the figure ``captions`` of each study folder (``{study: {file: caption}}``), the code version now
     (``current``) and the deep tier's tables (``deep``, ``None`` when there are none)."""
     captions = captions or {}
-    head = [TITLE, "",
-            f"Rendered by `python -m mpm_fem.app.report` from the tables of code version {code_version(tables)}. "
-            "Source: L.-T. Tran and M. Berzins, Error Analysis for Material Point Method and a case study from Gas "
-            "Dynamics (slides; the claims, the source's tables and the corrections made to them: `docs/claims.md` "
-            "of the repository).", "", "## Abstract", "", *abstract(tables),
-            "## The source's claims", "", *summary(tables, kind="C"), "",
-            "## Extensions", "", *summary(tables, kind="E"), ""]
+    found = judge(tables)
+    deep_found = judge(deep) if deep and deep.get("versions") else None
+    lines = [TITLE, "",
+             f"Rendered by `python -m mpm_fem.app.report` from the tables of code version {code_version(tables)}. "
+             "Source: L.-T. Tran and M. Berzins, Error Analysis for Material Point Method and a case study from Gas "
+             "Dynamics (slides; the claims, the source's tables and the corrections made to them: `docs/claims.md` "
+             "of the repository).", "", *lag_note(tables, current), *paper.abstract(tables, found)]
     for key in KEY_FIGURES:
         study, file = key.split("/")
         if file in captions.get(study, {}):
-            head += figure(study, file, captions[study])
-    lines = head + caveats(tables, current)
+            lines += figure(study, file, captions[study])
+    lines += paper.introduction(found) + paper.method(tables, caveats(tables, current))
+    lines += paper.results(tables, found, pages, captions, partial(summary, found, ""))
+    lines += paper.discussion(tables, found, captions, deep_found) + paper.conclusions(found)
+    lines += rules_appendix(found)
     shown = [page for page in pages if any(t.startswith(page.name + "/") for t in tables)]
-    for page in pages:
-        lines += (page_section(page, tables, captions.get(page.name, {})) if page in shown
-                  else missing_section(page, tables))
-    lines += reproduction_section(tables) + deep_section(deep)
+    letters = iter("BCDEFGHIJKLMNOPQRSTUVWXYZ")
     for page in shown:
-        lines += appendix_section(page, tables, captions.get(page.name, {}))
-    return "\n".join(lines)
-
-
-def deep_section(deep: Tables | None) -> list[str]:
-    """The deep tier's verdicts (``figures/deep/``), or a line saying it holds no tables."""
-    lines = ['<a id="deep"></a>', "", "## The deep tier", ""]
-    if not deep or not deep.get("versions"):
-        return lines + ["`deep/` holds no tables: `mpm-fem reproduce --deep` runs the finest meshes and the long "
-                        "sweeps into it, and this section then shows their verdicts.", ""]
-    return lines + [f"Verdicts on the deep tier's tables (code version {code_version(deep)}, "
-                    f"[deep/REPORT.md](deep/REPORT.md)):", "", *summary(deep, "deep/REPORT.md"), ""]
+        lines += appendix_section(next(letters), page, tables, captions.get(page.name, {}))
+    lines += stamps_appendix(next(letters), tables) + deep_appendix(next(letters), deep, deep_found)
+    return "\n".join(paper.numbered(lines))
 
 
 # ----------------------------------------------------------------------------- the command
@@ -352,7 +278,7 @@ def results_in_brief(tables: Tables, report: str = "figures/REPORT.md") -> str:
     """README's "Results in brief": the summary of the report, its links pointing into ``report``."""
     return "\n".join([README_BEGIN, f"Verdicts computed from the committed tables (code version "
                       f"{code_version(tables)}); each claim links to its section of `{report}`.", "",
-                      *summary(tables, report), README_END])
+                      *summary(judge(tables), report), README_END])
 
 
 def update_readme(readme: Path, tables: Tables) -> None:

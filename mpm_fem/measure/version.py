@@ -35,7 +35,8 @@ ROOT = Path(__file__).resolve().parents[2]
 #: The packages whose ``.py`` files compute the numbers of the tables.
 PACKAGES = ("mpm_fem", "baselines", "studies")
 #: Modules of those packages that only render tables already written (paths from the root).
-RENDERING = ("mpm_fem/app/report.py", "mpm_fem/app/pages.py", "mpm_fem/app/plots.py")
+RENDERING = ("mpm_fem/app/report.py", "mpm_fem/app/paper.py", "mpm_fem/app/markdown.py", "mpm_fem/app/pages.py",
+             "mpm_fem/app/plots.py")
 
 
 def versioned_files(root: Path = ROOT) -> list[Path]:
