@@ -203,6 +203,28 @@ def test_a_line_says_when_numba_compiles_and_none_when_the_kernel_comes_from_its
     assert off.getvalue() == ""
 
 
+def compiles(case: dict) -> dict:
+    """A sweep's case that compiles a fresh kernel (no cache) in the process that runs it."""
+    import time
+
+    from numba import njit
+
+    time.sleep(0.2)  # both workers take a case
+    n = case["n"]
+    return {"value": njit(lambda x: x + n)(1)}
+
+
+def test_of_the_workers_compiling_one_says_so(capfd):
+    from mpm_fem.app.compiling import LINE
+    from mpm_fem.app.sweep import run_cases
+
+    got = run_cases(compiles, [{"n": n} for n in range(4)], jobs=2, progress=True)
+    assert [r["value"] for r in got] == [1, 2, 3, 4]
+    assert capfd.readouterr().err.count(LINE) == 1
+    run_cases(compiles, [{"n": n} for n in range(2)], jobs=2, progress=False)
+    assert LINE not in capfd.readouterr().err
+
+
 def test_the_time_left_is_the_mean_time_of_the_cases_run_so_far():
     from mpm_fem.app.sweep import time_left
 
