@@ -41,7 +41,9 @@ class _Notice(event.Listener):
 
     def on_start(self, ev) -> None:
         if self._first():
-            print(LINE, file=self.stream or sys.stderr, flush=True)
+            stream = self.stream or sys.stderr
+            stream.write(LINE + "\n")  # one write: whole beside other processes' lines
+            stream.flush()
 
     def on_end(self, ev) -> None:
         pass
