@@ -121,6 +121,13 @@ def test_the_pages_baselines_are_the_committed_convergence_table():
         assert value == pytest.approx(float(convergence[0.01][column]), rel=5e-3), (column, shown)
 
 
+def test_the_pages_ratio_to_the_source_is_the_committed_one():
+    ratios = [float(r["ratio_nodes_L1"]) for r in _study_rows("convergence") if r["source_L1"]]
+    assert len(ratios) == 5
+    assert f"L1 is {min(ratios):.2f} to {max(ratios):.2f} times the source's on its five meshes" in \
+        " ".join(DOCS.read_text().split())
+
+
 # --- the API's pieces ------------------------------------------------------------------------------
 
 
