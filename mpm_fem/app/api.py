@@ -36,6 +36,8 @@ from mpm_fem.app.guard import LONG_RUN_S, UsageError, check_cost
 from mpm_fem.core.particles import Particles
 from mpm_fem.core.solve import Result
 
+#: The fields whose error a convergence study can measure, by problem.
+MEASURED = {"sod": ("density", "velocity", "pressure"), "burgers": ("velocity",)}
 #: How a Python caller asks for a long run (the guard's message names it).
 YES_LONG = "yes_long=True"
 
@@ -156,15 +158,18 @@ def convergence(problem: str, hs, seeds=(0,), preset: str = "defaults", solver: 
     """
     from mpm_fem.app.sweep import run_cases
 
-    presets.check_name(f"solver of {problem}", solver, SOLVERS.get(problem, ("mpm",)))
+    presets.check_name("problem", problem, presets.PROBLEMS)
+    presets.check_name(f"solver of {problem}", solver, SOLVERS[problem])
     field = field or FIELDS[problem]
+    presets.check_name(f"field of {problem}", field, MEASURED[problem])
+    seeds = tuple(seeds)
+    if not seeds or any(isinstance(k, bool) or not isinstance(k, int) or k < 0 for k in seeds):
+        raise ValueError(f"seeds are integers >= 0 (0: the settings' own layout), got seeds={seeds}")
     hs, seeds = tuple(sorted((float(h) for h in hs), reverse=True)), tuple(sorted(set(seeds)))
     if len(hs) < 2 or len(set(hs)) < len(hs):
         raise ValueError(f"a convergence study takes at least two different meshes, got hs={hs}")
     if solver != "mpm" and seeds != (0,):
         raise ValueError(f"the {solver} baseline has no particle layout: run it with seeds=(0,), got seeds={seeds}")
-    if any(isinstance(k, bool) or not isinstance(k, int) or k < 0 for k in seeds) or not seeds:
-        raise ValueError(f"seeds are integers >= 0 (0: the settings' own layout), got seeds={seeds}")
     cases, seconds = [], 0.0
     for h in hs:
         for k in seeds:
@@ -176,6 +181,8 @@ def convergence(problem: str, hs, seeds=(0,), preset: str = "defaults", solver: 
                 given = s.as_dict()
             else:
                 given = _baseline_settings(problem, solver, preset, {**settings, "h": h})
+                problem_of = {k: given[k] for k in ("solution", "eps") if k in given}
+                presets.settings_type(problem)(h=h, **problem_of)  # h divides the domain (GridError)
             cases.append({"problem": problem, "solver": solver, "field": field, "settings": given})
     if seconds > LONG_RUN_S and not yes_long:
         raise UsageError(f"{len(cases)} runs estimated at {seconds / 3600:.3g} h together: over "
