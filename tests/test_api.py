@@ -121,6 +121,20 @@ def test_the_pages_baselines_are_the_committed_convergence_table():
         assert value == pytest.approx(float(convergence[0.01][column]), rel=5e-3), (column, shown)
 
 
+def test_the_pages_burgers_numbers_are_the_committed_errors_table():
+    import csv
+
+    with open(FIGURES / "burgers" / "errors.csv") as f:
+        rows = {(r["method"], float(r["h"])): r for r in csv.DictReader(f)
+                if r["solution"] == "rarefaction" and float(r["eps"]) == 0.045}
+    mpm, fem = rows[("mpm_calculated", 0.01)], rows[("fem_consistent", 0.01)]
+    shown = _shown("velocity max error").split()
+    assert (float(shown[4].rstrip(",")), float(shown[6])) == pytest.approx(
+        (float(mpm["particles_max"]), float(mpm["nodes_max"])), rel=5e-3)
+    shown = _shown('burgers.fem(h=0.01, mass="consistent")')
+    assert float(shown.split("L1 ")[1].split(",")[0]) == pytest.approx(float(fem["nodes_L1"]), rel=5e-3)
+
+
 def test_the_pages_ratio_to_the_source_is_the_committed_one():
     rows = sorted((r for r in _study_rows("convergence") if r["source_L1"]), key=lambda r: -float(r["h"]))
     ratios = [float(r["ratio_nodes_L1"]) for r in rows]
