@@ -107,3 +107,139 @@ def test_saved_fields_read_back_with_meshio_match_the_run(tmp_path):
     assert grid.points.shape[0] == 21 and grid.cells_dict["line"].shape == (20, 2)
     assert abs(grid.point_data["mass"].sum() - 0.5625) < 1e-12
     assert main(["sod", "--h", "0.05", "--save-fields", "0", "--out", str(out)]) == 2
+
+
+# --- a mistyped option or command: the closest valid one, and the subcommand's own help ----------
+
+MISTYPED = [
+    (["sod", "--ppcc", "8"], "unrecognized arguments: --ppcc 8; did you mean --ppc? (see mpm-fem sod --help)"),
+    (["sood", "--h", "0.01"], "invalid choice: 'sood' (choose from 'sod', 'burgers', 'study', 'reproduce'); "
+                              "did you mean 'sod'? (see mpm-fem sod --help)"),
+    (["study", "sood"], "did you mean 'sod'? (see mpm-fem study --help)"),
+    (["sod", "--mass", "lumpd"], "did you mean 'lumped'? (see mpm-fem sod --help)"),
+    (["burgers", "--solutoin=front"], "did you mean --solution? (see mpm-fem burgers --help)"),
+]
+
+
+@pytest.mark.parametrize("argv,message", MISTYPED, ids=[" ".join(a) for a, _ in MISTYPED])
+def test_a_mistyped_name_gets_the_closest_one_and_the_subcommands_help(argv, message, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.endswith(message), err
+
+
+def test_an_unknown_argument_with_nothing_close_gets_the_help_alone(capsys):
+    with pytest.raises(SystemExit):
+        main(["sod", "--zzz"])
+    err = capsys.readouterr().err.strip()
+    assert err == "mpm-fem sod: error: unrecognized arguments: --zzz (see mpm-fem sod --help)", err
+
+
+# --- the grid's fields carry the density, the exact solution and the error --------------------------
+
+
+def test_the_grid_vtu_carries_the_nodal_density_the_exact_solution_and_the_error(tmp_path):
+    import meshio
+    import numpy as np
+
+    from mpm_fem.problems import sod
+
+    out = tmp_path / "f"
+    assert main(["sod", "--h", "0.05", "--T", "0.05", "--save-fields", "5", "--out", str(out), "--quiet"]) == 0
+    grids = sorted((out / "fields").glob("grid_*.vtu"))
+    times = [float(line.split('"')[1]) for line in (out / "fields" / "grid.pvd").read_text().splitlines()
+             if "<DataSet" in line]
+    for path, t in ((grids[1], times[1]), (grids[-1], times[-1])):
+        grid = meshio.read(path)
+        x, data = grid.points[:, 0], grid.point_data
+        np.testing.assert_allclose(data["density"], data["mass"] / sod.uniform_grid(0, 1, 0.05).lumped_mass)
+        rho, u, _ = sod.exact(sod.SodSettings(), x, t)
+        np.testing.assert_allclose(data["density_exact"], rho, rtol=1e-12)
+        np.testing.assert_allclose(data["velocity_exact"], u, rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(data["density_error"], data["density"] - rho, rtol=1e-12, atol=1e-15)
+        assert 0 < np.abs(data["density_error"]).max() < 0.5
+    summary = json.loads((out / "summary.json").read_text())
+    final = meshio.read(grids[-1]).point_data
+    l1 = float(np.sum(np.abs(final["density_error"]) * sod.uniform_grid(0, 1, 0.05).lumped_mass))
+    assert l1 == pytest.approx(summary["errors"]["density"]["nodes"]["L1"], rel=1e-6)
+    particles = meshio.read(sorted((out / "fields").glob("particles_*.vtu"))[-1]).point_data
+    assert {"density_exact", "density_error", "velocity_error", "pressure_error"} <= set(particles)
+
+
+def test_burgers_grid_vtu_has_the_velocity_error_and_no_exact_density(tmp_path):
+    import meshio
+
+    out = tmp_path / "b"
+    assert main(["burgers", "--h", "0.05", "--T", "0.05", "--save-fields", "5", "--out", str(out), "--quiet"]) == 0
+    data = meshio.read(sorted((out / "fields").glob("grid_*.vtu"))[-1]).point_data
+    assert {"density", "velocity_exact", "velocity_error"} <= set(data) and "density_exact" not in data
+
+
+# --- progress: a line while numba compiles, and the time left ---------------------------------------
+
+
+def test_a_line_says_when_numba_compiles_and_none_when_the_kernel_comes_from_its_cache(tmp_path, monkeypatch):
+    import importlib
+    import io
+
+    from mpm_fem.app.compiling import LINE, compile_notice
+
+    (tmp_path / "toy_kernel.py").write_text("from numba import njit\n\n\n@njit(cache=True)\n"
+                                            "def twice(x):\n    return 2 * x\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    toy = importlib.import_module("toy_kernel")
+    first, again, off = io.StringIO(), io.StringIO(), io.StringIO()
+    with compile_notice(stream=first):
+        assert toy.twice(2) == 4 and toy.twice(3) == 6
+    assert first.getvalue() == LINE + "\n"  # once, at the compilation
+    toy = importlib.reload(toy)  # a new dispatcher: loads the compiled kernel from the disk cache
+    with compile_notice(stream=again):
+        assert toy.twice(2) == 4
+    assert again.getvalue() == ""
+    with compile_notice(enabled=False, stream=off):
+        assert toy.twice(2.5) == 5.0  # a new signature compiles, unannounced when disabled
+    assert off.getvalue() == ""
+
+
+def compiles(case: dict) -> dict:
+    """A sweep's case that compiles a fresh kernel (no cache) in the process that runs it."""
+    import time
+
+    from numba import njit
+
+    time.sleep(0.2)  # both workers take a case
+    n = case["n"]
+    return {"value": njit(lambda x: x + n)(1)}
+
+
+def test_of_the_workers_compiling_one_says_so(capfd):
+    from mpm_fem.app.compiling import LINE
+    from mpm_fem.app.sweep import run_cases
+
+    got = run_cases(compiles, [{"n": n} for n in range(4)], jobs=2, progress=True)
+    assert [r["value"] for r in got] == [1, 2, 3, 4]
+    assert capfd.readouterr().err.count(LINE) == 1
+    run_cases(compiles, [{"n": n} for n in range(2)], jobs=2, progress=False)
+    assert LINE not in capfd.readouterr().err
+
+
+def test_the_time_left_is_the_mean_time_of_the_cases_run_so_far():
+    from mpm_fem.app.sweep import time_left
+
+    assert time_left(10.0, 2, 3) == "about 15 s left"
+    assert time_left(600.0, 1, 1) == "about 10 min left"
+    assert time_left(5.0, 0, 4) == "time left unknown" and time_left(5.0, 4, 0) == "done"
+
+
+def test_plain_progress_lines_show_the_time_left(capsys, monkeypatch):
+    from mpm_fem.app import sweep
+    from mpm_fem.app.convergence import measured
+
+    monkeypatch.setattr(sweep.sys.stderr, "isatty", lambda: False, raising=False)
+    case = {"problem": "sod", "solver": "fv", "field": "density", "settings": {"h": 0.1, "T": 0.01}}
+    sweep.run_cases(measured, [case, {**case, "settings": {"h": 0.05, "T": 0.01}}], jobs=1, progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[1].startswith("[cases] 1/2 done, ") and lines[1].endswith(" s left"), lines
+    assert lines[2].endswith(", done"), lines

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from mpm_fem.app import guard, output
+from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.guard import UsageError
 from mpm_fem.app.study import add_study_options, add_tier_options, run_study, study_options
 from mpm_fem.core.grid import GridError
@@ -179,14 +180,17 @@ def _prepare(args, problem: str, module, settings_cls):
     return settings, cost, out
 
 
-def _simulate(args, module, settings, folder: Path, grid):
-    """Run ``module.simulate``, writing fields into ``folder/fields`` if ``--save-fields``."""
+def _simulate(args, module, settings, folder: Path, grid, exact=None):
+    """Run ``module.simulate``, writing fields into ``folder/fields`` if ``--save-fields`` (with the
+    exact solution ``exact(x, t) -> {field: values}`` and the errors beside them); a line on stderr
+    while numba compiles (unless ``--quiet``)."""
     writer = None
     if args.save_fields is not None:
         from mpm_fem.app.fields import FieldWriter
 
-        writer = FieldWriter(folder / "fields", grid, args.save_fields)
-    result = module.simulate(settings, progress=False if args.quiet else None, observer=writer)
+        writer = FieldWriter(folder / "fields", grid, args.save_fields, exact, settings.basis)
+    with compile_notice(not args.quiet):
+        result = module.simulate(settings, progress=False if args.quiet else None, observer=writer)
     if writer is not None:
         writer.close(result.t, result.particles, result.nodal_mass, result.nodal_velocity)
     return result
@@ -223,7 +227,10 @@ def cmd_sod(args) -> dict:
     settings, cost, out = _prepare(args, "sod", sod, sod.SodSettings)
     from mpm_fem.app import plots  # after the checks: matplotlib takes a while to import
     with _publishing(out, args) as folder:
-        result = _simulate(args, sod, settings, folder, sod.uniform_grid(*sod.DOMAIN, settings.h))
+        def exact(x, t):
+            return dict(zip(("density", "velocity", "pressure"), sod.exact(settings, x, t), strict=True))
+
+        result = _simulate(args, sod, settings, folder, sod.uniform_grid(*sod.DOMAIN, settings.h), exact)
         errors = sod.errors(settings, result)
         P = result.particles
         rho, u, p = sod.exact(settings, P.x, result.t)
@@ -252,7 +259,8 @@ def cmd_burgers(args) -> dict:
     from mpm_fem.app import plots  # after the checks: matplotlib takes a while to import
     solution = settings.exact
     with _publishing(out, args) as folder:
-        result = _simulate(args, burgers, settings, folder, burgers.uniform_grid(*solution.domain, settings.h))
+        result = _simulate(args, burgers, settings, folder, burgers.uniform_grid(*solution.domain, settings.h),
+                           lambda x, t: {"velocity": solution.v(x, t)})
         errors = burgers.errors(settings, result)
         P = result.particles
         # Unit density, no energy or pressure: the meaningful columns only.

@@ -12,7 +12,9 @@
 from __future__ import annotations
 
 import argparse
+import difflib
 import os
+import re
 import socket
 import sys
 from urllib.parse import urlsplit
@@ -27,12 +29,52 @@ class UsageError(Exception):
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """An ``argparse`` parser whose usage errors are one line (exit status 2), not the usage text."""
+    """An ``argparse`` parser whose usage errors are one line (exit status 2), not the usage text,
+    ending with the closest valid name to a mistyped option or choice ("did you mean") and the
+    ``--help`` of the (sub)command that refused it."""
 
     def error(self, message: str):
         if "expected one argument" in message:
             message += "; write a negative value as --option=VALUE"
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        help_of = self.prog
+        choice = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)$", message)
+        if choice:
+            close = closest(choice.group(1), re.findall(r"'([^']*)'", choice.group(2)))
+            if close:
+                message += f"; did you mean {close!r}?"
+                sub = self._subcommands().get(close)
+                help_of = sub.prog if sub is not None else help_of
+        self.exit(2, f"{self.prog}: error: {message} (see {help_of} --help)\n")
+
+    def _subcommands(self) -> dict:
+        """The parsers of this parser's subcommands, by name."""
+        actions = [a for a in self._actions if isinstance(a, argparse._SubParsersAction)]
+        return dict(actions[0].choices) if actions else {}
+
+    def parse_args(self, args=None, namespace=None):
+        """As ``argparse``'s, but an unknown option is refused by the subcommand it was given to, with
+        the closest option of that subcommand."""
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            parser = self
+            while True:  # the innermost subcommand chosen
+                subs = parser._subcommands() if isinstance(parser, OneLineParser) else {}
+                chosen = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+                name = getattr(parsed, chosen[0].dest, None) if chosen else None
+                if name not in subs:
+                    break
+                parser = subs[name]
+            message = f"unrecognized arguments: {' '.join(extras)}"
+            unknown = next((e.split("=", 1)[0] for e in extras if e.startswith("-")), None)
+            close = closest(unknown, list(parser._option_string_actions)) if unknown else None
+            parser.error(message + (f"; did you mean {close}?" if close else ""))
+        return parsed
+
+
+def closest(name: str, choices: list[str]) -> str | None:
+    """The choice closest to a mistyped ``name`` (``difflib``'s ratio at least 0.6), or ``None``."""
+    close = difflib.get_close_matches(name, [c for c in choices if c not in ("-h", "--help")], n=1)
+    return close[0] if close else None
 
 
 def available_memory() -> int | None:
@@ -78,9 +120,10 @@ def describe(cost) -> str:
             f"{_size(cost.bytes)}, ~{_duration(cost.seconds)}")
 
 
-def check_cost(cost, yes_long: bool = False, memory: int | None = None) -> None:
+def check_cost(cost, yes_long: bool = False, memory: int | None = None, flag: str = "--yes-long") -> None:
     """Refuse a run over ``MEMORY_SHARE`` of the available memory, or over ``LONG_RUN_S`` unless
-    ``yes_long``. ``memory`` defaults to :func:`available_memory`."""
+    ``yes_long``. ``memory`` defaults to :func:`available_memory`; ``flag`` is how the caller asks
+    for a long run (the option, or the Python keyword ``yes_long=True``)."""
     memory = available_memory() if memory is None else memory
     if memory is not None and cost.bytes > MEMORY_SHARE * memory:
         raise UsageError(f"the run needs about {_size(cost.bytes)} ({_count(cost.particles)} particles, "
@@ -88,7 +131,7 @@ def check_cost(cost, yes_long: bool = False, memory: int | None = None) -> None:
                          f"over the limit of {_size(MEMORY_SHARE * memory)} "
                          f"({MEMORY_SHARE:.0%} of the available memory)")
     if cost.seconds > LONG_RUN_S and not yes_long:
-        raise UsageError(f"{describe(cost)}: over {LONG_RUN_S / 3600:g} h; pass --yes-long to run it")
+        raise UsageError(f"{describe(cost)}: over {LONG_RUN_S / 3600:g} h; pass {flag} to run it")
 
 
 def cap_jobs(jobs: int | None) -> int | None:

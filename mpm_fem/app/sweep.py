@@ -12,7 +12,8 @@ stopped and never reads a half-written result.
 
 Parallelism: ``jobs`` worker processes (``concurrent.futures``), or an existing Dask cluster when
 ``scheduler="tcp://HOST:PORT"`` is given (``dask.distributed``, the optional extra ``[dask]``).
-Progress: a ``tqdm`` bar on a terminal, plain lines otherwise (CI logs).
+Progress: a ``tqdm`` bar on a terminal, plain lines otherwise (CI logs), both with the time left;
+one line when numba starts compiling the kernels (a first run: :mod:`mpm_fem.app.compiling`).
 
 Workers die with their parent: each worker ignores Ctrl-C (the parent handles it and ends them),
 asks Linux to kill it when its parent dies (``prctl(PR_SET_PDEATHSIG)``), and runs a watchdog
@@ -24,6 +25,7 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import json
+import multiprocessing
 import os
 import signal
 import sys
@@ -37,6 +39,7 @@ from typing import Callable
 
 from tqdm.auto import tqdm
 
+from mpm_fem.app.compiling import compile_notice, notice_once
 from mpm_fem.app.output import write_json
 from mpm_fem.measure.version import case_version, code_version
 
@@ -76,8 +79,11 @@ def _watch_parent(parent: int, interval: float = 0.5) -> None:
     os._exit(1)  # the parent is gone: nobody waits for this worker's result
 
 
-def _worker_init(parent: int) -> None:
-    """Runs in each worker process before its first case: see the module docstring."""
+def _worker_init(parent: int, compiling=None) -> None:
+    """Runs in each worker process before its first case: see the module docstring. ``compiling``: the
+    workers' shared flag of the compile line (:func:`mpm_fem.app.compiling.notice_once`), ``None``: no line."""
+    if compiling is not None:
+        notice_once(compiling)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if sys.platform.startswith("linux"):
         try:
@@ -89,12 +95,14 @@ def _worker_init(parent: int) -> None:
     threading.Thread(target=_watch_parent, args=(parent,), daemon=True, name="watch-parent").start()
 
 
-def _run_pool(tasks, todo, jobs: int, finish, followups=()) -> None:
+def _run_pool(tasks, todo, jobs: int, finish, followups=(), notice: bool = False) -> None:
     """The tasks of ``todo`` in ``jobs`` worker processes, started in their order and at most ``jobs + 1``
     at a time, so that a follow-up (a function of no arguments: ``followups``, and what ``finish``
     returns) starts ahead of the tasks still waiting. If the parent is interrupted (Ctrl-C) or fails,
-    the workers are ended at once instead of finishing their cases."""
-    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(),))
+    the workers are ended at once instead of finishing their cases. ``notice``: the first worker to
+    compile a kernel says so in one line."""
+    compiling = multiprocessing.Value("b", 0) if notice else None
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(), compiling))
     waiting, ahead, running = deque(todo), deque(followups), {}
 
     def start() -> None:
@@ -213,14 +221,15 @@ def run_tasks(
             if todo:
                 _run_dask(tasks, todo, scheduler, finish)
         elif pooled and len(todo) + len(followups) > 1:
-            _run_pool(tasks, todo, min(jobs, len(todo) + len(followups)), finish, followups)
+            _run_pool(tasks, todo, min(jobs, len(todo) + len(followups)), finish, followups, notice=reporter.enabled)
         else:
-            for then in followups:
-                then()
-            for k, path in todo:
-                then = finish(k, path, timed(tasks[k].fn, tasks[k].case))
-                if then is not None:
+            with compile_notice(reporter.enabled):
+                for then in followups:
                     then()
+                for k, path in todo:
+                    then = finish(k, path, timed(tasks[k].fn, tasks[k].case))
+                    if then is not None:
+                        then()
     finally:
         reporter.close()
     return results  # type: ignore[return-value]
@@ -253,11 +262,12 @@ PLAIN_EVERY = 60.0
 
 
 class _Progress:
-    """A tqdm bar on a terminal; on other streams a plain line every ~10 % of the cases or every
-    :data:`PLAIN_EVERY` seconds, whichever comes first."""
+    """A tqdm bar on a terminal (elapsed and left); on other streams a plain line every ~10 % of the
+    cases or every :data:`PLAIN_EVERY` seconds, whichever comes first, with the time left at the
+    rate of the cases run so far (:func:`time_left`)."""
 
     def __init__(self, total: int, done: int, desc: str, progress: bool | None):
-        self.total, self.done, self.desc = total, done, desc
+        self.total, self.done, self.desc, self.cached = total, done, desc, done
         self.start = self.last = time.perf_counter()
         tty = sys.stderr.isatty()
         self.enabled = progress if progress is not None else True
@@ -275,9 +285,21 @@ class _Progress:
             now = time.perf_counter()
             if self.done % self.step == 0 or self.done == self.total or now - self.last >= PLAIN_EVERY:
                 self.last = now
-                print(f"[{self.desc}] {self.done}/{self.total} done, {now - self.start:.0f} s", file=sys.stderr,
+                left = time_left(now - self.start, self.done - self.cached, self.total - self.done)
+                print(f"[{self.desc}] {self.done}/{self.total} done, {now - self.start:.0f} s, {left}", file=sys.stderr,
                       flush=True)
 
     def close(self) -> None:
         if self.bar is not None:
             self.bar.close()
+
+
+def time_left(elapsed: float, run: int, left: int) -> str:
+    """``"about N s left"`` for ``left`` cases at the mean time of the ``run`` cases so far (tqdm's
+    estimate; the longest cases start first, so it errs long), ``"done"`` when none is left."""
+    if left <= 0:
+        return "done"
+    seconds = elapsed / run * left if run else float("nan")
+    if seconds != seconds:
+        return "time left unknown"
+    return f"about {seconds:.0f} s left" if seconds < 120 else f"about {seconds / 60:.0f} min left"
