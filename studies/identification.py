@@ -189,9 +189,11 @@ PLOTS = (
          xlabel="rank", ylabel="misfit", split=("source_row",), size=(4.6, 3.8)),
     Plot("burgers.png", "Burgers: each candidate's misfit to the source's rows (mean |log(measured/source)| over the "
          "meshes and the five eps) against its rank; circles the stable dt, triangles dt ~ h",
-         IDENTIFICATION_BURGERS.stem, "rank", (
-             Curve("{solution}, stable dt", "misfit", "o", where={"dt_rule": "stable"}, group=("solution",)),
-             Curve("{solution}, dt ~ h", "misfit", "^", where={"dt_rule": "advective"}, group=("solution",))),
+         IDENTIFICATION_BURGERS.stem, "rank", tuple(
+             Curve(f"{solution}, {name}", "misfit", marker, where={"dt_rule": dt_rule, "solution": solution},
+                   options={"color": colour})
+             for dt_rule, name, marker in (("stable", "stable dt", "o"), ("advective", "dt ~ h", "^"))
+             for solution, colour in zip(SOLUTIONS, ("tab:blue", "tab:orange", "tab:green", "tab:red"), strict=True)),
          xlabel="rank", ylabel="misfit", split=("source_row",), size=(4.6, 3.8)),
 )
 
