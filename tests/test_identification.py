@@ -173,6 +173,13 @@ def test_the_burgers_candidates_share_the_burgers_studys_cases():
     assert {s for _, s, *_ in identification.burgers_candidates("full")} == set(burgers_study.SOLUTIONS)
 
 
+def test_the_deep_plan_holds_every_case_of_the_full_plan_and_more():
+    for study in identification.SWEEPS:
+        full, deep = ({repr(sorted(c.items())) for c in identification.plans(t)[study]["candidates"].values()}
+                      for t in ("full", "deep"))
+        assert full < deep, study
+
+
 @pytest.mark.parametrize("tier, limit_s", [("quick", 5.0), ("full", 12 * 60.0)])
 def test_the_tiers_fit_their_budgets(tier, limit_s, tmp_path):
     """By the Sod and Burgers studies' cost models, every case counted (none cached, none shared)."""
