@@ -173,7 +173,8 @@ def run(options: StudyOptions) -> None:
                                        "layout": "regular"},
              IDENTIFICATION_BURGERS.stem: {"meshes": list(BURGERS_MESHES[tier]), "eps": list(EPS),
                                            "where": BURGERS_WHERE, "other settings": "as in the Burgers study's mpm",
-                                           "raw": "entries marked corrected in source.BURGERS_CORRECTED x 10"}}
+                                           "raw": "the entries of source.BURGERS_CORRECTED with the exponent the slide "
+                                                  "prints (one power of ten up)"}}
     tables = {IDENTIFICATION_SOD: sod_rows(got["sod"], SOD_MESHES[tier]),
               IDENTIFICATION_BURGERS: burgers_rows(got["burgers"], BURGERS_MESHES[tier])}
     publish(options.folder(NAME), tables, settings, extra, PLOTS)
