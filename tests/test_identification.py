@@ -200,12 +200,15 @@ def _count(case: dict) -> dict:
     return {"x": case["x"]}
 
 
-def test_a_task_listed_twice_runs_once_and_ends_both(tmp_path):
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_task_listed_twice_runs_once_and_ends_both(jobs, tmp_path):
+    """Two studies sharing a case in one ``reproduce`` pool: it runs once, and both are told it is in."""
     _CALLS.clear()
     done = []
     tasks = [Task(_count, {"x": 1}, tmp_path), Task(_count, {"x": 2}, tmp_path), Task(_count, {"x": 1}, tmp_path)]
-    results = run_tasks(tasks, jobs=1, progress=False, done=done.append)
-    assert results == [{"x": 1}, {"x": 2}, {"x": 1}] and sorted(_CALLS) == [1, 2] and sorted(done) == [0, 1, 2]
+    results = run_tasks(tasks, jobs=jobs, progress=False, done=done.append)
+    assert results == [{"x": 1}, {"x": 2}, {"x": 1}] and sorted(done) == [0, 1, 2]
+    assert sorted(_CALLS) == ([1, 2] if jobs == 1 else [])  # a pool runs them in its workers
     assert len(list(Path(tmp_path).glob("*.json"))) == 2
 
 
