@@ -27,7 +27,7 @@ step makes a Burgers run cost ~ h^-3). Deep: Sod to h = 0.0003125, Burgers to 0.
 cost about 8 CPU-hours more). Quick: the two coarsest meshes and a few candidates (:data:`QUICK`).
 
 Sizing (the cost models of the Sod and Burgers studies, :mod:`mpm_fem.app.estimate`): the full tier's
-candidates as listed cost about 12 CPU-min, of which about 2 are cases the Sod and Burgers studies run
+candidates as listed cost about 12 CPU-min, of which about 2.5 are cases the Sod and Burgers studies run
 anyway. Trimmed to fit: the stable rule runs at two CFL numbers for the calculated acceleration (0.5,
 the study's, and 1, the largest stable one; dt ~ h^2 makes the time error small, so the CFL moves little)
 and at one (0.5) with 4 and 16 per cell for the exact acceleration, whose dt ~ h rule spans four CFL
