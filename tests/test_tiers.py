@@ -86,7 +86,7 @@ def test_tiers_are_exclusive_on_the_command_line(capsys):
 
 
 def test_every_study_has_a_plan_per_tier():
-    assert set(PLANS) | {"projection"} == set(STUDIES)
+    assert set(PLANS) | {"projection", "identification"} == set(STUDIES)  # identification: PLANS, by study
 
 
 def test_the_estimate_counts_the_cached_cases_and_grows_with_the_tier(tmp_path):
@@ -114,7 +114,7 @@ def test_the_quick_reproduction_leaves_out_the_plateau_studies_and_says_so(tmp_p
     neither (``mpm-fem study NAME --quick`` still does), the full and deep ones run every study."""
     from mpm_fem.app import report, study
 
-    assert study.reproduced("quick") == ("projection", "sod", "burgers", "budget", "time")
+    assert study.reproduced("quick") == ("projection", "sod", "burgers", "identification", "budget", "time")
     assert study.reproduced("full") == study.reproduced("deep") == study.STUDIES
     started = []
     monkeypatch.setattr(study, "run_study", lambda name, options: started.append(name))

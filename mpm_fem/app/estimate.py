@@ -7,7 +7,17 @@ A study opts in by naming three things (module attributes of ``studies/<name>.py
     SECONDS_PER_COST                         CPU seconds per unit of COST, measured on the project's
                                              2-core machine (each study states its measurement)
 
-``CPU seconds = SECONDS_PER_COST * sum(COST(case))`` over the cases not in the cache. On ``J``
+``CPU seconds = SECONDS_PER_COST * sum(COST(case))`` over the cases not in the cache.
+
+A study whose cases are other studies' cases (the identification runs the Sod and Burgers studies'
+case functions, so that a case both run is one cached case) names instead
+
+    SWEEPS                                   {study: its module}, whose run_case, cache, COST and
+                                             SECONDS_PER_COST run and price the cases
+    PLANS(tier) -> {study: {group: {label: case}}}
+
+and a case that study's own PLAN holds at the same tier costs nothing here (it is counted there;
+:func:`mpm_fem.app.sweep.run_tasks` runs a case listed twice once). On ``J``
 workers the wall time is at least the total over ``J`` and at least the largest single case (the
 critical path): :meth:`Estimate.wall`. The estimate is a model fitted to one machine; the progress
 line of each sweep reports the real progress.
@@ -42,6 +52,8 @@ def tasks(name: str, options) -> list[tuple[float, Task]] | None:
     """The cases of study ``name`` at ``options.tier``, once each, as ``(estimated CPU seconds, task)``
     with ``options``' cache; ``None`` if the study does not state its cost model."""
     module = importlib.import_module(f"studies.{name}")
+    if hasattr(module, "SWEEPS"):
+        return _shared_tasks(module, options)
     plan, cost, rate = (getattr(module, a, None) for a in ("PLAN", "COST", "SECONDS_PER_COST"))
     if plan is None or cost is None or rate is None:
         return None
@@ -51,6 +63,26 @@ def tasks(name: str, options) -> list[tuple[float, Task]] | None:
             unique.setdefault(repr(sorted(case.items())), case)
     cache = options.cache_dir(name)
     return [(rate * cost(c), Task(module.run_case, c, cache)) for c in unique.values()]
+
+
+def _key(case: dict) -> str:
+    return repr(sorted(case.items()))
+
+
+def _shared_tasks(module, options) -> list[tuple[float, Task]]:
+    """The tasks of a study that runs other studies' cases (``SWEEPS``, ``PLANS``): see the module docstring."""
+    out = []
+    for study, plan in module.PLANS(options.tier).items():
+        owner = module.SWEEPS[study]
+        owned = {_key(c) for group in owner.PLAN(options.tier).values() for c in group.values()}
+        unique = {}
+        for group in plan.values():
+            for case in group.values():
+                unique.setdefault(_key(case), case)
+        cache = options.cache_dir(study)
+        out += [(0.0 if k in owned else owner.SECONDS_PER_COST * owner.COST(c), Task(owner.run_case, c, cache))
+                for k, c in unique.items()]
+    return out
 
 
 def estimate(name: str, options) -> Estimate | None:

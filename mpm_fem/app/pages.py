@@ -128,6 +128,21 @@ PAGES = (
              View("burgers/diagnosis", "The calculated acceleration with one change at a time (regular layout)",
                   ("variant", "h", f"{_WHERE}_L1", "order_L1"), {}, "diagnosis.png"),
          )),
+    Page("identification", "The source's unstated settings, identified from its own tables",
+         "For each of the source's tables, every candidate for what the slides leave unsaid runs on the table's "
+         "meshes, one setting held fixed over the whole table; its misfit is the mean absolute log ratio of its error "
+         "to the source's entry (for Burgers over the meshes and the five eps), against the corrected table and, "
+         "beside it, the printed one. The rows shown are the source-matching settings: the least misfit of each "
+         "source row and every candidate within the rule book's band of it.",
+         views=(
+             View("identification/sod", "Sod: the source-matching settings of the L1 and L2 columns",
+                  ("source_row", "rank", "ppc", "cfl", "quantity", "norm", "misfit", "misfit_raw", "meshes"),
+                  {"matching": "True"}, "sod.png"),
+             View("identification/burgers", "Burgers: the source-matching settings of the exact- and the "
+                  "calculated-acceleration rows", ("source_row", "rank", "solution", "dt_rule", "cfl", "ppc", "norm",
+                                                  "misfit", "misfit_raw", "meshes"),
+                  {"matching": "True"}, "burgers.png"),
+         )),
     Page("budget", "Error budget (E1) and bases (E2)",
          "Every combination of the four stages in MPM or exact form, on each mesh and basis: the error of each "
          "combination, its exact decomposition into each stage's Shapley value (main effect plus an equal share of "

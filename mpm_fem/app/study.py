@@ -183,7 +183,7 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
 
 #: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
 #: layer and import it, never the other way round).
-STUDIES = ("projection", "sod", "burgers", "budget", "time", "remedies", "drift")
+STUDIES = ("projection", "sod", "burgers", "identification", "budget", "time", "remedies", "drift")
 #: The studies the quick reproduction leaves out: their questions (E5, and the mechanism of C11) are
 #: about the plateau of Sod's particle error, which appears only below the quick tier's meshes (C11
 #: itself is not measured there). ``mpm-fem study NAME --quick`` still runs them.

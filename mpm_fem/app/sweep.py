@@ -34,6 +34,7 @@ import time
 from collections import deque
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Callable
 
@@ -172,8 +173,10 @@ def run_tasks(
     done: Callable[[int], Callable[[], object] | None] | None = None,
 ) -> list[dict]:
     """``[t.fn(t.case) for t in tasks]``, in parallel, each cached in its task's folder; results in the
-    order of ``tasks``, which is also the order they start in. Tasks of several functions (several
-    studies) share one pool, so no worker idles at the end of one study while another has cases left.
+    order of ``tasks``, which is also the order they start in; a task listed twice (the same function and
+    case into the same cache folder: two studies sharing a case) runs once and fills both. Tasks of
+    several functions (several studies) share one pool, so no worker idles at the end of one study
+    while another has cases left.
     ``done(k)`` is called in this process once task ``k``'s result is in (cached ones first), while the
     workers go on with the others. It may return a follow-up, a picklable function of no arguments
     (a study's tables and figures once its last case is in): a worker of the pool runs it ahead of the
@@ -185,13 +188,17 @@ def run_tasks(
     for folder in {Path(t.cache_dir) for t in tasks if t.cache_dir is not None}:
         folder.mkdir(parents=True, exist_ok=True)
     results: list[dict | None] = [None] * len(tasks)
-    todo = []
+    todo, first, twins = [], {}, {}  # a case listed twice (same cache file) runs once, for both
     for k, task in enumerate(tasks):
         path = task.path
         cached = _load(path) if path is not None and path.exists() else None
         if cached is not None:
             results[k] = cached
+        elif path is not None and path in first:
+            twins.setdefault(first[path], []).append(k)
         else:
+            if path is not None:
+                first[path] = k
             todo.append((k, path))
     pooled = scheduler is None and jobs > 1
     reporter = _Progress(len(tasks), len(tasks) - len(todo), desc, progress)
@@ -204,17 +211,21 @@ def run_tasks(
             return None
         return then
 
-    running = {k for k, _ in todo}
+    running = {k for k, _ in todo} | {j for js in twins.values() for j in js}
     followups = [f for f in (follow(k) for k in range(len(tasks)) if k not in running) if f is not None]
 
     def finish(k: int, path: Path | None, run: tuple[dict, float, float]):
         result, cpu_s, wall_s = run
-        results[k] = result
         if path is not None:
             write_json(path, {"case": tasks[k].case, "case_code": fn_version(tasks[k].fn), "code": code_version(),
                               "cpu_s": round(cpu_s, 3), "wall_s": round(wall_s, 3), "result": result})
-        reporter.update(tasks[k].case)
-        return follow(k)
+        thens = []
+        for j in (k, *twins.get(k, ())):
+            results[j] = result
+            reporter.update(tasks[j].case)
+            thens.append(follow(j))
+        thens = tuple(t for t in thens if t is not None)
+        return None if not thens else thens[0] if len(thens) == 1 else partial(_run_all, thens)
 
     try:
         if scheduler is not None:
@@ -233,6 +244,12 @@ def run_tasks(
     finally:
         reporter.close()
     return results  # type: ignore[return-value]
+
+
+def _run_all(functions) -> None:
+    """Call each of ``functions`` (follow-ups due at once: a case listed twice ended two studies)."""
+    for f in functions:
+        f()
 
 
 def _run_dask(tasks, todo, scheduler, finish) -> None:

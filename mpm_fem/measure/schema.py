@@ -179,6 +179,17 @@ DRIFT = Table("drift/drift", (
     "h", "variant", "layout", "seed", "change", "kernel", "ok", "particles_L1", "nodes_L1", "volume_drift",
     "abs_volume_drift", "particles_vs_study", "order_particles_L1", "order_nodes_L1", "steps"), optional=("error",))
 
+# ----------------------------------------------------------------------------- identification (issue 42, A)
+
+#: One row per candidate setting (held fixed over the whole source table) and source row: the misfit
+#: (mean |log(measured/source)|) against the corrected and the raw table, over ``meshes`` (and for
+#: Burgers the five eps), the ``rank`` within the source row and ``matching`` (within the band).
+_IDENTIFIED = ("source_row", "misfit", "misfit_raw", "meshes", "rank", "matching")
+IDENTIFICATION_SOD = Table("identification/sod", ("problem", "candidate", "ppc", "cfl", "quantity", "norm",
+                                                  *_IDENTIFIED))
+IDENTIFICATION_BURGERS = Table("identification/burgers", ("problem", "candidate", "solution", "dt_rule", "cfl", "ppc",
+                                                          "norm", *_IDENTIFIED))
+
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
 VERSIONS = Table("versions", ("table", "code", "quick"))
@@ -192,7 +203,8 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     TIME_ORDER, TIME_LOCAL_ERROR, TIME_CROSSING_SUMMARY,
     BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,
     REMEDIES_ERRORS,
-    DRIFT)}
+    DRIFT,
+    IDENTIFICATION_SOD, IDENTIFICATION_BURGERS)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}
 

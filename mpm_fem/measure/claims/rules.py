@@ -52,3 +52,17 @@ def rule(name: str) -> float:
         return RULES[name].value
     except KeyError:
         raise KeyError(f"no rule {name!r} in the rule book; rules: {', '.join(RULES)}") from None
+
+
+# ----------------------------------------------------------------------------- identification (issue 42, A)
+
+_add("IDENTIFICATION_BAND", 0.05,
+     "a candidate setting matches the source when its misfit (mean |log(measured/source)| over the source's "
+     "table) is at most this much above the least misfit of the same source row",
+     "the study's (the slides state no tolerance): 0.05 in the mean log is about 5 % in the mean factor, taken as "
+     "too small a difference to prefer one unstated setting over another", ("C11", "C13"))
+_add("IDENTIFICATION_REPRODUCED", 0.1,
+     "the source's table is reproduced by a candidate whose misfit is at most this (a mean factor within about "
+     "10 %)",
+     "the study's (the slides state no tolerance): the goal is the source's behaviour, not its digits; a mean "
+     "factor within 10 % is read as the same table", ("C11", "C13"))
