@@ -175,20 +175,12 @@ def _candidate(row: dict) -> str:
 
 
 def identification_sentence(tables: Tables) -> str:
-    """Where the source's tables are reproduced: the identification module's own sentence
-    (``identification.sentence(tables, problem)``) when it has one, else the best source-matching
-    candidate of each problem; "" without the identification tables."""
-    own = getattr(identification, "sentence", None)
-    parts = []
-    for problem in identification.IDENTIFICATION:
-        if not tables.get(identification.IDENTIFICATION[problem]):
-            continue
-        if callable(own):
-            parts.append(own(tables, problem).strip().rstrip("."))
-            continue
-        best = identification.source_matching(tables, problem)
-        if best:
-            parts.append(f"the source's {problem.capitalize()} table is matched best by {_candidate(best[0])}")
+    """Where the source's tables are reproduced: the identification module's sentence of each problem
+    (:func:`mpm_fem.measure.claims.identification.identification_sentence`); "" without the
+    identification tables."""
+    parts = [identification.identification_sentence(tables, problem).strip().rstrip(".")
+             for problem in identification.IDENTIFICATION if tables.get(identification.IDENTIFICATION[problem])]
+    parts = [p for p in parts if p]
     if not parts:
         return ""
     joined = "; ".join(p if k == 0 or p[1:2].isupper() else p[0].lower() + p[1:] for k, p in enumerate(parts))
