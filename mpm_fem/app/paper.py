@@ -166,14 +166,6 @@ def seeds_text(tables: Tables) -> str:
 
 # ----------------------------------------------------------------------------- the source-matching settings
 
-def _candidate(row: dict) -> str:
-    """A candidate of the identification table in words: its settings, then its misfit."""
-    skip = {"source_row", "rank", "matching", "problem"}
-    settings = ", ".join(f"{k} {v}" for k, v in row.items() if k not in skip and not k.startswith("misfit") and v)
-    misfit = next((f"misfit {num(row, k):.3g}" for k in row if k.startswith("misfit") and row[k] != ""), "")
-    return settings + (f" ({misfit})" if misfit else "")
-
-
 def identification_sentence(tables: Tables) -> str:
     """Where the source's tables are reproduced: the identification module's sentence of each problem
     (:func:`mpm_fem.measure.claims.identification.identification_sentence`); "" without the
