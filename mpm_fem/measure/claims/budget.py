@@ -8,6 +8,7 @@ import math
 
 from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Tables, claim
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
+from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.decomposition import decompose
 from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF, BUDGET_SUBSETS
 
@@ -17,7 +18,7 @@ SUBSETS = BUDGET_SUBSETS.name
 STEP_ORDER = ("projection", "mass", "interpolation", "time")
 #: E1 (a): the stages separate when their interactions (the Moebius terms of two stages or more), in
 #: total magnitude, are at most SEPARATE of |v(all MPM) - v(all exact)|.
-SEPARATE = 0.25
+SEPARATE = rule("SEPARATE")
 #: E1 (b): the attributions that must name the same largest stage for it to dominate: the Shapley
 #: value, and the error removed by each stage when the stages are made exact one after another from
 #: all MPM, in the step's order and in its reverse.

@@ -4,12 +4,13 @@ errors (``projection/orders``, ``projection/bounds``, ``projection/d2_constant``
 from __future__ import annotations
 
 from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Tables, claim
-from mpm_fem.measure.claims.rows import count_verdict, num, select, span
+from mpm_fem.measure.claims.rows import ORDER_TOLERANCE, count_verdict, in_band, num, select, span
 from mpm_fem.measure.schema import PROJECTION_BOUNDS, PROJECTION_D2_CONSTANT, PROJECTION_ORDERS
 from mpm_fem.measure.source import D2_C, PROJECTION_BANDS, band_text
 
-#: Least-squares orders within this distance of a band count as inside (sampling noise of the fit).
-BAND_TOLERANCE = 0.1
+#: Least-squares orders within this distance of a band count as inside: the rule book's one tolerance
+#: of an order (ORDER_TOLERANCE, shared with C1 and C13).
+BAND_TOLERANCE = ORDER_TOLERANCE
 #: The layouts a band is judged on: seeded particles and particles moved by a run, with the slides'
 #: weights h/N_p^i and the point-mass basis. Regular midpoints are reported beside, not judged.
 JUDGED_LAYOUTS = ("jittered", "random", "advected")
@@ -34,7 +35,7 @@ def _inside(t: Tables, quantity: str) -> tuple[int, int]:
             ref = select(t[ORDERS], quantity=band, layout=r["layout"], N_p=r["N_p"], **_SHOWN)
             ok = bool(ref) and abs(order - num(ref[0], "order")) <= BAND_TOLERANCE
         else:
-            ok = band[0] - BAND_TOLERANCE <= order <= band[1] + BAND_TOLERANCE
+            ok = in_band(order, band[0], band[1])
         hits, total = hits + ok, total + 1
     return hits, total
 

@@ -7,6 +7,7 @@ import math
 
 from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Tables, claim
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
+from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import BUDGET_SHAPLEY, REMEDIES_ERRORS, SETTINGS
 from mpm_fem.measure.tables import setting
 
@@ -18,12 +19,12 @@ REMEDY_ERRORS = REMEDIES_ERRORS.name
 ORDER_MARGIN = CONVERGING_ORDER - FLOOR_ORDER
 #: E5 on Sod: the error stays within a constant factor of the FV's when its ratio to the FV error at the
 #: finest mesh is at most FV_DRIFT times the ratio at the coarsest.
-FV_DRIFT = 1.5
+FV_DRIFT = rule("FV_DRIFT")
 #: The thresholds of :func:`remedy_assessment`'s ``removes_plateau``, as the remedies study records them.
 PLATEAU_CRITERION = {"order_margin_to_fv": ORDER_MARGIN, "floor_order": FLOOR_ORDER, "fv_drift": FV_DRIFT,
                      "converging_order_without_fv": CONVERGING_ORDER}
-FV_FACTOR = 1.5  # the goal on Sod: within this factor of the finite-volume error at every h
-BURGERS_ORDER = 1.0  # the goal on Burgers (4 per cell): fitted order >= this, nodes and particles
+FV_FACTOR = rule("FV_FACTOR")  # the goal on Sod: within this factor of the finite-volume error at every h
+BURGERS_ORDER = rule("BURGERS_ORDER")  # the goal on Burgers (4 per cell): fitted order >= this, nodes and particles
 REMEDY_MEASURES = ("nodes_L1", "particles_L1")
 
 

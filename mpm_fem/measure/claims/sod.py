@@ -13,10 +13,14 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Tables, claim
+from mpm_fem.measure.claims import shape
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Finding, Tables, claim
 from mpm_fem.measure.claims.drift import mechanism
+from mpm_fem.measure.claims.identification import source_matching
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
+from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, lumping_claim, ppc_claim
+from mpm_fem.measure.regions import REGION_NAMES
 from mpm_fem.measure.schema import (
     DRIFT,
     SOD_CONVERGENCE,
@@ -34,19 +38,22 @@ CONVERGENCE, SEEDS = SOD_CONVERGENCE.name, SOD_SEEDS.name
 #: C11, E3: an order or a ratio is judged only over at least MIN_RUNS runs on each mesh (the regular
 #: layout and five jittered ones), and C11 needs FLOOR_MESHES such meshes; its trend is read from the
 #: orders between the last FLOOR_STEPS + 1 of them.
-MIN_RUNS, FLOOR_MESHES, FLOOR_STEPS = 6, 5, 2
+MIN_RUNS, FLOOR_MESHES, FLOOR_STEPS = (int(rule(k)) for k in ("MIN_RUNS", "FLOOR_MESHES", "FLOOR_STEPS"))
 #: C11: the errors judged (the slides: "the overall error at particles as density, energy") and the
 #: one shown beside them (the nodal density, which the source's table follows).
 C11_JUDGED = {"particle density": "particles_L1", "particle energy": "energy_L1"}
 C11_BESIDE = {"nodal density": "nodes_L1"}
-#: C12: the waves (regions 1, 3, 4, 6) carry at least WAVE_SHARE of the nodal L1 error.
-WAVE_REGIONS, WAVE_SHARE = (1, 3, 4, 6), 0.5
+#: C12: the waves (the rarefaction's edges, the contact, the shock front, by their region numbers) carry
+#: at least WAVE_SHARE of the nodal L1 error.
+WAVE_NAMES = ("rarefaction head", "rarefaction tail", "contact", "shock front")
+WAVE_REGIONS = tuple(REGION_NAMES.index(name) for name in WAVE_NAMES)
+WAVE_SHARE = rule("WAVE_SHARE")
 #: C14: a crossing particle becomes a new extremum at least EXTREMA_RATIO times as often as a moving
 #: particle that does not cross (``moving_ratio``: its definition of moving is recorded with the table).
-EXTREMA_RATIO = 2.0
+EXTREMA_RATIO = rule("EXTREMA_RATIO")
 #: E3: MPM's error over the fixed-mesh FEM's (lumped mass, as MPM's) on the finest mesh within E3_FACTOR
 #: of that ratio on the coarsest, at the nodes and at the particles.
-E3_FACTOR = 1.5
+E3_FACTOR = rule("E3_FACTOR")
 E3_WHERE = {"particles": "particles_L1", "nodes": "nodes_L1"}
 #: E3: the methods whose density L1 the evidence names on the finest mesh.
 SIDE_BY_SIDE = {"MPM nodes": "mpm_nodes_L1", "FEM consistent": "fem_consistent_L1", "FEM lumped": "fem_lumped_L1",
@@ -99,72 +106,132 @@ def _judged_orders(rows: list[dict], key: str) -> list[tuple]:
     return [(a, b, o) for a, b, o in order_spreads(kept, key) if o.n >= MIN_RUNS]
 
 
-def trend(orders: list[Spread]) -> str:
-    """What the last FLOOR_STEPS orders say, each counted only when its range over the seeds lies on
-    one side: ``diverges`` (every one below 0: the error grows), ``stops converging`` (every one below
-    FLOOR_ORDER, not all below 0), ``converges`` (every one at least CONVERGING_ORDER), else ``undecided``."""
-    tail = orders[-FLOOR_STEPS:]
-    if all(o.below(0.0) for o in tail):
-        return "diverges"
-    if all(o.below(FLOOR_ORDER) for o in tail):
-        return "stops converging"
-    return "converges" if all(o.above(CONVERGING_ORDER) for o in tail) else "undecided"
+def _c11_setting(rows: list[dict], n: int, cfl: float) -> tuple[str, str, dict]:
+    """C11 on one setting: the shape of every quantity (:mod:`.shape`), the size of the particle density at
+    the coarsest mesh, the verdict and one row of the Finding's table."""
+    orders = {name: _judged_orders(rows, key) for name, key in {**C11_JUDGED, **C11_BESIDE}.items()}
+    meshes = len(orders["particle density"]) + 1
+    row = {"setting": _label(n, cfl)}
+    if meshes < FLOOR_MESHES:
+        row["verdict"] = "not measured"
+        return "not measured", f"{meshes} meshes with {MIN_RUNS} runs, the shape needs {FLOOR_MESHES}", row
+    shapes = {name: shape.shape([o for _, _, o in found]) for name, found in orders.items()}
+    h, ratio = shape.size(rows, C11_JUDGED["particle density"], 0)
+    judged = [shapes[name] for name in C11_JUDGED]
+    levels = all(s == shape.LEVELS for s in judged)
+    verdict = (DIFFERS if shape.GROWS in judged or all(s == shape.STALLS for s in judged)
+               else CONFIRMED if levels and shape.same_size(ratio)
+               else REFUTED if all(s == shape.CONVERGES for s in judged) else PARTLY)
+    for name, found in orders.items():
+        row[name] = shape.shape_text(shapes[name], found)
+    row[f"particle density / source at h = {h:g}"] = ratio.text()
+    row["verdict"] = verdict
+    text = ", ".join(f"{name} {shape.shape_text(shapes[name], found)} [ranges {_orders_text(found)}]"
+                     for name, found in orders.items())
+    return verdict, text + f", particle density / source at h = {h:g} {ratio.text()}", row
 
 
 def _orders_text(orders: list[tuple]) -> str:
     return ", ".join(o.text() for _, _, o in orders)
 
 
-def _trends(rows: list[dict]) -> dict[str, tuple[str, list]]:
-    """``{error: (trend, orders)}`` of the judged errors and the one beside them, over the seeds."""
-    found = {name: _judged_orders(rows, key) for name, key in {**C11_JUDGED, **C11_BESIDE}.items()}
-    return {name: (trend([o for _, _, o in orders]), orders) for name, orders in found.items()}
+def _matching(t: Tables) -> tuple[dict, str]:
+    """The source-matching settings of Sod, ``{(ppc, cfl): "nodes L1, rank 1"}``, and where they come
+    from: the identification table (``source_matching``), or, without it, the setting and density of
+    the convergence table with the smallest mean |log(measured / source)| (said so)."""
+    found = {}
+    for r in source_matching(t, "sod"):
+        found.setdefault((int(num(r, "ppc")), num(r, "cfl")), f"{r['quantity']} {r['norm']}, rank {r['rank']}")
+    if found:
+        return found, "the identification table"
+    rows, best = t.get(CONVERGENCE, []), None
+    for n, cfl in _settings(rows):
+        for q in ("nodes", "particles"):
+            for norm in ("L1", "L2"):
+                m = shape.misfit(select(rows, ppc=n, cfl=cfl), f"ratio_{q}_{norm}")
+                if math.isfinite(m) and (best is None or m < best[0]):
+                    best = (m, (n, cfl), f"{q} {norm}, closest in {CONVERGENCE}")
+    if best is None:
+        return {}, "no identification table and no ratio to the source"
+    return {best[1]: best[2]}, (f"no identification table: the closest setting of the study's "
+                                f"({CONVERGENCE}, mean |log ratio| {best[0]:.2f})")
 
 
-def _c11_setting(rows: list[dict], n: int, cfl: float, convergence: list[dict]) -> tuple[str, str]:
-    trends = _trends(rows)
-    meshes = len(trends["particle density"][1]) + 1
-    if meshes < FLOOR_MESHES:
-        return "not measured", f"{meshes} meshes with {MIN_RUNS} runs, the trend needs {FLOOR_MESHES}"
-    judged = [trends[name][0] for name in C11_JUDGED]
-    verdict = (CONFIRMED if all(t in ("diverges", "stops converging") for t in judged)
-               else REFUTED if all(t == "converges" for t in judged) else PARTLY)
-    text = ", ".join(f"{name} {found} (orders {_orders_text(orders)})" for name, (found, orders) in trends.items())
-    compared = [r for r in select(convergence, ppc=n, cfl=cfl) if r.get("ratio_nodes_L1", "") != ""][-1:]
-    if compared:
-        text += f", regular nodal L1 / source {num(compared[0], 'ratio_nodes_L1'):.2f} at h = {compared[0]['h']}"
-    return verdict, text
+def _reproduction(t: Tables, matching: dict) -> str:
+    """How closely the best source-matching setting of the convergence table reproduces the source: the
+    span of its measured/source ratios over the meshes."""
+    for (n, cfl), what in matching.items():
+        quantity, norm = what.split(",")[0].split()
+        rows = select(t.get(CONVERGENCE, []), ppc=n, cfl=cfl)
+        ratios = [num(r, f"ratio_{quantity}_{norm}") for r in rows]
+        ratios = [x for x in ratios if math.isfinite(x)]
+        if ratios:
+            where = "nodal" if quantity == "nodes" else "particle"
+            return (f"at {n} per cell and CFL {cfl:g} the {where} density {norm} is {span(ratios)} times the "
+                    f"source's on {len(ratios)} meshes")
+    return ""
 
 
-@claim("C11", source=f"density L1 {SOD[0.01][0]:.3g} at h = 0.01 levelling at {SOD[0.0003125][0]:.3g}; "
-                     "the error at particles (density, energy) stops converging as h shrinks",
+def _c11_sentence(rows: list[dict], verdicts: dict, reproduction: str) -> str:
+    """The plain sentence: what the particle density does at the source's particles per cell, with its
+    mean orders from where it departs, and where the source's table is reproduced."""
+    prescribed = [k for k in verdicts if _prescribed(k[0]) and verdicts[k] != "not measured"]
+    shapes, tails = {}, []
+    for k in prescribed:
+        found = _judged_orders(select(rows, ppc=k[0], cfl=k[1]), C11_JUDGED["particle density"])
+        shapes[k] = shape.shape([o for _, _, o in found])
+        start = shape.growth_start(found)
+        tails += [o for h1, _, o in found if shapes[k] != shape.GROWS or h1 <= start]
+    if not prescribed:
+        return reproduction
+    ppcs = "-".join(map(str, sorted({k[0] for k in prescribed})))
+    kinds = set(shapes.values())
+    what = {shape.GROWS: "grows under refinement", shape.LEVELS: "converges, then levels off",
+            shape.STALLS: "stalls from the coarsest mesh", shape.CONVERGES: "keeps converging"}
+    does = what.get(kinds.pop(), "changes order undecidedly") if len(kinds) == 1 else "behaves differently by setting"
+    mean = [o.mean for o in tails]
+    text = (f"at {ppcs} particles per cell the particle density error {does} (mean orders "
+            f"{max(mean):.2f} to {min(mean):.2f})")
+    return text + (f"; {reproduction}" if reproduction else "")
+
+
+@claim("C11", source=f"density L1 {SOD[max(SOD)][0]:.3g} at h = {max(SOD):g}, orders near 0.9 before it levels at "
+                     f"{SOD[min(SOD)][0]:.3g}; the error at particles (density, energy) stops converging as h shrinks",
        tables=(SEEDS, CONVERGENCE), study="sod",
-       thresholds=f"per setting, over the regular and the jittered layouts (orders paired by seed, judged between "
-                  f"meshes with at least {MIN_RUNS} runs, at least {FLOOR_MESHES} meshes): the last {FLOOR_STEPS} "
-                  f"orders of the particle density L1 and of the particle energy L1 each below {FLOOR_ORDER} over "
-                  f"every seed -> confirmed, saying 'diverges' when they are below 0 over every seed and 'stops "
-                  f"converging' otherwise; both at least {CONVERGING_ORDER} over every seed -> refuted; else "
-                  f"(an order whose range straddles a threshold, or the two disagree) -> partly; the nodal density "
-                  f"beside it, not judged. Headline: the settings with {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} particles "
-                  "per cell, their common verdict, partly when they differ")
-def _c11(t: Tables) -> tuple[str, str]:
+       thresholds=f"per setting and quantity, over the regular and the jittered layouts (orders paired by seed, "
+                  f"judged between meshes with at least {MIN_RUNS} runs, at least {FLOOR_MESHES} meshes), the "
+                  f"source's shape: the first order at least {CONVERGING_ORDER} and the last {FLOOR_STEPS} below "
+                  f"{FLOOR_ORDER} over every seed, not all below 0 (levels off). The particle density and energy "
+                  f"both level off with the density within {shape.SAME_SIZE:g}x the source's at the coarsest mesh -> "
+                  f"confirmed; a judged error whose orders are below 0 over every seed from some refinement on "
+                  "(grows: a divergence, not a plateau) or that never converges -> differs; both keep converging "
+                  f"-> refuted; else partly; the nodal density beside, not judged. Headline: the settings with "
+                  f"{OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} particles per cell, their common verdict, partly when they "
+                  "differ; the source-matching setting (identification) in its own column")
+def _c11(t: Tables) -> Finding:
     """The orders are paired by seed: each run of a layout on one mesh with the run of the same seed on
     the next mesh, the regular layout being seed 0; the range over seeds holds the order of every layout.
-    The mechanism of the growth is the drift study's finding, quoted from its table (not judged here)."""
+    A plateau and a growing error are different behaviours: only the first is the source's. The
+    mechanism of the growth is the drift study's finding, quoted from its table (not judged here)."""
     rows = t[SEEDS]
-    verdicts, lines = _per_setting(_c11_setting, rows, t[CONVERGENCE])
-    density = [f"{_density_trend(rows, k, verdicts[k])} ({k[0]} ppc at CFL {k[1]:g})" for k in verdicts
-               if _prescribed(k[0])]
-    return headline(verdicts), (f"particle density at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell: "
-                                + ", ".join(density) + "; " + _settings_text(verdicts, lines)
-                                + f". Mechanism ({DRIFT.name}): {mechanism(t)}")
-
-
-def _density_trend(rows: list[dict], ppc_cfl: tuple, verdict: str) -> str:
-    """The particle density's trend for one setting (``not measured`` when its verdict is)."""
-    if verdict == "not measured":
-        return verdict
-    return _trends(select(rows, ppc=ppc_cfl[0], cfl=ppc_cfl[1]))["particle density"][0]
+    verdicts, lines, table = {}, {}, []
+    for n, cfl in _settings(rows):
+        verdicts[(n, cfl)], lines[(n, cfl)], row = _c11_setting(select(rows, ppc=n, cfl=cfl), n, cfl)
+        table.append(row)
+    matching, whence = _matching(t)
+    for row, k in zip(table, verdicts, strict=True):
+        row["source-matching"] = matching.get(k, "")
+    table += [{"setting": _label(*k), "verdict": "not run in sod/seeds", "source-matching": v}
+              for k, v in matching.items() if k not in verdicts]
+    reproduction = _reproduction(t, matching)
+    density = [f"{v} ({k[0]} ppc at CFL {k[1]:g})" for k, v in verdicts.items() if _prescribed(k[0])]
+    evidence = (f"particle density at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell: "
+                + ", ".join(density) + "; " + _settings_text(verdicts, lines)
+                + f"; source-matching settings from {whence}: "
+                + (", ".join(f"{_label(*k)} ({v})" for k, v in matching.items()) or "none")
+                + (f"; {reproduction}" if reproduction else "")
+                + f". Mechanism ({DRIFT.name}): {mechanism(t)}")
+    return Finding(headline(verdicts), evidence, _c11_sentence(rows, verdicts, reproduction), tuple(table))
 
 
 @claim("C12", source="regions 1 and 3 rarefaction edges, 4 contact, 6 shock front, 2 smooth, 5 behind the shock",
@@ -186,7 +253,7 @@ def _c12(t: Tables) -> tuple[str, str]:
 
 def _c12_setting(rows: list[dict], n: int, cfl: float) -> tuple[str, str]:
     waves = [sum(num(r, f"share_{k}") for k in WAVE_REGIONS) for r in rows]
-    smooth = [num(r, "share_2") for r in rows]
+    smooth = [num(r, f"share_{REGION_NAMES.index('smooth')}") for r in rows]
     hits = sum(w >= WAVE_SHARE for w in waves)
     return count_verdict(hits, len(rows), DIFFERS), (
         f"waves carry {waves[-1]:.0%} of the nodal L1 at h = {rows[-1]['h']} ({waves[0]:.0%} at h = {rows[0]['h']}), "

@@ -4,15 +4,18 @@ node crossing), from ``time/*``."""
 from __future__ import annotations
 
 from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Tables, claim
-from mpm_fem.measure.claims.rows import count_verdict, num, select, span
+from mpm_fem.measure.claims.rows import ORDER_TOLERANCE, count_verdict, num, select, span
+from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import TIME_CROSSING_SUMMARY, TIME_LOCAL_ERROR, TIME_ORDER
 
-#: C1: least-squares orders in dt inside these bands count as first (global) and second (local) order.
-GLOBAL_ORDER, LOCAL_ORDER = (0.8, 1.2), (1.8, 2.2)
+#: C1: least-squares orders in dt inside these bands count as first (global) and second (local) order: the
+#: stated order +- the rule book's one tolerance of an order (ORDER_TOLERANCE, shared with C5-C10 and C13).
+GLOBAL_ORDER = (1 - ORDER_TOLERANCE, 1 + ORDER_TOLERANCE)
+LOCAL_ORDER = (GLOBAL_ORDER[0] + 1, GLOBAL_ORDER[1] + 1)
 #: C2: P1 with the exact nodal acceleration matches the formula when every crossing's measured/predicted
 #: ratio is within CROSSING_TOLERANCE of one; a C1 basis has no jump when |measured| stays below
 #: NO_JUMP x the P1 formula at every crossing.
-CROSSING_TOLERANCE, NO_JUMP = 0.1, 0.1
+CROSSING_TOLERANCE, NO_JUMP = rule("CROSSING_TOLERANCE"), rule("NO_JUMP")
 
 
 @claim("C1", source="local error O(dt^2), global O(dt)", tables=(TIME_ORDER.name, TIME_LOCAL_ERROR.name),
