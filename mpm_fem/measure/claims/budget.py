@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Tables, claim
-from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Finding, Tables, claim
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.decomposition import decompose
 from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF, BUDGET_SUBSETS
@@ -19,6 +19,8 @@ STEP_ORDER = ("projection", "mass", "interpolation", "time")
 #: E1 (a): the stages separate when their interactions (the Moebius terms of two stages or more), in
 #: total magnitude, are at most SEPARATE of |v(all MPM) - v(all exact)|.
 SEPARATE = rule("SEPARATE")
+#: E1 (b): no stage is named dominant where the interactions exceed ATTRIBUTABLE times the gap.
+ATTRIBUTABLE = rule("ATTRIBUTABLE")
 #: E1 (b): the attributions that must name the same largest stage for it to dominate: the Shapley
 #: value, and the error removed by each stage when the stages are made exact one after another from
 #: all MPM, in the step's order and in its reverse.
@@ -46,7 +48,8 @@ def stage_findings(rows: list[dict]) -> dict | None:
     """E1's two questions on the ``budget/subsets`` rows of one (problem, h, basis, norm): the
     interactions' total magnitude over |v(all MPM) - v(all exact)| (``interactions``), whether the
     stages separate, the largest stage by each attribution (``tops``: Shapley, forward, backward),
-    the dominant stage when they agree (else None), the largest main effect (``alone``: stage,
+    the dominant stage when they agree and the interactions are at most ATTRIBUTABLE times the gap
+    (else None), the largest main effect (``alone``: stage,
     m({s})) and the end points; None when a subset of STEP_ORDER is missing."""
     v = {_subset(r["mpm_stages"]): num(r, "error") for r in rows}
     try:
@@ -60,8 +63,9 @@ def stage_findings(rows: list[dict]) -> dict | None:
         removed = sequential(v, order)
         tops[name] = max(order, key=lambda s: removed[s])
     alone = max(STEP_ORDER, key=lambda s: abs(d.moebius[frozenset({s})]))
+    agree = len(set(tops.values())) == 1 and ratio <= ATTRIBUTABLE
     return {"interactions": ratio, "separate": ratio <= SEPARATE, "tops": tops,
-            "dominant": tops["Shapley"] if len(set(tops.values())) == 1 else None,
+            "dominant": tops["Shapley"] if agree else None,
             "alone": (alone, d.moebius[frozenset({alone})]), "mpm": d.total, "exact": d.floor}
 
 
@@ -92,8 +96,12 @@ def _e1_text(found: dict) -> str:
         by_stage.setdefault(s, []).append(names[k])
     head += (f"; a dominant stage in {len(dominant)} of {n}: "
              + ("; ".join(f"{s} ({', '.join(ks)})" for s, ks in by_stage.items()) if dominant else "none"))
+    tangled = [names[k] for k, (_, f) in finest.items() if f["interactions"] > ATTRIBUTABLE]
     undecided = [f"{names[k]} (" + ", ".join(f"{a} {s}" for a, s in f["tops"].items()) + ")"
-                 for k, (_, f) in finest.items() if not f["dominant"]]
+                 for k, (_, f) in finest.items() if not f["dominant"] and names[k] not in tangled]
+    if tangled:
+        head += (f"; no stage named where the interactions exceed {ATTRIBUTABLE:g}x the gap: "
+                 + ", ".join(tangled))
     if undecided:
         head += "; the attributions disagree for " + ", ".join(undecided)
     (k0, (h0, f0)) = next(iter(finest.items()))
@@ -104,21 +112,53 @@ def _e1_text(found: dict) -> str:
     return head + f"; interactions / |v(all MPM) - v(all exact)| from the coarsest mesh to the finest: {trend}"
 
 
+def e1_result(rows: list[dict]) -> dict | None:
+    """E1's result on one problem's ``budget/subsets`` rows, at the finest mesh of every basis and
+    norm: ``cases`` (how many), ``separate`` and ``dominant`` (how many), the interactions over the gap
+    (``ratios``), the meshes (``h``) and the verdict: ``refuted`` when the stages separate nowhere,
+    ``confirmed`` when they separate and one stage dominates everywhere, else ``partly``. None without
+    a complete budget. E5 reads it to say what the budget found."""
+    found = budget_findings(rows)
+    if not found:
+        return None
+    finest = [series[-1][1] for series in found.values()]
+    n, sep = len(finest), sum(f["separate"] for f in finest)
+    dom = sum(f["dominant"] is not None for f in finest)
+    verdict = REFUTED if sep == 0 else CONFIRMED if sep == dom == n else PARTLY
+    return {"cases": n, "separate": sep, "dominant": dom, "ratios": [f["interactions"] for f in finest],
+            "h": [series[-1][0] for series in found.values()], "verdict": verdict, "found": found,
+            "stages": sorted({f["dominant"] for f in finest if f["dominant"]})}
+
+
+def e1_sentence(problem: str, r: dict) -> str:
+    """E1's plain sentence on one problem from :func:`e1_result`."""
+    ratios = f"{min(r['ratios']):.2g} to {max(r['ratios']):.2g}"
+    if r["separate"] == 0:
+        return (f"on {problem} the four stages of the step do not separate: their interactions are {ratios} times "
+                f"the gap between the all-MPM and the all-exact error, so no stage is the error's source alone")
+    return (f"on {problem} the stages separate in {r['separate']} of {r['cases']} bases and norms (interactions "
+            f"{ratios} times the gap)" + (f"; {', '.join(r['stages'])} dominates where they do" if r["stages"] else ""))
+
+
 def _e1(problem: str) -> Criterion:
-    def criterion(t: Tables) -> tuple[str, str]:
+    def criterion(t: Tables) -> Finding:
         """The sixteen combinations of the four stages in MPM or exact form are the raw measurements.
         The stages separate when the error of every combination is close to the all-exact error plus
         the errors each stage adds alone: the Moebius interactions, which measure the departure from
         that sum, are small beside the gap between all MPM and all exact. A stage dominates when the
         Shapley value and the errors removed by making the stages exact one after another, in the
-        step's order and in its reverse, name it as the largest; where the interactions are large these
-        attributions can disagree, and then no stage is named."""
-        found = budget_findings(select(t[SUBSETS], problem=problem))
-        if not found:
+        step's order and in its reverse, name it as the largest and the interactions do not exceed the
+        gap; where the interactions are large these attributions are artefacts of the order, and then
+        no stage is named."""
+        r = e1_result(select(t[SUBSETS], problem=problem))
+        if r is None:
             return "not measured", f"no complete set of the {2 ** len(STEP_ORDER)} combinations of {STEP_ORDER}"
-        finest = [series[-1][1] for series in found.values()]
-        hits = sum(f["separate"] for f in finest) + sum(f["dominant"] is not None for f in finest)
-        return count_verdict(hits, 2 * len(finest)), _e1_text(found) + _roundoff_text(t, problem)
+        table = tuple({"basis": k[0], "norm": k[1], "h": f"{series[-1][0]:g}",
+                       "interactions / gap": f"{series[-1][1]['interactions']:.2g}",
+                       "separate": str(series[-1][1]["separate"]), "dominant": series[-1][1]["dominant"] or "none"}
+                      for k, series in r["found"].items())
+        return Finding(r["verdict"], _e1_text(r["found"]) + _roundoff_text(t, problem), e1_sentence(problem, r),
+                       table)
     return criterion
 
 
@@ -144,7 +184,8 @@ _E1_RULE = (f"at the finest mesh of every basis and norm, (a) the interactions o
             f"stages or more), in total magnitude, are at most {SEPARATE:.0%} of |v(all MPM) - v(all exact)| (the "
             "stages separate) and (b) the Shapley value and the sequential replacement (the stages made exact one "
             f"after another from all MPM, in the step's order {' -> '.join(STEP_ORDER)} and in its reverse) name the "
-            "same largest stage (it dominates) -> confirmed; some of these -> partly; none -> refuted. Read from "
+            f"same largest stage, with the interactions at most {ATTRIBUTABLE:g}x the gap (it dominates) -> "
+            "confirmed; the stages separate nowhere -> refuted (no stage named); otherwise partly. Read from "
             "budget/subsets, the value of every combination")
 for _problem in ("sod", "burgers"):
     claim("E1", source="the four error sources of the slides (projection, FE + mass lumping, interpolation, time)",

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Finding, Tables, claim
+from mpm_fem.measure.claims.budget import SUBSETS, e1_result
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import BUDGET_SHAPLEY, REMEDIES_ERRORS, SETTINGS
@@ -117,13 +118,15 @@ def _series(rows: list[dict], problem: str) -> dict[str, list[dict]]:
                   "evidence adds which stage carries the largest Shapley share of the named remedy's remaining "
                   "error, from the error budget of its basis at its finest mesh (budget/shapley, when the budget "
                   "was run)")
-def _e5(t: Tables) -> tuple[str, str]:
-    """The remedies attack the error sources the budget found: the particle-domain B-spline the force
-    quadrature and the jump of the basis gradient at node crossings, the Taylor reconstruction the force
-    quadrature, the volume reset the volume drift, the PIC/FLIP blend and XPIC(m) the noise carried by the
-    particle velocities (XPIC filters FLIP's null-space noise without PIC's diffusion). The contact
-    discontinuity of Sod's tube limits the L1 order of every method, the finite-volume reference's too, so
-    a remedy is held to the FV reference's own orders on the same meshes, not to first order."""
+def _e5(t: Tables) -> Finding:
+    """Each remedy targets a mechanism the slides or the diagnosis name: the particle-domain B-spline the
+    force quadrature and the jump of the basis gradient at node crossings, the Taylor reconstruction the
+    force quadrature, the volume reset the volume drift, the PIC/FLIP blend and XPIC(m) the noise carried
+    by the particle velocities (XPIC filters FLIP's null-space noise without PIC's diffusion). Whether
+    these are the error's separate sources is E1's question, and the evidence states E1's answer. The
+    contact discontinuity of Sod's tube limits the L1 order of every method, the finite-volume
+    reference's too, so a remedy is held to the FV reference's own orders on the same meshes, not to
+    first order."""
     rows = t[REMEDY_ERRORS]
     sod = {k: v for k, v in _series(rows, "sod").items() if len(v) >= 2}
     burgers = _series(rows, "burgers")
@@ -158,8 +161,35 @@ def _e5(t: Tables) -> tuple[str, str]:
     text += "; " + remedy_budget(t, name)
     removers = [f"{n} ({sc['max_fv_ratio_nodes_L1']:.2f}x / {sc['max_fv_ratio_particles_L1']:.2f}x FV)"
                 for _, n, sc, *_ in scored if sc["removes_plateau"]]
+    why = budget_clause(t)
+    table = tuple({"remedy": n, "removes the Sod plateau": str(sc["removes_plateau"]),
+                   "lowest Sod order (nodes / particles)": f"{sc['min_order_nodes_L1']:.2f} / "
+                                                            f"{sc['min_order_particles_L1']:.2f}",
+                   "largest FV ratio": f"{max(sc[f'max_fv_ratio_{m}'] for m in REMEDY_MEASURES):.2f}",
+                   "Burgers goal": str(ok)} for _, n, sc, _, _, ok in scored)
+    sentence = (f"{name} keeps Sod's density error converging (lowest orders {s['min_order_nodes_L1']:.2f} at the "
+                f"nodes, {s['min_order_particles_L1']:.2f} at the particles) within "
+                f"{max(s[f'max_fv_ratio_{m}'] for m in REMEDY_MEASURES):.2f}x the finite-volume error"
+                if s["removes_plateau"] else f"no remedy keeps Sod's density error converging on every mesh; "
+                f"the closest is {name}") + f"; {why}"
     if s["removes_plateau"] and fv and b_ok:
-        return CONFIRMED, "meets the goal: " + text
+        return Finding(CONFIRMED, "meets the goal: " + text + f"; {why}", sentence, table)
     if removers:
-        return PARTLY, text + f"; the Sod plateau is removed by {', '.join(removers)}"
-    return REFUTED, f"closest: {text}; no remedy converges as the FV reference does on every Sod mesh"
+        return Finding(PARTLY, text + f"; the Sod plateau is removed by {', '.join(removers)}; {why}", sentence,
+                       table)
+    return Finding(REFUTED, f"closest: {text}; no remedy converges as the FV reference does on every Sod mesh; "
+                            f"{why}", sentence, table)
+
+
+def budget_clause(t: Tables) -> str:
+    """What the error budget found, from E1's result on Sod (:func:`~.budget.e1_result`), in the words
+    E5's evidence uses: never that the remedies attack separate sources when the stages do not separate."""
+    r = e1_result(select(t.get(SUBSETS) or [], problem="sod"))
+    if r is None:
+        return "the error budget (E1) was not run, so no remedy is tied to a stage of it"
+    if r["separate"] == 0:
+        return (f"the error budget's stages do not separate (E1: interactions {min(r['ratios']):.2g}-"
+                f"{max(r['ratios']):.2g}x the gap), so no remedy is tied to one stage: each is judged by the "
+                "plateau it should remove")
+    return (f"the error budget's stages separate in {r['separate']} of {r['cases']} bases and norms (E1)"
+            + (f", {', '.join(r['stages'])} dominating there" if r["stages"] else ", no stage dominating"))
