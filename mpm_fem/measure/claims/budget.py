@@ -9,13 +9,9 @@ import math
 from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Finding, Tables, claim
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span
 from mpm_fem.measure.claims.rules import rule
-from mpm_fem.measure.decomposition import decompose
-from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF, BUDGET_SUBSETS
+from mpm_fem.measure.claims.stages import STEP_ORDER, SUBSETS, decomposition, runs, values
+from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF
 
-SUBSETS = BUDGET_SUBSETS.name
-#: E1: the stages in the order the step runs them (projection to the grid, the FE solve with the
-#: lumped mass, the interpolation back to the particles, the time update); the budget's stages.
-STEP_ORDER = ("projection", "mass", "interpolation", "time")
 #: E1 (a): the stages separate when their interactions (the Moebius terms of two stages or more), in
 #: total magnitude, are at most SEPARATE of |v(all MPM) - v(all exact)|.
 SEPARATE = rule("SEPARATE")
@@ -27,10 +23,6 @@ ATTRIBUTABLE = rule("ATTRIBUTABLE")
 SEQUENCES = {"forward": STEP_ORDER, "backward": STEP_ORDER[::-1]}
 # E2: a basis keeps converging with a last-refinement order of the particle density L1 above C11's
 # CONVERGING_ORDER, and P1 has levelled off below C11's FLOOR_ORDER.
-
-
-def _subset(label: str) -> frozenset:
-    return frozenset() if label == "none" else frozenset(label.split("+"))
 
 
 def sequential(v: dict, order: tuple) -> dict:
@@ -51,10 +43,8 @@ def stage_findings(rows: list[dict]) -> dict | None:
     the dominant stage when they agree and the interactions are at most ATTRIBUTABLE times the gap
     (else None), the largest main effect (``alone``: stage,
     m({s})) and the end points; None when a subset of STEP_ORDER is missing."""
-    v = {_subset(r["mpm_stages"]): num(r, "error") for r in rows}
-    try:
-        d = decompose(v, STEP_ORDER)
-    except ValueError:
+    v, d = values(rows), decomposition(rows)
+    if d is None:
         return None
     inter = sum(abs(m) for m in d.interactions().values())
     ratio = inter / abs(d.gap) if d.gap else math.inf
@@ -70,15 +60,15 @@ def stage_findings(rows: list[dict]) -> dict | None:
 
 
 def budget_findings(rows: list[dict]) -> dict:
-    """:func:`stage_findings` of every mesh, per ``(basis, norm)`` of one problem's
-    ``budget/subsets`` rows: ``{(basis, norm): [(h, findings), ...]}``, coarsest mesh first."""
-    out = {}
-    for basis, norm in dict.fromkeys((r["basis"], r["norm"]) for r in rows):
-        sub = select(rows, basis=basis, norm=norm)
-        hs = sorted({num(r, "h") for r in sub}, reverse=True)
-        found = [(h, stage_findings([r for r in sub if num(r, "h") == h])) for h in hs]
-        out[(basis, norm)] = [(h, f) for h, f in found if f is not None]
-    return {k: v for k, v in out.items() if v}
+    """:func:`stage_findings` of every mesh, per ``(basis, norm, run)`` of one problem's
+    ``budget/subsets`` rows (``run``: particles per cell, layout and seed where the table records them,
+    :func:`~.stages.run_label`): ``{(basis, norm, run): [(h, findings), ...]}``, coarsest mesh first."""
+    out: dict = {}
+    for (basis, norm, h, run), sub in runs(rows).items():
+        found = stage_findings(sub)
+        if found is not None:
+            out.setdefault((basis, norm, run), []).append((h, found))
+    return {k: sorted(v, key=lambda x: -x[0]) for k, v in out.items()}
 
 
 def _e1_text(found: dict) -> str:
@@ -87,7 +77,7 @@ def _e1_text(found: dict) -> str:
     n, sep = len(finest), [k for k, (_, f) in finest.items() if f["separate"]]
     dominant = {k: f["dominant"] for k, (_, f) in finest.items() if f["dominant"]}
     hs = span([h for h, _ in finest.values()], "g")
-    names = {k: f"{k[0]} {k[1]}" for k in finest}
+    names = {k: " ".join(p for p in k if p) for k in finest}
     ratios = [f["interactions"] for _, f in finest.values()]
     head = (f"the stages separate in {len(sep)} of {n} bases and norms at h = {hs} (the interactions are "
             f"{span(ratios, '.2g')}x |v(all MPM) - v(all exact)|, at most {SEPARATE:.0%} to separate)")
@@ -153,7 +143,7 @@ def _e1(problem: str) -> Criterion:
         r = e1_result(select(t[SUBSETS], problem=problem))
         if r is None:
             return "not measured", f"no complete set of the {2 ** len(STEP_ORDER)} combinations of {STEP_ORDER}"
-        table = tuple({"basis": k[0], "norm": k[1], "h": f"{series[-1][0]:g}",
+        table = tuple({"basis": k[0], "norm": k[1], "run": k[2] or "regular", "h": f"{series[-1][0]:g}",
                        "interactions / gap": f"{series[-1][1]['interactions']:.2g}",
                        "separate": str(series[-1][1]["separate"]), "dominant": series[-1][1]["dominant"] or "none"}
                       for k, series in r["found"].items())

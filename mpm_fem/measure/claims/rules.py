@@ -99,10 +99,14 @@ _add("SATURATION", 0.05,
      "C3: the fewest particles per cell whose error is within this fraction of the smallest one",
      _STUDY + ": the slides say '4-8 particles per cell is optimal' without a tolerance", ("C3",))
 _add("LUMPING_BAND", 0.9,
-     "C15: a consistent/lumped error ratio below this means lumping is a source of error, above its inverse "
-     "that it compensates; a mass stage's share of the budget's gap above 1 minus it, alone, that it is a source",
+     "C15 (second reading): a consistent/lumped error ratio below this means lumping is a source of error, above "
+     "its inverse that it compensates",
      _STUDY + ": the slides name FE + mass lumping a source without a size; a 10 % change is well outside the "
      "spread over meshes of the FEM's own ratio (0.996-0.998)", ("C15",))
+_add("SOURCE_SHARE", 0.1,
+     "C15: the mass stage (the FE solve with the lumped mass) is an error source when its MPM form alone raises "
+     "the all-exact error by at least this fraction of the all-MPM error",
+     _STUDY + ": the slides list FE + mass lumping among four sources without a size; a tenth of MPM's error", ("C15",))
 _add("WAVE_SHARE", 0.5,
      "C12: the named wave regions (rarefaction edges, contact, shock front) carry the error when they hold at "
      "least this share of the nodal L1 error",
