@@ -49,15 +49,15 @@ def c13_order(rows: list[dict], method: str) -> dict:
     """The fitted order of ``method`` in the orders rows of one solution and error: over its series of
     several runs, the mean of their means (``mean``), the least ``fitted_lo`` and the largest
     ``fitted_hi`` (``lo``, ``hi``); a method run once per eps: the mean and range of its fitted orders
-    over the eps; their :func:`~mpm_fem.measure.seeds.side` of FIRST_ORDER (``side``), the runs
+    over the eps (two at least); their :func:`~mpm_fem.measure.seeds.side` of FIRST_ORDER (``side``), the runs
     (``runs``) and ``single``: the regular layout's order of each series of one run."""
     sub = select(rows, method=method)
     seeded = [r for r in sub if num(r, "runs") > 1]
     single = [num(r, "fitted") for r in sub if not num(r, "runs") > 1]
     means, los, his = (_finite(num(r, k) for r in seeded) for k in ("fitted_mean", "fitted_lo", "fitted_hi"))
     runs = "/".join(r["runs"] for r in seeded)
-    if not seeded:
-        means = los = his = _finite(single)
+    if not seeded:  # a range needs two eps at least
+        means = los = his = _finite(single) if len(_finite(single)) > 1 else []
         runs = f"{len(means)} eps x 1"
     lo, hi = (min(los) if los else math.nan), (max(his) if his else math.nan)
     return {"mean": sum(means) / len(means) if means else math.nan, "lo": lo, "hi": hi,
