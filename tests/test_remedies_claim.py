@@ -52,7 +52,7 @@ def test_one_stalled_pair_of_meshes_is_a_plateau():
 
 def test_more_than_one_and_a_half_times_the_fv_error_is_partly():
     v, evidence = verdict(table(fv=[x / 1.6 for x in GOOD_SOD["particles"]]))
-    assert v == "partly" and evidence.endswith("the Sod plateau is removed by fix (1.31x / 1.60x FV)")
+    assert v == "partly" and "the Sod plateau is removed by fix (1.31x / 1.60x FV); " in evidence
 
 
 def test_burgers_below_first_order_is_partly():
