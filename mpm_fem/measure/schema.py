@@ -154,7 +154,9 @@ TIME_CROSSING_SUMMARY = Table("time/crossing_summary", (
 
 #: v(S), the error with the stages of ``mpm_stages`` (``+``-joined, ``none`` for the empty set) in
 #: MPM form and the others exact: the raw measurements of the budget, which E1 reads.
-BUDGET_SUBSETS = Table("budget/subsets", ("problem", "h", "basis", "norm", "mpm_stages", "error"))
+#: ``ppc``, ``layout`` and ``seed`` where the budget runs several particles per cell and layouts.
+BUDGET_SUBSETS = Table("budget/subsets", ("problem", "h", "basis", "norm", "mpm_stages", "error"),
+                       optional=("ppc", "layout", "seed"))
 BUDGET_SHAPLEY = Table("budget/shapley", (
     "problem", "h", "basis", "norm", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error"))
 BUDGET_ROUNDOFF = Table("budget/roundoff", (
@@ -179,6 +181,17 @@ DRIFT = Table("drift/drift", (
     "h", "variant", "layout", "seed", "change", "kernel", "ok", "particles_L1", "nodes_L1", "volume_drift",
     "abs_volume_drift", "particles_vs_study", "order_particles_L1", "order_nodes_L1", "steps"), optional=("error",))
 
+# ----------------------------------------------------------------------------- identification (C11, C13)
+
+#: One row per candidate setting and source row, with its misfit to the corrected source table
+#: (:mod:`mpm_fem.measure.claims.identification`); the settings columns are the problem's.
+IDENTIFICATION_SOD = Table("identification/sod", (
+    "problem", "candidate", "ppc", "cfl", "quantity", "norm", "source_row", "misfit", "misfit_raw", "meshes", "rank",
+    "matching"))
+IDENTIFICATION_BURGERS = Table("identification/burgers", (
+    "problem", "candidate", "solution", "dt_rule", "cfl", "ppc", "norm", "source_row", "misfit", "misfit_raw",
+    "meshes", "rank", "matching"))
+
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
 VERSIONS = Table("versions", ("table", "code", "quick"))
@@ -192,7 +205,7 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     TIME_ORDER, TIME_LOCAL_ERROR, TIME_CROSSING_SUMMARY,
     BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,
     REMEDIES_ERRORS,
-    DRIFT)}
+    DRIFT, IDENTIFICATION_SOD, IDENTIFICATION_BURGERS)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}
 
