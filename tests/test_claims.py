@@ -48,6 +48,20 @@ def test_band_claims_follow_the_orders(label, quantity, good, bad):
     assert f"{bad:.2f}" in judge(label, failing)[1]
 
 
+@pytest.mark.parametrize("label, quantity, inside, outside", [("C5", "E_m", 1.5, 3.0), ("C9", "E_v", 0.9, 2.0)])
+def test_band_claims_judge_the_regular_layout_in_a_row_of_its_own(label, quantity, inside, outside):
+    """Every layout inside but the regular one: partly, naming the layouts on which the band holds."""
+    others = mutate(TABLES, ORDERS, {"quantity": quantity}, order=1.0)
+    passing = mutate(others, ORDERS, {"quantity": quantity, "layout": "regular"}, order=inside)
+    failing = mutate(others, ORDERS, {"quantity": quantity, "layout": "regular"}, order=outside)
+    assert_flips(label, failing, passing)
+    verdict, evidence = judge(label, failing)
+    assert verdict == "partly" and "holds on advected, jittered, random; not on regular (0 of " in evidence
+    found = claim_named(label).finding(failing)
+    assert {"layout": "regular", "orders": f"{outside:.2f}", "inside": "0 of 6", "holds": "False"} in found.table
+    assert found.sentence.endswith(f"on advected, jittered, random; not on regular {outside:.2f}")
+
+
 def test_c10_compares_the_gradient_order_with_the_velocity_order():
     passing = mutate(TABLES, ORDERS, {"quantity": "E_VG_proj"}, order=lambda r: _order(r, "E_v"))
     assert_flips("C10", TABLES, passing)
