@@ -165,15 +165,22 @@ def test_e3_counts_a_change_only_when_its_range_over_the_seeds_is_decided():
 
 # ----------------------------------------------------------------------------- C12, C14
 
-def test_c12_follows_the_share_of_the_waves_per_setting(tables):
-    assert judge("C12", tables)[0] == "confirmed"
-    fewer = mutate(tables, "sod/regions", {"method": "MPM nodes", "h": FINEST}, share_1=0.0, share_6=0.0)
-    assert judge("C12", fewer)[0] == "partly"
-    none = mutate(tables, "sod/regions", {"method": "MPM nodes"}, share_1=0.0, share_6=0.0)
+def test_c12_ranks_the_waves_by_error_per_unit_length_per_setting(tables):
+    """The made-up waves carry 60% of the error on 0.16 of the tube, the smooth region 25% on 0.34: 5x per
+    unit length. A smooth region carrying 90% brings the waves to 1.4x, below the study's factor 2."""
+    verdict, evidence = judge("C12", tables)
+    assert verdict == "confirmed" and "the waves' error per unit length 5.1x the smooth region's" in evidence
+    smooth = mutate(tables, "sod/regions", {"method": "MPM nodes", "h": FINEST}, share_2=0.9)
+    assert judge("C12", smooth)[0] == "partly"
+    none = mutate(tables, "sod/regions", {"method": "MPM nodes"}, share_2=0.9)
     assert judge("C12", none)[0] == "differs"
-    only_16 = mutate(tables, "sod/regions", {"method": "MPM nodes", "ppc": 16}, share_1=0.0, share_6=0.0)
+    only_16 = mutate(tables, "sod/regions", {"method": "MPM nodes", "ppc": 16}, share_2=0.9)
     verdict, evidence = judge("C12", only_16)
     assert verdict == "confirmed" and "16 ppc, CFL 0.05: differs" in evidence
+    sentences = {claim_named("C12").finding(t).sentence for t in (tables, none)}
+    assert len(sentences) == 2 and all("times the smooth region's" in x for x in sentences)
+    unrecorded = {**tables, "settings": [r for r in tables["settings"] if r["key"] != "region_half_width"]}
+    assert judge("C12", unrecorded)[0] == "not measured"
 
 
 def test_c14_compares_crossing_particles_with_moving_ones():

@@ -107,11 +107,12 @@ _add("SOURCE_SHARE", 0.1,
      "C15: the mass stage (the FE solve with the lumped mass) is an error source when its MPM form alone raises "
      "the all-exact error by at least this fraction of the all-MPM error",
      _STUDY + ": the slides list FE + mass lumping among four sources without a size; a tenth of MPM's error", ("C15",))
-_add("WAVE_SHARE", 0.5,
-     "C12: the named wave regions (rarefaction edges, contact, shock front) carry the error when they hold at "
-     "least this share of the nodal L1 error",
+_add("WAVE_DENSITY", 2.0,
+     "C12: the named wave regions (rarefaction edges, contact, shock front) carry the error when their error per "
+     "unit length is at least this factor times that of the smooth region between them",
      _STUDY + ": the slides say where the error sits (rarefaction edges, contact, shock front), not how much of "
-     "it; half is the study's reading of 'sits at'", ("C12",))
+     "it; ranking the regions by error per unit length judges that statement, and twice the smooth region's "
+     "is the study's reading of 'sits at'", ("C12",))
 _add("EXTREMA_RATIO", 2.0,
      "C14: a crossing particle becomes a new extremum at least this many times as often as a moving one that "
      "does not cross",
