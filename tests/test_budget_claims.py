@@ -166,9 +166,34 @@ def _crossing(p1_error: float, smooth: float) -> dict:
 
 
 def test_c2_needs_the_p1_formula_and_no_jump_for_the_smooth_basis():
-    assert_flips("C2", _crossing(0.3, 0.001), _crossing(0.02, 0.001))
+    orders = _orders_by_basis(0.75, 1.05)
+    assert_flips("C2", {**_crossing(0.3, 0.001), **orders}, {**_crossing(0.02, 0.001), **orders})
     assert judge("C2", _crossing(0.3, 0.001))[0] == "refuted"
-    assert judge("C2", _crossing(0.02, 0.5))[0] == "partly"
+    assert judge("C2", {**_crossing(0.02, 0.5), **orders})[0] == "partly"
+
+
+def _orders_by_basis(p1: float, smooth: float) -> dict:
+    rows = [{"problem": p, "basis": b, "quantity": "velocity", "refine": "1", "dt": "0.01", "error": "0.001",
+             "order": "", "fitted_order": repr(p1 if b == "mpm" else smooth)}
+            for p in ("pulse", "burgers") for b in ("mpm", "gimp", "bspline")]
+    return {"time/time_order": rows}
+
+
+def test_c2_second_half_compares_p1s_order_in_dt_with_the_smooth_bases():
+    """P1 at most first order where the bases without a jump reach it: confirmed; P1 above first order,
+    or the smooth bases below it too (the integrator, not the jump, limits): partly; no smooth rows: partly,
+    said so."""
+    from claim_mutations import claim_named
+
+    passing = {**_crossing(0.02, 0.001), **_orders_by_basis(0.75, 1.05)}
+    assert judge("C2", passing)[0] == "confirmed"
+    assert_flips("C2", {**passing, **_orders_by_basis(1.6, 1.05)}, passing)
+    assert judge("C2", {**passing, **_orders_by_basis(0.75, 0.5)})[0] == "partly"
+    missing = {**passing, "time/time_order": [r for r in passing["time/time_order"] if r["basis"] == "mpm"]}
+    assert judge("C2", missing)[0] == "partly" and "second half not measured" in judge("C2", missing)[1]
+    found = claim_named("C2").finding(passing)
+    assert {"problem": "pulse", "quantity": "velocity", "P1": "0.75", "GIMP": "1.05", "B-spline": "1.05"} in found.table
+    assert "P1's global order in dt is 0.75 against 1.05 for the smooth bases" in found.sentence
 
 
 def test_e2_follows_the_last_refinement_orders():
