@@ -196,21 +196,37 @@ def test_c2_second_half_compares_p1s_order_in_dt_with_the_smooth_bases():
     assert "P1's global order in dt is 0.75 against 1.05 for the smooth bases" in found.sentence
 
 
-def test_e2_follows_the_last_refinement_orders():
-    meshes = sorted({r["h"] for r in TABLES["budget/bases"]}, key=float)  # the last refinement: meshes[1] -> [0]
-    finest = {"h": meshes[0]}
-    coarse = {r["basis"]: float(r["particles_L1"]) for r in TABLES["budget/bases"] if r["h"] == meshes[1]}
-    p1_fine = next(float(r["particles_L1"]) for r in TABLES["budget/bases"]
-                   if r["h"] == meshes[0] and r["basis"] == "mpm")
-    stalled = TABLES
-    for basis in ("gimp", "bspline"):  # the smooth bases level off as P1 does, a little worse (order P1's - 0.14)
-        stalled = mutate(stalled, "budget/bases", {**finest, "basis": basis},
-                         particles_L1=1.1 * coarse[basis] * p1_fine / coarse["mpm"])
-    converging = mutate(TABLES, "budget/bases", {**finest, "basis": "bspline"}, particles_L1=0.45 * coarse["bspline"])
-    assert_flips("E2", stalled, converging)
-    assert judge("E2", stalled)[0] == "refuted"
-    p1_converges = mutate(converging, "budget/bases", {**finest, "basis": "mpm"}, particles_L1=0.5 * coarse["mpm"])
-    assert judge("E2", p1_converges)[0] == "differs"
+def _bases(orders: dict, runs: int = 1) -> dict:
+    """``budget/bases`` rows on four meshes from ``{basis: (order, order, order)}`` of the particle density
+    (the nodes first order); ``runs`` > 1 adds jittered runs at 8 per cell whose orders differ by 0.05 each."""
+    rows = []
+    for basis, os in orders.items():
+        for k in range(runs):
+            e, h = 0.01, 0.01
+            extra = {} if runs == 1 else {"ppc": "8", "layout": "regular" if k == 0 else "jittered", "seed": str(k)}
+            for step in (None, *os):
+                if step is not None:
+                    e, h = e / 2 ** (step + 0.05 * k), h / 2
+                rows.append({"h": repr(h), "basis": basis, "ok": "True", "particles_L1": repr(e), "nodes_L1": repr(h),
+                             "plateau_noise": "0.001", **extra})
+    return {"budget/bases": rows}
+
+
+def test_e2_follows_the_orders_over_the_last_two_refinements():
+    from claim_mutations import claim_named
+
+    converging = _bases({"mpm": (1.0, -0.3, -0.6), "bspline": (1.0, 0.9, 0.85)})
+    assert judge("E2", converging)[0] == "confirmed"
+    one_step = _bases({"mpm": (1.0, -0.3, -0.6), "bspline": (1.0, 0.6, 0.85)})  # only the last order converges
+    assert_flips("E2", one_step, converging, "confirmed")
+    assert judge("E2", one_step)[0] == "partly"
+    assert judge("E2", _bases({"mpm": (1.0, -0.3, -0.6), "bspline": (1.0, -0.4, -0.7)}))[0] == "refuted"
+    assert judge("E2", _bases({"mpm": (1.0, 0.9, -0.6), "bspline": (1.0, 0.9, 0.85)}))[0] == "differs"
+    found = claim_named("E2").finding(converging)
+    assert "-0.30, -0.60 with P1, 0.90, 0.85 with the C1 B-spline" in found.sentence
+    seeded = claim_named("E2").finding(_bases({"mpm": (1.0, -0.3, -0.6), "bspline": (1.0, 0.9, 0.85)}, runs=3))
+    assert seeded.verdict == "confirmed" and "(3 runs each)" in seeded.evidence
+    assert seeded.table[1]["particle density orders"].startswith("0.95 [0.90, 1.00]")
 
 
 # ---------------------------------------------------------------- C15: the direct comparison, with its sign

@@ -165,7 +165,7 @@ BUDGET_ROUNDOFF = Table("budget/roundoff", (
 #: ``error`` only when a run failed (its row then has no errors).
 BUDGET_BASES = Table("budget/bases", (
     "h", "basis", "ok", "steps", "wall_s", "particles_L1", "nodes_L1", "plateau_noise", "plateau_offset"),
-    optional=("error",))
+    optional=("error", "ppc", "layout", "seed"))
 
 # ----------------------------------------------------------------------------- remedies (E5)
 

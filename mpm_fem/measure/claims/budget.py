@@ -7,10 +7,11 @@ from __future__ import annotations
 import math
 
 from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Finding, Tables, claim
-from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
 from mpm_fem.measure.claims.rules import rule
-from mpm_fem.measure.claims.stages import STEP_ORDER, SUBSETS, decomposition, runs, values
+from mpm_fem.measure.claims.stages import STEP_ORDER, SUBSETS, decomposition, run_label, runs, values
 from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF
+from mpm_fem.measure.spread import Spread, spread
 
 #: E1 (a): the stages separate when their interactions (the Moebius terms of two stages or more), in
 #: total magnitude, are at most SEPARATE of |v(all MPM) - v(all exact)|.
@@ -21,8 +22,6 @@ ATTRIBUTABLE = rule("ATTRIBUTABLE")
 #: value, and the error removed by each stage when the stages are made exact one after another from
 #: all MPM, in the step's order and in its reverse.
 SEQUENCES = {"forward": STEP_ORDER, "backward": STEP_ORDER[::-1]}
-# E2: a basis keeps converging with a last-refinement order of the particle density L1 above C11's
-# CONVERGING_ORDER, and P1 has levelled off below C11's FLOOR_ORDER.
 
 
 def sequential(v: dict, order: tuple) -> dict:
@@ -182,27 +181,57 @@ for _problem in ("sod", "burgers"):
           tables=(SUBSETS,), study="budget", problem=_problem, thresholds=_E1_RULE)(_e1(_problem))
 
 
-@claim("E2", source="whether a smooth basis removes the stagnation of C11", tables=(BUDGET_BASES.name,), study="budget",
-       thresholds=f"P1's particle density L1 order over the last refinement is below {FLOOR_ORDER} and a C1 basis "
-                  f"keeps it above {CONVERGING_ORDER} -> confirmed; a C1 basis above P1 -> partly; none above P1 -> "
-                  "refuted; P1 not levelled off -> differs")
-def _e2(t: Tables) -> tuple[str, str]:
-    rows = select(t[BUDGET_BASES.name], ok="True")
-    last = {}
-    for basis in dict.fromkeys(r["basis"] for r in rows):
-        sub = sorted(select(rows, basis=basis), key=lambda r: -num(r, "h"))[-2:]
-        if len(sub) == 2:
-            last[basis] = ({k: math.log(num(sub[0], k) / num(sub[1], k)) / math.log(num(sub[0], "h") / num(sub[1], "h"))
-                            for k in ("particles_L1", "nodes_L1")}
-                           | {"h": sub[1]["h"], "noise": num(sub[1], "plateau_noise")})
-    if "mpm" not in last or len(last) < 2:
-        return "not measured", "fewer than two meshes or no point-mass row"
-    p1, smooth = last["mpm"]["particles_L1"], {b: v["particles_L1"] for b, v in last.items() if b != "mpm"}
-    verdict = (DIFFERS if p1 >= FLOOR_ORDER else CONFIRMED if max(smooth.values()) > CONVERGING_ORDER
-               else PARTLY if max(smooth.values()) > p1 else REFUTED)
-    return verdict, ("last-refinement order of the particle density L1: "
-                     + ", ".join(f"{b} {v['particles_L1']:.2f}" for b, v in last.items())
-                     + "; nodes " + ", ".join(f"{b} {v['nodes_L1']:.2f}" for b, v in last.items())
-                     + f"; plateau std(v_p) at h = {last['mpm']['h']}: "
-                     + ", ".join(f"{b} {v['noise']:.3g}" for b, v in last.items()))
+FLOOR_STEPS = int(rule("FLOOR_STEPS"))
 
+
+def _tail_orders(rows: list[dict], key: str) -> list[Spread]:
+    """The orders of ``key`` over the last FLOOR_STEPS refinements of one basis, each a range over its
+    runs (particles per cell, layout and seed where the table records them; one run otherwise)."""
+    per_run: dict[str, list[dict]] = {}
+    for r in rows:
+        per_run.setdefault(run_label(r), []).append(r)
+    series = [successive_orders(sorted(v, key=lambda r: -num(r, "h")), key)[-FLOOR_STEPS:] for v in per_run.values()]
+    steps = min(map(len, series), default=0)
+    return [spread(s[len(s) - steps + k] for s in series) for k in range(steps)]
+
+
+@claim("E2", source="whether a smooth basis removes the stagnation of C11", tables=(BUDGET_BASES.name,), study="budget",
+       thresholds=f"over the last {FLOOR_STEPS} refinements (each order a range over the runs: particles per cell, "
+                  f"layouts and seeds where the table holds them): P1's particle density L1 orders all below "
+                  f"{FLOOR_ORDER} and a C1 basis's all at least {CONVERGING_ORDER} -> confirmed; a C1 basis above P1 "
+                  "on every one -> partly; none above P1 -> refuted; P1 not levelled off -> differs")
+def _e2(t: Tables) -> Finding:
+    rows = select(t[BUDGET_BASES.name], ok="True")
+    tails = {b: {k: _tail_orders(select(rows, basis=b), k) for k in ("particles_L1", "nodes_L1")}
+             for b in dict.fromkeys(r["basis"] for r in rows)}
+    tails = {b: v for b, v in tails.items() if len(v["particles_L1"]) == FLOOR_STEPS}
+    if "mpm" not in tails or len(tails) < 2:
+        return Finding("not measured", f"fewer than {FLOOR_STEPS + 1} meshes or no point-mass row")
+    p1 = tails["mpm"]["particles_L1"]
+    smooth = {b: v["particles_L1"] for b, v in tails.items() if b != "mpm"}
+    converges = [b for b, o in smooth.items() if all(x.above(CONVERGING_ORDER) for x in o)]
+    above = [b for b, o in smooth.items() if all(x.lo > y.hi for x, y in zip(o, p1, strict=True))]
+    verdict = (DIFFERS if not all(x.below(FLOOR_ORDER) for x in p1) else CONFIRMED if converges
+               else PARTLY if above else REFUTED)
+    runs_n = max(x.n for x in p1)
+    finest = sorted(rows, key=lambda r: num(r, "h"))[0]["h"]
+    noise = {b: span([num(r, "plateau_noise") for r in select(rows, basis=b, h=finest)], ".3g") for b in tails}
+    table = tuple({"basis": b, "particle density orders": ", ".join(o.text() if o.n > 1 else f"{o.mean:.2f}"
+                                                                    for o in v["particles_L1"]),
+                   "nodal density orders": ", ".join(f"{o.mean:.2f}" for o in v["nodes_L1"]),
+                   f"plateau std(v_p) at h = {finest}": noise[b]} for b, v in tails.items())
+    sentence = (f"over the last {FLOOR_STEPS} refinements the particle density error's order is "
+                + ", ".join(f"{r['particle density orders']} with {_BASIS_NAMES.get(r['basis'], r['basis'])}"
+                            for r in table))
+    return Finding(verdict, (f"particle density L1 orders over the last {FLOOR_STEPS} refinements ({runs_n} run"
+                             f"{'s' if runs_n > 1 else ''} each): "
+                             + "; ".join(f"{r['basis']} {r['particle density orders']}"
+                                         for r in table)
+                             + "; nodes " + "; ".join(f"{r['basis']} {r['nodal density orders']}" for r in table)
+                             + f"; plateau std(v_p) at h = {finest}: "
+                             + ", ".join(f"{b} {v}" for b, v in noise.items())),
+                   sentence, table)
+
+
+_BASIS_NAMES = {"mpm": "P1", "gimp": "GIMP", "bspline": "the C1 B-spline",
+                "bspline_gimp": "the particle-domain B-spline"}
