@@ -172,7 +172,7 @@ BUDGET_BASES = Table("budget/bases", (
 REMEDIES_ERRORS = Table("remedies/errors", (
     "problem", "remedy", "h", "quantity", "nodes_L1", "nodes_L2", "particles_L1", "particles_L2", "fv_L1",
     "ratio_fv_nodes_L1", "ratio_fv_particles_L1", "steps", "n_p", "volume_drift", "error", "order_nodes_L1",
-    "order_particles_L1"))
+    "order_particles_L1"), optional=("ppc", "layout", "seed"))
 
 # ----------------------------------------------------------------------------- drift (C11's mechanism)
 

@@ -9,6 +9,7 @@ from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Finding, Tab
 from mpm_fem.measure.claims.budget import SUBSETS, e1_result
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
 from mpm_fem.measure.claims.rules import rule
+from mpm_fem.measure.claims.stages import run_label
 from mpm_fem.measure.schema import BUDGET_SHAPLEY, REMEDIES_ERRORS, SETTINGS
 from mpm_fem.measure.tables import setting
 
@@ -93,11 +94,34 @@ def remedy_budget(t: Tables, remedy: str) -> str:
             + ", ".join(f"{r['stage']} {num(r, 'share'):.0%}" for r in at[1:]))
 
 
-def _series(rows: list[dict], problem: str) -> dict[str, list[dict]]:
-    out: dict[str, list[dict]] = {}
+def _runs(rows: list[dict], problem: str) -> dict[str, dict[str, list[dict]]]:
+    """``{remedy: {run: rows}}`` of ``problem`` (run: particles per cell, layout and seed where the table
+    records them, :func:`~.stages.run_label`; one run otherwise)."""
+    out: dict[str, dict[str, list[dict]]] = {}
     for r in select(rows, problem=problem):
-        out.setdefault(r["remedy"], []).append(r)
+        out.setdefault(r["remedy"], {}).setdefault(run_label(r), []).append(r)
     return out
+
+
+def _series(rows: list[dict], problem: str) -> dict[str, list[dict]]:
+    """Each remedy's main series: its run on the most meshes (the first such run in the table's order);
+    the other runs (other particles per cell, jittered layouts) are read by :func:`_other_runs`."""
+    return {name: max(runs.values(), key=len) for name, runs in _runs(rows, problem).items()}
+
+
+def _other_runs(rows: list[dict], name: str) -> str:
+    """The clause on ``name``'s other Sod runs (where the table holds them): their number, meshes and
+    the range of their lowest successive orders, nodes and particles; empty without."""
+    runs = _runs(rows, "sod").get(name, {})
+    main = max(runs.values(), key=len) if runs else []
+    others = [v for v in runs.values() if v is not main and len(v) > 1]
+    if not others:
+        return ""
+    lows = [remedy_assessment(v)[f"min_order_{m}"] for v in others for m in REMEDY_MEASURES]
+    hs = sorted({num(r, "h") for v in others for r in v}, reverse=True)
+    labels = sorted({run_label(v[0]) for v in others})
+    return (f"; over {len(others)} more runs ({', '.join(labels)}) on h = {hs[0]:g}..{hs[-1]:g} its lowest "
+            f"successive orders {span(lows)}")
 
 
 @claim("E5", source="the goal set for the remedies: an MPM variant whose Sod density error keeps converging on "
@@ -158,7 +182,7 @@ def _e5(t: Tables) -> Finding:
              f"{b['fitted_order_particles_L1']:.2f}, "
              f"lowest successive {min(b['min_order_nodes_L1'], b['min_order_particles_L1']):.2f}"
              if b else "; Burgers not run")
-    text += "; " + remedy_budget(t, name)
+    text += _other_runs(rows, name) + "; " + remedy_budget(t, name)
     removers = [f"{n} ({sc['max_fv_ratio_nodes_L1']:.2f}x / {sc['max_fv_ratio_particles_L1']:.2f}x FV)"
                 for _, n, sc, *_ in scored if sc["removes_plateau"]]
     why = budget_clause(t)
