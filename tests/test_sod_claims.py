@@ -150,6 +150,14 @@ def test_e3_is_confirmed_when_mpm_stays_within_a_constant_factor_of_fem():
     assert "FV: FV MUSCL-HLLC (MC); FEM: viscosity everywhere" in evidence
 
 
+def test_e3_gives_a_sentence_and_a_table_from_its_numbers(tables):
+    constant = claim_named("E3").finding(made_up_tables(_model(lambda h: 2.2 * h, nodes=lambda h: 1.5 * h)))
+    grows = claim_named("E3").finding(tables)
+    assert "changes by a factor 1.0 at 4-8 particles per cell" in constant.sentence
+    assert constant.sentence != grows.sentence and "changes by a factor" in grows.sentence
+    assert [r["verdict"] for r in constant.table] == ["confirmed"] * len(study.SETTINGS)
+
+
 def test_e3_names_the_error_that_grows(tables):
     verdict, evidence = judge("E3", tables)  # MPM's particle error grows below h = 0.00125, FEM's falls
     assert verdict == "refuted" and "(MPM's grows)" in evidence
