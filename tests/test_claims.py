@@ -88,8 +88,24 @@ def _best_at(n_best):
 def test_c3_follows_where_the_error_saturates(label, table, keys):
     passing = mutate(TABLES, table, **{k: _best_at(4) for k in keys})
     failing = mutate(TABLES, table, **{k: _best_at(32) for k in keys})
+    if label == "C3 (sod)":  # the seeded runs at 4, 8, 16 per cell are cases too
+        passing = mutate(passing, "sod/seeds", **{k: _best_at(4) for k in keys})
+        failing = mutate(failing, "sod/seeds", **{k: _best_at(16) for k in keys})
     assert_flips(label, failing, passing)
     assert judge(label, failing)[0] == "differs"
+
+
+def test_c3_sod_reads_the_range_over_the_seeded_runs():
+    """Every run of sod/ppc best at 4 per cell; one jittered seed best at 16 on one mesh moves that case
+    out of the range (its range over the runs 4..16)."""
+    passing = mutate(mutate(TABLES, "sod/ppc", nodes_L1=_best_at(4), particles_L1=_best_at(4)), "sod/seeds",
+                     nodes_L1=_best_at(4), particles_L1=_best_at(4))
+    one_seed = mutate(passing, "sod/seeds", {"seed": 3, "h": 0.01}, particles_L1=_best_at(16))
+    assert_flips("C3 (sod)", one_seed, passing)
+    found = claim_named("C3 (sod)").finding(one_seed)
+    assert {"run": "6 runs (sod/seeds)", "case": "h = 0.01, particles", "fewest near the smallest": "4..16"} \
+        in found.table
+    assert "lie in the source's 4-8 on 17 of 18 meshes and errors" in found.sentence
 
 
 def _stamped(code: str):

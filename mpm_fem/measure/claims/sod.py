@@ -19,9 +19,9 @@ from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Fin
 from mpm_fem.measure.claims.drift import mechanism
 from mpm_fem.measure.claims.identification import source_matching
 from mpm_fem.measure.claims.mass import MASS_RULE, mass_finding
-from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, saturation, select, span
 from mpm_fem.measure.claims.rules import rule
-from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, lumping_claim, ppc_claim
+from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, SATURATION, lumping_claim, ppc_claim
 from mpm_fem.measure.claims.stages import SUBSETS
 from mpm_fem.measure.regions import REGION_NAMES
 from mpm_fem.measure.schema import (
@@ -326,12 +326,59 @@ def _c14(t: Tables) -> tuple[str, str]:
         f"{num(rows[0], 'moving_speed'):.3g})")
 
 
+def _seeded_saturation(rows: list[dict], key: str) -> dict[float, list[int]]:
+    """``{h: [fewest particles per cell within SATURATION of the smallest error, per run]}`` over the
+    runs of ``sod/seeds`` (the regular layout and each jittered seed) at the CFL shared by the most
+    particles-per-cell settings; only meshes where every run holds every such setting."""
+    cfls = {}
+    for n, cfl in _settings(rows):
+        cfls.setdefault(cfl, set()).add(n)
+    if not cfls:
+        return {}
+    cfl = max(cfls, key=lambda c: len(cfls[c]))
+    ppcs = cfls[cfl]
+    found: dict[float, list[int]] = {}
+    for h in sorted({num(r, "h") for r in rows}, reverse=True):
+        at = select(rows, cfl=cfl, h=h)
+        per_seed = {}
+        for r in at:
+            per_seed.setdefault(r["seed"], []).append(r)
+        runs = [v for v in per_seed.values() if {int(num(r, "ppc")) for r in v} == ppcs]
+        if runs and len(runs) == len(per_seed):
+            found[h] = [saturation(v, key, SATURATION) for v in runs]
+    return found
+
+
 @claim("C3", source=f"{OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} particles per cell", tables=(SOD_PPC.name,), study="sod",
-       problem="sod", thresholds=PPC_RULE)
-def _c3_sod(t: Tables) -> tuple[str, str]:
+       problem="sod", thresholds=PPC_RULE + "; where sod/seeds holds several particles per cell on the regular and "
+       "the jittered layouts, each of its meshes and errors is one more case, holding when the fewest particles "
+       "per cell near the smallest error lies in the range on every run")
+def _c3_sod(t: Tables) -> Finding:
     ok = select(t[SOD_PPC.name], ok="True")
     groups = {f"h = {h}": select(ok, h=h) for h in dict.fromkeys(r["h"] for r in ok)}
-    return ppc_claim(groups, ("nodes_L1", "particles_L1"))
+    verdict, evidence = ppc_claim(groups, ("nodes_L1", "particles_L1"))
+    seeds = t.get(SEEDS) or []
+    table = [{"run": "regular (sod/ppc)", "case": f"{g}, {k.split('_')[0]}",
+              "fewest near the smallest": str(saturation(rows, k, SATURATION))}
+             for g, rows in groups.items() for k in ("nodes_L1", "particles_L1")]
+    seeded = {k: _seeded_saturation(seeds, k) for k in ("nodes_L1", "particles_L1")}
+    cases = [(k, h, ns) for k, by_h in seeded.items() for h, ns in by_h.items()]
+    if cases:
+        held = sum(all(OPTIMAL_PPC[0] <= n <= OPTIMAL_PPC[1] for n in ns) for _, _, ns in cases)
+        base = sum(OPTIMAL_PPC[0] <= int(r["fewest near the smallest"]) <= OPTIMAL_PPC[1] for r in table)
+        verdict = count_verdict(base + held, len(table) + len(cases), DIFFERS)
+        evidence += ("; over the regular and jittered layouts (sod/seeds), the fewest per cell near the smallest "
+                     "error, its range over the runs: " + "; ".join(
+                         f"h = {h:g}, {k.split('_')[0]}: {span(ns, 'g')}" for k, h, ns in cases))
+        table += [{"run": f"{len(ns)} runs (sod/seeds)", "case": f"h = {h:g}, {k.split('_')[0]}",
+                   "fewest near the smallest": span(ns, "g")} for k, h, ns in cases]
+    else:
+        evidence += "; sod/seeds holds no range over layouts: the regular layout only"
+    inside = [r for r in table if all(OPTIMAL_PPC[0] <= float(x) <= OPTIMAL_PPC[1]
+                                      for x in r["fewest near the smallest"].split(".."))]
+    sentence = (f"on Sod the fewest particles per cell within {SATURATION:.0%} of the smallest error lie in the "
+                f"source's {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} on {len(inside)} of {len(table)} meshes and errors")
+    return Finding(verdict, evidence, sentence, tuple(table))
 
 
 @claim("C15", source="one of four error sources", tables=(SUBSETS,), study="sod", problem="sod",
