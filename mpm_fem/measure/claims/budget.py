@@ -122,6 +122,7 @@ def e1_result(rows: list[dict]) -> dict | None:
 def e1_sentence(problem: str, r: dict) -> str:
     """E1's plain sentence on one problem from :func:`e1_result`."""
     ratios = f"{min(r['ratios']):.2g} to {max(r['ratios']):.2g}"
+    problem = problem.capitalize()
     if r["separate"] == 0:
         return (f"on {problem} the four stages of the step do not separate: their interactions are {ratios} times "
                 f"the gap between the all-MPM and the all-exact error, so no stage is the error's source alone")

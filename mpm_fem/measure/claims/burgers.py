@@ -8,8 +8,8 @@ import math
 from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, Finding, Tables, claim
 from mpm_fem.measure.claims.identification import source_matching
 from mpm_fem.measure.claims.mass import MASS_RULE, mass_finding
-from mpm_fem.measure.claims.rows import FIRST_ORDER, FLOOR_ORDER, GROWTH_ORDER, num, select, span
-from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, lumping_claim, ppc_claim
+from mpm_fem.measure.claims.rows import FIRST_ORDER, FLOOR_ORDER, GROWTH_ORDER, num, saturation, select, span
+from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, SATURATION, lumping_claim, ppc_claim
 from mpm_fem.measure.claims.stages import SUBSETS
 from mpm_fem.measure.schema import BURGERS_DIAGNOSIS, BURGERS_LUMPING, BURGERS_ORDERS, BURGERS_PPC
 from mpm_fem.measure.seeds import side
@@ -200,11 +200,17 @@ def diagnosis_text(rows: list[dict]) -> str:
 
 @claim("C3", source=f"{OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} particles per cell", tables=(BURGERS_PPC.name,),
        study="burgers", problem="burgers", thresholds=PPC_RULE)
-def _c3_burgers(t: Tables) -> tuple[str, str]:
+def _c3_burgers(t: Tables) -> Finding:
     rows = t[BURGERS_PPC.name]
     keys = {(r["method"], r["h"]) for r in rows}
     groups = {f"{m} h = {h}": select(rows, method=m, h=h) for m, h in sorted(keys)}
-    return ppc_claim(groups, (f"{BURGERS_SHOWN['where']}_{BURGERS_SHOWN['norm']}",))
+    key = f"{BURGERS_SHOWN['where']}_{BURGERS_SHOWN['norm']}"
+    verdict, evidence = ppc_claim(groups, (key,))
+    table = tuple({"case": g, "fewest near the smallest": saturation(v, key, SATURATION)} for g, v in groups.items())
+    inside = sum(OPTIMAL_PPC[0] <= r["fewest near the smallest"] <= OPTIMAL_PPC[1] for r in table)
+    sentence = (f"on Burgers the fewest particles per cell within {SATURATION:.0%} of the smallest error lie in the "
+                f"source's {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} on {inside} of {len(table)} methods and meshes")
+    return Finding(verdict, evidence, sentence, table)
 
 
 @claim("C15", source="one of four error sources", tables=(SUBSETS,), study="burgers", problem="burgers",

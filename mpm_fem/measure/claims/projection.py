@@ -87,7 +87,7 @@ _BAND_RULE = (f"least-squares L1 order over all meshes, point mass with the slid
        thresholds="bound/error >= 1 on every cell and node of every layout, and the fitted C inside the source's "
                   "band for the jittered and random layouts -> confirmed; the bound holds but C lies outside -> "
                   "partly; the bound fails somewhere -> refuted")
-def _c4(t: Tables) -> tuple[str, str]:
+def _c4(t: Tables) -> Finding:
     """D2 is scale-free: it depends on the pattern of the points in a cell, not on h. In the slides'
     formula the offsets are in physical units while the first term is not, so the fitted C is the mean
     squared offset in cell units and does not approach the slides' band."""
@@ -95,8 +95,13 @@ def _c4(t: Tables) -> tuple[str, str]:
     cs = [num(r, "C") for r in t[PROJECTION_D2_CONSTANT.name] if r["layout"] in ("jittered", "random")]
     inside = all(D2_C[0] <= c <= D2_C[1] for c in cs)
     verdict = REFUTED if ratio < 1 else (CONFIRMED if inside else PARTLY)
-    return verdict, (f"smallest bound/error {ratio:.3g}; fitted C (jittered, random) {span(cs, '.3g')}, "
-                     f"source [{D2_C[0]:.3g}, {D2_C[1]:.3g}]")
+    layouts = dict.fromkeys(r["layout"] for r in t[PROJECTION_D2_CONSTANT.name])
+    table = tuple({"layout": lay, "fitted C": span([num(r, "C") for r in t[PROJECTION_D2_CONSTANT.name]
+                                                    if r["layout"] == lay], ".3g")} for lay in layouts)
+    sentence = (f"Hickernell's bound holds with the smallest bound over error {ratio:.3g}; the fitted constant C is "
+                f"{span(cs, '.3g')} against the source's {D2_C[0]:.3g}-{D2_C[1]:.3g}")
+    return Finding(verdict, (f"smallest bound/error {ratio:.3g}; fitted C (jittered, random) {span(cs, '.3g')}, "
+                             f"source [{D2_C[0]:.3g}, {D2_C[1]:.3g}]"), sentence, table)
 
 
 @claim("C5", source=band_text("E_m"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE)

@@ -25,7 +25,7 @@ CROSSING_TOLERANCE, NO_JUMP = rule("CROSSING_TOLERANCE"), rule("NO_JUMP")
        thresholds=f"least-squares order in dt of every global error in [{GLOBAL_ORDER[0]}, {GLOBAL_ORDER[1]}] and of "
                   f"every local position error in [{LOCAL_ORDER[0]}, {LOCAL_ORDER[1]}] -> confirmed; some -> partly; "
                   "none -> refuted")
-def _c1(t: Tables) -> tuple[str, str]:
+def _c1(t: Tables) -> Finding:
     """With the point-mass basis node crossings make the solution a rough function of dt (C2), so its
     orders between successive refinements scatter about the fitted one."""
     fits = {(r["problem"], r["basis"], r["quantity"]): num(r, "fitted_order")
@@ -35,9 +35,16 @@ def _c1(t: Tables) -> tuple[str, str]:
     off = [" ".join(k) for k, o in fits.items() if not GLOBAL_ORDER[0] <= o <= GLOBAL_ORDER[1]]
     off += [f"{p} {b} local" for (p, b), o in local.items() if not LOCAL_ORDER[0] <= o <= LOCAL_ORDER[1]]
     total = len(fits) + len(local)
-    return count_verdict(total - len(off), total), (
+    table = tuple({"problem": p, "basis": b,
+                   "global orders": span([o for (p2, b2, _), o in fits.items() if (p2, b2) == (p, b)]),
+                   "local order of x_p": span([o for k, o in local.items() if k == (p, b)])}
+                  for p, b in dict.fromkeys((p, b) for p, b, _ in fits))
+    sentence = (f"the global error's order in dt is {span(fits.values())} and the local position error's "
+                f"{span(local.values())} over {len(fits)} and {len(local)} fits")
+    return Finding(count_verdict(total - len(off), total), (
         f"global order in dt {span(fits.values())}, local order of x_p {span(local.values())} over "
-        f"{len(fits)} global and {len(local)} local fits" + (f"; outside the band: {', '.join(off)}" if off else ""))
+        f"{len(fits)} global and {len(local)} local fits" + (f"; outside the band: {', '.join(off)}" if off else "")),
+        sentence, table)
 
 
 def _second_half(t: Tables) -> tuple[bool | None, str, tuple[dict, ...]]:
