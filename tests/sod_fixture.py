@@ -81,7 +81,8 @@ def made_up_tables(model=diverging, meshes=MESHES, seeds=study.SEEDS, counter=ex
     tables = {SOD_SEEDS: seed_rows,
               SOD_CONVERGENCE: builders.convergence_rows(seed_rows, regular, fem, fem, fv, study.SOURCE),
               SOD_REGIONS: builders.region_rows(regular, fem, fem), SOD_EXTREMA: builders.extrema_rows(regular)}
-    settings = {"fv": {"scheme": "FV MUSCL-HLLC (MC)", "limiter": "mc"}, "fem": {"viscosity": "viscosity everywhere"}}
+    settings = {"fv": {"scheme": "FV MUSCL-HLLC (MC)", "limiter": "mc"}, "fem": {"viscosity": "viscosity everywhere"},
+                "region_half_width": study.REGION_HALF_WIDTH, "T": study.T}
     with tempfile.TemporaryDirectory() as folder:
         (Path(folder) / "sod").mkdir()
         publish(Path(folder) / "sod", tables, settings)

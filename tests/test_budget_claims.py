@@ -1,7 +1,7 @@
 """The criteria of C1, C2, E1, E2 and C15 follow their numbers: a table perturbed to fail and one
 perturbed to pass give different verdicts. The time and budget tables are built here in the shape
 the studies write them (``studies/time.py``, ``studies/budget.py``), so the tests do not depend on
-which figures are committed; E2 and C15 mutate the committed tables."""
+which figures are committed; E2 and C15's second reading mutate the committed tables."""
 
 from __future__ import annotations
 
@@ -80,8 +80,7 @@ def test_e1_names_no_dominant_stage_when_the_attributions_disagree():
     verdict, evidence = judge("E1 (burgers)", _e1(_two_bases(TANGLED_TERMS)))
     assert verdict == "partly"
     assert "a dominant stage in 1 of 2: projection (mpm particles)" in evidence
-    assert "the attributions disagree for gimp particles (Shapley projection, forward interpolation, backward " \
-           "projection)" in evidence
+    assert "no stage named where the interactions exceed 1x the gap: gimp particles" in evidence
     assert "e.g. mpm particles at h = 0.02: projection alone adds 0.006" in evidence
 
 
@@ -95,7 +94,7 @@ def test_e1_sod_reads_both_norms_and_is_not_measured_without_its_table():
     groups = {**_two_bases(SEPARATE_TERMS), **_two_bases(TANGLED_TERMS, "nodes")}
     verdict, evidence = judge("E1 (sod)", _e1(groups, "sod"))
     assert verdict == "partly" and "the stages separate in 3 of 4" in evidence
-    assert "the attributions disagree for gimp nodes" in evidence
+    assert "no stage named where the interactions exceed 1x the gap: gimp nodes" in evidence
     assert judge("E1 (sod)", {})[0] == "not measured"
     incomplete = _e1(groups, "sod")["budget/subsets"][1:]  # the coarse mesh of mpm particles misses all exact
     assert "from the coarsest mesh to the finest: mpm particles 0.05, gimp" in judge(
@@ -115,7 +114,30 @@ def test_e1_on_the_committed_sod_budget_says_the_stages_do_not_separate():
     """The projection alone adds several times v(all MPM) on Sod: the interactions are not small."""
     verdict, evidence = judge("E1 (sod)", TABLES)
     assert evidence.startswith("the stages separate in 0 of ")
-    assert verdict in ("partly", "refuted")
+    assert verdict == "refuted" and "a dominant stage in 0 of" in evidence
+
+
+@pytest.mark.parametrize("x, named", [(0.011, True), (0.013, False)])
+def test_e1_names_no_dominant_stage_where_the_interactions_exceed_the_gap(x, named):
+    """The three attributions agree on the projection; the interactions (2x) are 0.94 and 1.1 times the
+    gap (0.0235): above it no stage is named, whatever the attributions say."""
+    from mpm_fem.measure.claims.budget import stage_findings
+
+    terms = {"projection": 0.02, "mass": 0.001, "interpolation": 0.002, "time": 0.0005,
+             "interpolation+time": x, "mass+time": -x}
+    found = stage_findings(_subsets({(0.02, "mpm", "particles"): terms}))
+    assert set(found["tops"].values()) == {"projection"}
+    assert found["dominant"] == ("projection" if named else None)
+
+
+def test_e1_gives_a_plain_sentence_and_a_table():
+    from claim_mutations import claim_named
+
+    tangled = claim_named("E1 (burgers)").finding(_e1({k: TANGLED_TERMS for k in _two_bases(TANGLED_TERMS)}))
+    assert tangled.verdict == "refuted" and "do not separate" in tangled.sentence
+    assert [r["dominant"] for r in tangled.table] == ["none", "none"]
+    separate = claim_named("E1 (burgers)").finding(_e1(_two_bases(SEPARATE_TERMS)))
+    assert "projection dominates" in separate.sentence and separate.sentence != tangled.sentence
 
 
 def _time_tables(global_order: float, local_order: float) -> dict:
@@ -144,26 +166,67 @@ def _crossing(p1_error: float, smooth: float) -> dict:
 
 
 def test_c2_needs_the_p1_formula_and_no_jump_for_the_smooth_basis():
-    assert_flips("C2", _crossing(0.3, 0.001), _crossing(0.02, 0.001))
+    orders = _orders_by_basis(0.75, 1.05)
+    assert_flips("C2", {**_crossing(0.3, 0.001), **orders}, {**_crossing(0.02, 0.001), **orders})
     assert judge("C2", _crossing(0.3, 0.001))[0] == "refuted"
-    assert judge("C2", _crossing(0.02, 0.5))[0] == "partly"
+    assert judge("C2", {**_crossing(0.02, 0.5), **orders})[0] == "partly"
 
 
-def test_e2_follows_the_last_refinement_orders():
-    meshes = sorted({r["h"] for r in TABLES["budget/bases"]}, key=float)  # the last refinement: meshes[1] -> [0]
-    finest = {"h": meshes[0]}
-    coarse = {r["basis"]: float(r["particles_L1"]) for r in TABLES["budget/bases"] if r["h"] == meshes[1]}
-    p1_fine = next(float(r["particles_L1"]) for r in TABLES["budget/bases"]
-                   if r["h"] == meshes[0] and r["basis"] == "mpm")
-    stalled = TABLES
-    for basis in ("gimp", "bspline"):  # the smooth bases level off as P1 does, a little worse (order P1's - 0.14)
-        stalled = mutate(stalled, "budget/bases", {**finest, "basis": basis},
-                         particles_L1=1.1 * coarse[basis] * p1_fine / coarse["mpm"])
-    converging = mutate(TABLES, "budget/bases", {**finest, "basis": "bspline"}, particles_L1=0.45 * coarse["bspline"])
-    assert_flips("E2", stalled, converging)
-    assert judge("E2", stalled)[0] == "refuted"
-    p1_converges = mutate(converging, "budget/bases", {**finest, "basis": "mpm"}, particles_L1=0.5 * coarse["mpm"])
-    assert judge("E2", p1_converges)[0] == "differs"
+def _orders_by_basis(p1: float, smooth: float) -> dict:
+    rows = [{"problem": p, "basis": b, "quantity": "velocity", "refine": "1", "dt": "0.01", "error": "0.001",
+             "order": "", "fitted_order": repr(p1 if b == "mpm" else smooth)}
+            for p in ("pulse", "burgers") for b in ("mpm", "gimp", "bspline")]
+    return {"time/time_order": rows}
+
+
+def test_c2_second_half_compares_p1s_order_in_dt_with_the_smooth_bases():
+    """P1 at most first order where the bases without a jump reach it: confirmed; P1 above first order,
+    or the smooth bases below it too (the integrator, not the jump, limits): partly; no smooth rows: partly,
+    said so."""
+    from claim_mutations import claim_named
+
+    passing = {**_crossing(0.02, 0.001), **_orders_by_basis(0.75, 1.05)}
+    assert judge("C2", passing)[0] == "confirmed"
+    assert_flips("C2", {**passing, **_orders_by_basis(1.6, 1.05)}, passing)
+    assert judge("C2", {**passing, **_orders_by_basis(0.75, 0.5)})[0] == "partly"
+    missing = {**passing, "time/time_order": [r for r in passing["time/time_order"] if r["basis"] == "mpm"]}
+    assert judge("C2", missing)[0] == "partly" and "second half not measured" in judge("C2", missing)[1]
+    found = claim_named("C2").finding(passing)
+    assert {"problem": "pulse", "quantity": "velocity", "P1": "0.75", "GIMP": "1.05", "B-spline": "1.05"} in found.table
+    assert "P1's global order in dt is 0.75 against 1.05 for the smooth bases" in found.sentence
+
+
+def _bases(orders: dict, runs: int = 1) -> dict:
+    """``budget/bases`` rows on four meshes from ``{basis: (order, order, order)}`` of the particle density
+    (the nodes first order); ``runs`` > 1 adds jittered runs at 8 per cell whose orders differ by 0.05 each."""
+    rows = []
+    for basis, os in orders.items():
+        for k in range(runs):
+            e, h = 0.01, 0.01
+            extra = {} if runs == 1 else {"ppc": "8", "layout": "regular" if k == 0 else "jittered", "seed": str(k)}
+            for step in (None, *os):
+                if step is not None:
+                    e, h = e / 2 ** (step + 0.05 * k), h / 2
+                rows.append({"h": repr(h), "basis": basis, "ok": "True", "particles_L1": repr(e), "nodes_L1": repr(h),
+                             "plateau_noise": "0.001", **extra})
+    return {"budget/bases": rows}
+
+
+def test_e2_follows_the_orders_over_the_last_two_refinements():
+    from claim_mutations import claim_named
+
+    converging = _bases({"mpm": (1.0, -0.3, -0.6), "bspline": (1.0, 0.9, 0.85)})
+    assert judge("E2", converging)[0] == "confirmed"
+    one_step = _bases({"mpm": (1.0, -0.3, -0.6), "bspline": (1.0, 0.6, 0.85)})  # only the last order converges
+    assert_flips("E2", one_step, converging, "confirmed")
+    assert judge("E2", one_step)[0] == "partly"
+    assert judge("E2", _bases({"mpm": (1.0, -0.3, -0.6), "bspline": (1.0, -0.4, -0.7)}))[0] == "refuted"
+    assert judge("E2", _bases({"mpm": (1.0, 0.9, -0.6), "bspline": (1.0, 0.9, 0.85)}))[0] == "differs"
+    found = claim_named("E2").finding(converging)
+    assert "-0.30, -0.60 with P1, 0.90, 0.85 with the C1 B-spline" in found.sentence
+    seeded = claim_named("E2").finding(_bases({"mpm": (1.0, -0.3, -0.6), "bspline": (1.0, 0.9, 0.85)}, runs=3))
+    assert seeded.verdict == "confirmed" and "(3 runs each)" in seeded.evidence
+    assert seeded.table[1]["particle density orders"].startswith("0.95 [0.90, 1.00]")
 
 
 # ---------------------------------------------------------------- C15: the direct comparison, with its sign
@@ -175,45 +238,59 @@ def test_the_sign_of_lumping_per_method(ratios, sign):
     assert lumping_sign(ratios) == sign
 
 
-def _sod_mass(mpm: float, fem: float = 1.0) -> dict:
-    return mutate(TABLES, "sod/mass", mpm_consistent_over_lumped_nodes=mpm, mpm_consistent_over_lumped_particles=mpm,
-                  fem_consistent_over_lumped=fem)
+def _mass(mass: float, interaction: float = 0.0005, problem: str = "burgers", **more) -> dict:
+    """The committed tables with a made-up budget of the point-mass basis on two meshes: the mass stage's
+    main effect ``mass`` and its interaction with the projection ``interaction``."""
+    terms = {**MAIN, "mass": mass, "mass+projection": interaction}
+    rows = _subsets({(0.04, "mpm", "particles"): terms, (0.02, "mpm", "particles"): terms}, problem)
+    return {**TABLES, "budget/subsets": rows, **more}
 
 
-def test_c15_sod_is_judged_on_mpm_with_the_sign_of_lumping():
-    """Consistent clearly better in MPM: a source (confirmed); clearly worse: lumping compensates
-    (differs); within the band: neutral (refuted). The FEM beside does not enter the verdict."""
-    assert_flips("C15 (sod)", _sod_mass(1.5), _sod_mass(0.5))
-    assert judge("C15 (sod)", _sod_mass(1.5))[0] == "differs"
-    assert judge("C15 (sod)", _sod_mass(1.0, fem=0.5))[0] == "refuted"
-    assert judge("C15 (sod)", _sod_mass(0.5, fem=2.0))[0] == "confirmed"
-    one_mesh = mutate(_sod_mass(1.0), "sod/mass", {"h": 0.01}, mpm_consistent_over_lumped_nodes=0.5)
-    assert judge("C15 (sod)", one_mesh)[0] == "partly"
-    evidence = judge("C15 (sod)", _sod_mass(1.5))[1]
-    assert evidence.startswith("MPM nodes: compensating (consistent/lumped 1.50 at h = 0.00125..0.01)")
-    assert "beside, on the same meshes: FEM: neutral (consistent/lumped 1.00" in evidence
+@pytest.mark.parametrize("problem", ["sod", "burgers"])
+def test_c15_reads_the_mass_stage_of_the_error_budget(problem):
+    """Alone, the mass stage adds 25% of the all-MPM error (a source); with an interaction of 0.0005 it
+    separates (confirmed), with 0.004 its interactions exceed its own effect (partly); alone 4%: not a
+    source (refuted); alone negative: it compensates (differs)."""
+    label = f"C15 ({problem})"
+    source = _mass(0.003, problem=problem)
+    assert_flips(label, _mass(0.0005, problem=problem), source)
+    assert judge(label, _mass(0.0005, problem=problem))[0] == "refuted"
+    assert judge(label, _mass(0.003, 0.004, problem=problem))[0] == "partly"
+    assert judge(label, _mass(-0.002, problem=problem))[0] == "differs"
+    verdict, evidence = judge(label, source)
+    assert evidence.startswith("the mass stage alone adds 25% to 25% of the all-MPM error")
+    assert "Second reading, consistent against lumped mass (" in evidence
 
 
-def test_c15_burgers_follows_the_consistent_over_lumped_ratio_of_mpm():
-    mpm = {"method": "mpm_calculated"}, {"method": "mpm_exact"}
-    source = TABLES
-    for where in mpm:
-        source = mutate(source, "burgers/lumping", {**where, "mass": "consistent"}, L2=1e-9)
-    assert_flips("C15 (burgers)", TABLES, source)
-    assert judge("C15 (burgers)", TABLES)[0] == "differs"  # the committed MPM: consistent clearly worse
-    neutral = TABLES
-    for where in mpm:
-        lumped = {r["h"]: r["L2"] for r in TABLES["burgers/lumping"] if r["method"] == where["method"]
-                  and r["mass"] == "lumped"}
-        neutral = mutate(neutral, "burgers/lumping", {**where, "mass": "consistent"},
-                         L2=lambda r, lumped=lumped: lumped[r["h"]])
-    assert judge("C15 (burgers)", neutral)[0] == "refuted"
+def test_c15_gives_ranges_over_the_runs_and_a_sentence():
+    """Two runs (a regular and a jittered layout at 8 per cell): the share alone is a range; one run
+    below the threshold makes the case no source over every run."""
+    one = _mass(0.003)["budget/subsets"]
+    other = _mass(0.0005)["budget/subsets"]
+    rows = ([{**r, "ppc": "8", "layout": "regular", "seed": "0"} for r in one]
+            + [{**r, "ppc": "8", "layout": "jittered", "seed": "1"} for r in other])
+    both = {**TABLES, "budget/subsets": rows}
+    from claim_mutations import claim_named
+
+    found = claim_named("C15 (burgers)").finding(both)
+    assert found.verdict == "refuted" and found.table[0]["ppc"] == "8 ppc"
+    assert "[" in found.table[0]["mass alone / all-MPM"]
+    assert "lumped-mass FE stage alone changes the all-exact error by" in found.sentence
+    assert "lumped-mass FE stage alone adds 25% to 25%" in claim_named("C15 (burgers)").finding(_mass(0.003)).sentence
 
 
-def test_c15_needs_no_error_budget():
-    without = {k: v for k, v in TABLES.items() if k != "budget/shapley"}
-    assert judge("C15 (sod)", without)[0] != "not measured"
-    assert judge("C15 (burgers)", without)[0] != "not measured"
+def test_c15_keeps_the_consistent_lumped_reading_beside():
+    """The second reading follows sod/mass but does not enter the verdict; without it C15 still judges."""
+    compensating = mutate(_mass(0.003, problem="sod"), "sod/mass", mpm_consistent_over_lumped_nodes=1.5,
+                          mpm_consistent_over_lumped_particles=1.5)
+    source = mutate(_mass(0.003, problem="sod"), "sod/mass", mpm_consistent_over_lumped_nodes=0.5,
+                    mpm_consistent_over_lumped_particles=0.5)
+    assert judge("C15 (sod)", compensating)[0] == judge("C15 (sod)", source)[0] == "confirmed"
+    assert "(differs): MPM nodes: compensating (consistent/lumped 1.50" in judge("C15 (sod)", compensating)[1]
+    assert "(confirmed): MPM nodes: source of error" in judge("C15 (sod)", source)[1]
+    without = {k: v for k, v in _mass(0.003, problem="sod").items() if k != "sod/mass"}
+    assert judge("C15 (sod)", without)[0] == "confirmed" and "no table `sod/mass.csv`" in judge("C15 (sod)", without)[1]
+    assert judge("C15 (sod)", {k: v for k, v in TABLES.items() if k != "budget/subsets"})[0] == "not measured"
 
 
 # ---------------------------------------------------------------- E5: the budget of the closest remedy
@@ -239,3 +316,19 @@ def test_e5_names_the_stage_that_dominates_the_closest_remedys_remaining_error()
     assert "time carries 60%" in moved and "projection carries" not in moved
     assert "no error budget of its basis bspline_gimp" in judge(
         "E5", {**_e5_tables((0.7, 0, 0.2, 0.1)), "budget/shapley": []})[1]
+
+
+def test_e5_states_e1s_result_and_never_contradicts_it():
+    """E5's explanation names no budget finding; its evidence and sentence say what E1 found: that the
+    stages do not separate (then no remedy is tied to a stage), or where they separate and what dominates."""
+    from claim_mutations import claim_named
+
+    assert "the budget found" not in claim_named("E5").explanation
+    tangled = {**_e5_tables((0.7, -0.1, 0.3, 0.1)),
+               "budget/subsets": _subsets({k: TANGLED_TERMS for k in _two_bases(TANGLED_TERMS)}, "sod")}
+    found = claim_named("E5").finding(tangled)
+    assert "the error budget's stages do not separate (E1" in found.evidence
+    assert "no remedy is tied to one stage" in found.sentence
+    separate = claim_named("E5").finding({**tangled, "budget/subsets": _subsets(_two_bases(SEPARATE_TERMS), "sod")})
+    assert "separate in 2 of 2 bases and norms (E1), projection dominating there" in separate.sentence
+    assert judge("E1 (sod)", tangled)[0] == "refuted" and found.verdict == separate.verdict

@@ -37,9 +37,9 @@ from mpm_fem.measure.claims.projection import BAND_TOLERANCE, JUDGED_LAYOUTS, OR
 from mpm_fem.measure.claims.shared import LUMPING_BAND, SATURATION, lumping_sign
 from mpm_fem.measure.claims.sod import (
     CONVERGENCE, CONVERGING_ORDER, EXTREMA_RATIO, FLOOR_MESHES, FLOOR_ORDER, FLOOR_STEPS, SIDE_BY_SIDE, WAVE_REGIONS,
-    WAVE_SHARE)
+    WAVE_DENSITY)
 from mpm_fem.measure.claims import reproduce  # noqa: F401  (registers E4)
-from mpm_fem.measure.claims.burgers import BURGERS_SHOWN, C13_METHODS, FIRST_ORDER
+from mpm_fem.measure.claims.burgers import BURGERS_SHOWN, FIRST_ORDER
 from mpm_fem.measure.claims.time import CROSSING_TOLERANCE, GLOBAL_ORDER, LOCAL_ORDER, NO_JUMP
 from mpm_fem.measure.claims.budget import (
     ROUNDOFF, SEPARATE, SEQUENCES, STEP_ORDER, SUBSETS, _roundoff_text, budget_findings, sequential, stage_findings)
@@ -53,9 +53,9 @@ __all__ = [
     "num", "select", "span", "count_verdict", "saturation", "successive_orders",
     "BAND_TOLERANCE", "JUDGED_LAYOUTS", "ORDERS",
     "SATURATION", "LUMPING_BAND", "lumping_sign",
-    "CONVERGENCE", "FLOOR_ORDER", "CONVERGING_ORDER", "FLOOR_MESHES", "FLOOR_STEPS", "WAVE_REGIONS", "WAVE_SHARE",
+    "CONVERGENCE", "FLOOR_ORDER", "CONVERGING_ORDER", "FLOOR_MESHES", "FLOOR_STEPS", "WAVE_REGIONS", "WAVE_DENSITY",
     "EXTREMA_RATIO", "SIDE_BY_SIDE",
-    "BURGERS_SHOWN", "FIRST_ORDER", "C13_METHODS",
+    "BURGERS_SHOWN", "FIRST_ORDER",
     "GLOBAL_ORDER", "LOCAL_ORDER", "CROSSING_TOLERANCE", "NO_JUMP",
     "SUBSETS", "STEP_ORDER", "SEPARATE", "SEQUENCES", "ROUNDOFF", "budget_findings", "stage_findings", "sequential",
     "_roundoff_text",

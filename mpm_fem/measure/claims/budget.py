@@ -6,28 +6,22 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Tables, claim
-from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, select, span
-from mpm_fem.measure.decomposition import decompose
-from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF, BUDGET_SUBSETS
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Finding, Tables, claim
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
+from mpm_fem.measure.claims.rules import rule
+from mpm_fem.measure.claims.stages import STEP_ORDER, SUBSETS, decomposition, run_label, runs, values
+from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF
+from mpm_fem.measure.spread import Spread, spread
 
-SUBSETS = BUDGET_SUBSETS.name
-#: E1: the stages in the order the step runs them (projection to the grid, the FE solve with the
-#: lumped mass, the interpolation back to the particles, the time update); the budget's stages.
-STEP_ORDER = ("projection", "mass", "interpolation", "time")
 #: E1 (a): the stages separate when their interactions (the Moebius terms of two stages or more), in
 #: total magnitude, are at most SEPARATE of |v(all MPM) - v(all exact)|.
-SEPARATE = 0.25
+SEPARATE = rule("SEPARATE")
+#: E1 (b): no stage is named dominant where the interactions exceed ATTRIBUTABLE times the gap.
+ATTRIBUTABLE = rule("ATTRIBUTABLE")
 #: E1 (b): the attributions that must name the same largest stage for it to dominate: the Shapley
 #: value, and the error removed by each stage when the stages are made exact one after another from
 #: all MPM, in the step's order and in its reverse.
 SEQUENCES = {"forward": STEP_ORDER, "backward": STEP_ORDER[::-1]}
-# E2: a basis keeps converging with a last-refinement order of the particle density L1 above C11's
-# CONVERGING_ORDER, and P1 has levelled off below C11's FLOOR_ORDER.
-
-
-def _subset(label: str) -> frozenset:
-    return frozenset() if label == "none" else frozenset(label.split("+"))
 
 
 def sequential(v: dict, order: tuple) -> dict:
@@ -45,12 +39,11 @@ def stage_findings(rows: list[dict]) -> dict | None:
     """E1's two questions on the ``budget/subsets`` rows of one (problem, h, basis, norm): the
     interactions' total magnitude over |v(all MPM) - v(all exact)| (``interactions``), whether the
     stages separate, the largest stage by each attribution (``tops``: Shapley, forward, backward),
-    the dominant stage when they agree (else None), the largest main effect (``alone``: stage,
+    the dominant stage when they agree and the interactions are at most ATTRIBUTABLE times the gap
+    (else None), the largest main effect (``alone``: stage,
     m({s})) and the end points; None when a subset of STEP_ORDER is missing."""
-    v = {_subset(r["mpm_stages"]): num(r, "error") for r in rows}
-    try:
-        d = decompose(v, STEP_ORDER)
-    except ValueError:
+    v, d = values(rows), decomposition(rows)
+    if d is None:
         return None
     inter = sum(abs(m) for m in d.interactions().values())
     ratio = inter / abs(d.gap) if d.gap else math.inf
@@ -59,21 +52,22 @@ def stage_findings(rows: list[dict]) -> dict | None:
         removed = sequential(v, order)
         tops[name] = max(order, key=lambda s: removed[s])
     alone = max(STEP_ORDER, key=lambda s: abs(d.moebius[frozenset({s})]))
+    agree = len(set(tops.values())) == 1 and ratio <= ATTRIBUTABLE
     return {"interactions": ratio, "separate": ratio <= SEPARATE, "tops": tops,
-            "dominant": tops["Shapley"] if len(set(tops.values())) == 1 else None,
+            "dominant": tops["Shapley"] if agree else None,
             "alone": (alone, d.moebius[frozenset({alone})]), "mpm": d.total, "exact": d.floor}
 
 
 def budget_findings(rows: list[dict]) -> dict:
-    """:func:`stage_findings` of every mesh, per ``(basis, norm)`` of one problem's
-    ``budget/subsets`` rows: ``{(basis, norm): [(h, findings), ...]}``, coarsest mesh first."""
-    out = {}
-    for basis, norm in dict.fromkeys((r["basis"], r["norm"]) for r in rows):
-        sub = select(rows, basis=basis, norm=norm)
-        hs = sorted({num(r, "h") for r in sub}, reverse=True)
-        found = [(h, stage_findings([r for r in sub if num(r, "h") == h])) for h in hs]
-        out[(basis, norm)] = [(h, f) for h, f in found if f is not None]
-    return {k: v for k, v in out.items() if v}
+    """:func:`stage_findings` of every mesh, per ``(basis, norm, run)`` of one problem's
+    ``budget/subsets`` rows (``run``: particles per cell, layout and seed where the table records them,
+    :func:`~.stages.run_label`): ``{(basis, norm, run): [(h, findings), ...]}``, coarsest mesh first."""
+    out: dict = {}
+    for (basis, norm, h, run), sub in runs(rows).items():
+        found = stage_findings(sub)
+        if found is not None:
+            out.setdefault((basis, norm, run), []).append((h, found))
+    return {k: sorted(v, key=lambda x: -x[0]) for k, v in out.items()}
 
 
 def _e1_text(found: dict) -> str:
@@ -82,7 +76,7 @@ def _e1_text(found: dict) -> str:
     n, sep = len(finest), [k for k, (_, f) in finest.items() if f["separate"]]
     dominant = {k: f["dominant"] for k, (_, f) in finest.items() if f["dominant"]}
     hs = span([h for h, _ in finest.values()], "g")
-    names = {k: f"{k[0]} {k[1]}" for k in finest}
+    names = {k: " ".join(p for p in k if p) for k in finest}
     ratios = [f["interactions"] for _, f in finest.values()]
     head = (f"the stages separate in {len(sep)} of {n} bases and norms at h = {hs} (the interactions are "
             f"{span(ratios, '.2g')}x |v(all MPM) - v(all exact)|, at most {SEPARATE:.0%} to separate)")
@@ -91,8 +85,12 @@ def _e1_text(found: dict) -> str:
         by_stage.setdefault(s, []).append(names[k])
     head += (f"; a dominant stage in {len(dominant)} of {n}: "
              + ("; ".join(f"{s} ({', '.join(ks)})" for s, ks in by_stage.items()) if dominant else "none"))
+    tangled = [names[k] for k, (_, f) in finest.items() if f["interactions"] > ATTRIBUTABLE]
     undecided = [f"{names[k]} (" + ", ".join(f"{a} {s}" for a, s in f["tops"].items()) + ")"
-                 for k, (_, f) in finest.items() if not f["dominant"]]
+                 for k, (_, f) in finest.items() if not f["dominant"] and names[k] not in tangled]
+    if tangled:
+        head += (f"; no stage named where the interactions exceed {ATTRIBUTABLE:g}x the gap: "
+                 + ", ".join(tangled))
     if undecided:
         head += "; the attributions disagree for " + ", ".join(undecided)
     (k0, (h0, f0)) = next(iter(finest.items()))
@@ -103,21 +101,54 @@ def _e1_text(found: dict) -> str:
     return head + f"; interactions / |v(all MPM) - v(all exact)| from the coarsest mesh to the finest: {trend}"
 
 
+def e1_result(rows: list[dict]) -> dict | None:
+    """E1's result on one problem's ``budget/subsets`` rows, at the finest mesh of every basis and
+    norm: ``cases`` (how many), ``separate`` and ``dominant`` (how many), the interactions over the gap
+    (``ratios``), the meshes (``h``) and the verdict: ``refuted`` when the stages separate nowhere,
+    ``confirmed`` when they separate and one stage dominates everywhere, else ``partly``. None without
+    a complete budget. E5 reads it to say what the budget found."""
+    found = budget_findings(rows)
+    if not found:
+        return None
+    finest = [series[-1][1] for series in found.values()]
+    n, sep = len(finest), sum(f["separate"] for f in finest)
+    dom = sum(f["dominant"] is not None for f in finest)
+    verdict = REFUTED if sep == 0 else CONFIRMED if sep == dom == n else PARTLY
+    return {"cases": n, "separate": sep, "dominant": dom, "ratios": [f["interactions"] for f in finest],
+            "h": [series[-1][0] for series in found.values()], "verdict": verdict, "found": found,
+            "stages": sorted({f["dominant"] for f in finest if f["dominant"]})}
+
+
+def e1_sentence(problem: str, r: dict) -> str:
+    """E1's plain sentence on one problem from :func:`e1_result`."""
+    ratios = f"{min(r['ratios']):.2g} to {max(r['ratios']):.2g}"
+    problem = problem.capitalize()
+    if r["separate"] == 0:
+        return (f"on {problem} the four stages of the step do not separate: their interactions are {ratios} times "
+                f"the gap between the all-MPM and the all-exact error, so no stage is the error's source alone")
+    return (f"on {problem} the stages separate in {r['separate']} of {r['cases']} bases and norms (interactions "
+            f"{ratios} times the gap)" + (f"; {', '.join(r['stages'])} dominates where they do" if r["stages"] else ""))
+
+
 def _e1(problem: str) -> Criterion:
-    def criterion(t: Tables) -> tuple[str, str]:
+    def criterion(t: Tables) -> Finding:
         """The sixteen combinations of the four stages in MPM or exact form are the raw measurements.
         The stages separate when the error of every combination is close to the all-exact error plus
         the errors each stage adds alone: the Moebius interactions, which measure the departure from
         that sum, are small beside the gap between all MPM and all exact. A stage dominates when the
         Shapley value and the errors removed by making the stages exact one after another, in the
-        step's order and in its reverse, name it as the largest; where the interactions are large these
-        attributions can disagree, and then no stage is named."""
-        found = budget_findings(select(t[SUBSETS], problem=problem))
-        if not found:
+        step's order and in its reverse, name it as the largest and the interactions do not exceed the
+        gap; where the interactions are large these attributions are artefacts of the order, and then
+        no stage is named."""
+        r = e1_result(select(t[SUBSETS], problem=problem))
+        if r is None:
             return "not measured", f"no complete set of the {2 ** len(STEP_ORDER)} combinations of {STEP_ORDER}"
-        finest = [series[-1][1] for series in found.values()]
-        hits = sum(f["separate"] for f in finest) + sum(f["dominant"] is not None for f in finest)
-        return count_verdict(hits, 2 * len(finest)), _e1_text(found) + _roundoff_text(t, problem)
+        table = tuple({"basis": k[0], "norm": k[1], "run": k[2] or "regular", "h": f"{series[-1][0]:g}",
+                       "interactions / gap": f"{series[-1][1]['interactions']:.2g}",
+                       "separate": str(series[-1][1]["separate"]), "dominant": series[-1][1]["dominant"] or "none"}
+                      for k, series in r["found"].items())
+        return Finding(r["verdict"], _e1_text(r["found"]) + _roundoff_text(t, problem), e1_sentence(problem, r),
+                       table)
     return criterion
 
 
@@ -143,34 +174,65 @@ _E1_RULE = (f"at the finest mesh of every basis and norm, (a) the interactions o
             f"stages or more), in total magnitude, are at most {SEPARATE:.0%} of |v(all MPM) - v(all exact)| (the "
             "stages separate) and (b) the Shapley value and the sequential replacement (the stages made exact one "
             f"after another from all MPM, in the step's order {' -> '.join(STEP_ORDER)} and in its reverse) name the "
-            "same largest stage (it dominates) -> confirmed; some of these -> partly; none -> refuted. Read from "
+            f"same largest stage, with the interactions at most {ATTRIBUTABLE:g}x the gap (it dominates) -> "
+            "confirmed; the stages separate nowhere -> refuted (no stage named); otherwise partly. Read from "
             "budget/subsets, the value of every combination")
 for _problem in ("sod", "burgers"):
     claim("E1", source="the four error sources of the slides (projection, FE + mass lumping, interpolation, time)",
           tables=(SUBSETS,), study="budget", problem=_problem, thresholds=_E1_RULE)(_e1(_problem))
 
 
-@claim("E2", source="whether a smooth basis removes the stagnation of C11", tables=(BUDGET_BASES.name,), study="budget",
-       thresholds=f"P1's particle density L1 order over the last refinement is below {FLOOR_ORDER} and a C1 basis "
-                  f"keeps it above {CONVERGING_ORDER} -> confirmed; a C1 basis above P1 -> partly; none above P1 -> "
-                  "refuted; P1 not levelled off -> differs")
-def _e2(t: Tables) -> tuple[str, str]:
-    rows = select(t[BUDGET_BASES.name], ok="True")
-    last = {}
-    for basis in dict.fromkeys(r["basis"] for r in rows):
-        sub = sorted(select(rows, basis=basis), key=lambda r: -num(r, "h"))[-2:]
-        if len(sub) == 2:
-            last[basis] = ({k: math.log(num(sub[0], k) / num(sub[1], k)) / math.log(num(sub[0], "h") / num(sub[1], "h"))
-                            for k in ("particles_L1", "nodes_L1")}
-                           | {"h": sub[1]["h"], "noise": num(sub[1], "plateau_noise")})
-    if "mpm" not in last or len(last) < 2:
-        return "not measured", "fewer than two meshes or no point-mass row"
-    p1, smooth = last["mpm"]["particles_L1"], {b: v["particles_L1"] for b, v in last.items() if b != "mpm"}
-    verdict = (DIFFERS if p1 >= FLOOR_ORDER else CONFIRMED if max(smooth.values()) > CONVERGING_ORDER
-               else PARTLY if max(smooth.values()) > p1 else REFUTED)
-    return verdict, ("last-refinement order of the particle density L1: "
-                     + ", ".join(f"{b} {v['particles_L1']:.2f}" for b, v in last.items())
-                     + "; nodes " + ", ".join(f"{b} {v['nodes_L1']:.2f}" for b, v in last.items())
-                     + f"; plateau std(v_p) at h = {last['mpm']['h']}: "
-                     + ", ".join(f"{b} {v['noise']:.3g}" for b, v in last.items()))
+FLOOR_STEPS = int(rule("FLOOR_STEPS"))
 
+
+def _tail_orders(rows: list[dict], key: str) -> list[Spread]:
+    """The orders of ``key`` over the last FLOOR_STEPS refinements of one basis, each a range over its
+    runs (particles per cell, layout and seed where the table records them; one run otherwise)."""
+    per_run: dict[str, list[dict]] = {}
+    for r in rows:
+        per_run.setdefault(run_label(r), []).append(r)
+    series = [successive_orders(sorted(v, key=lambda r: -num(r, "h")), key)[-FLOOR_STEPS:] for v in per_run.values()]
+    steps = min(map(len, series), default=0)
+    return [spread(s[len(s) - steps + k] for s in series) for k in range(steps)]
+
+
+@claim("E2", source="whether a smooth basis removes the stagnation of C11", tables=(BUDGET_BASES.name,), study="budget",
+       thresholds=f"over the last {FLOOR_STEPS} refinements (each order a range over the runs: particles per cell, "
+                  f"layouts and seeds where the table holds them): P1's particle density L1 orders all below "
+                  f"{FLOOR_ORDER} and a C1 basis's all at least {CONVERGING_ORDER} -> confirmed; a C1 basis above P1 "
+                  "on every one -> partly; none above P1 -> refuted; P1 not levelled off -> differs")
+def _e2(t: Tables) -> Finding:
+    rows = select(t[BUDGET_BASES.name], ok="True")
+    tails = {b: {k: _tail_orders(select(rows, basis=b), k) for k in ("particles_L1", "nodes_L1")}
+             for b in dict.fromkeys(r["basis"] for r in rows)}
+    tails = {b: v for b, v in tails.items() if len(v["particles_L1"]) == FLOOR_STEPS}
+    if "mpm" not in tails or len(tails) < 2:
+        return Finding("not measured", f"fewer than {FLOOR_STEPS + 1} meshes or no point-mass row")
+    p1 = tails["mpm"]["particles_L1"]
+    smooth = {b: v["particles_L1"] for b, v in tails.items() if b != "mpm"}
+    converges = [b for b, o in smooth.items() if all(x.above(CONVERGING_ORDER) for x in o)]
+    above = [b for b, o in smooth.items() if all(x.lo > y.hi for x, y in zip(o, p1, strict=True))]
+    verdict = (DIFFERS if not all(x.below(FLOOR_ORDER) for x in p1) else CONFIRMED if converges
+               else PARTLY if above else REFUTED)
+    runs_n = max(x.n for x in p1)
+    finest = sorted(rows, key=lambda r: num(r, "h"))[0]["h"]
+    noise = {b: span([num(r, "plateau_noise") for r in select(rows, basis=b, h=finest)], ".3g") for b in tails}
+    table = tuple({"basis": b, "particle density orders": ", ".join(o.text() if o.n > 1 else f"{o.mean:.2f}"
+                                                                    for o in v["particles_L1"]),
+                   "nodal density orders": ", ".join(f"{o.mean:.2f}" for o in v["nodes_L1"]),
+                   f"plateau std(v_p) at h = {finest}": noise[b]} for b, v in tails.items())
+    sentence = (f"over the last {FLOOR_STEPS} refinements the particle density error's order is "
+                + ", ".join(f"{r['particle density orders']} with {_BASIS_NAMES.get(r['basis'], r['basis'])}"
+                            for r in table))
+    return Finding(verdict, (f"particle density L1 orders over the last {FLOOR_STEPS} refinements ({runs_n} run"
+                             f"{'s' if runs_n > 1 else ''} each): "
+                             + "; ".join(f"{r['basis']} {r['particle density orders']}"
+                                         for r in table)
+                             + "; nodes " + "; ".join(f"{r['basis']} {r['nodal density orders']}" for r in table)
+                             + f"; plateau std(v_p) at h = {finest}: "
+                             + ", ".join(f"{b} {v}" for b, v in noise.items())),
+                   sentence, table)
+
+
+_BASIS_NAMES = {"mpm": "P1", "gimp": "GIMP", "bspline": "the C1 B-spline",
+                "bspline_gimp": "the particle-domain B-spline"}

@@ -36,18 +36,25 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
+from mpm_fem.measure.claims.rows import (
+    CONVERGING_ORDER,
+    FLOOR_ORDER,
+    GROWTH_ORDER,
+    num,
+    select,
+    span,
+    successive_orders,
+)
+from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import DRIFT
 
 #: The variant every other one changes one thing against: the Sod study's MPM settings.
 STUDY = "study settings"
-#: An order of the particle density L1 error below GROWTH_ORDER: the error grows as h shrinks.
-GROWTH_ORDER = 0.0
 #: A variant whose error still grows reduces the growth when its order is at least REDUCED times the
 #: study settings' (both negative: at most half as fast).
-REDUCED = 0.5
+REDUCED = rule("REDUCED")
 #: Nodal L1 errors within SAME_NODES of each other (relative) count as the same motion.
-SAME_NODES = 1e-3
+SAME_NODES = rule("SAME_NODES")
 
 
 def _ok(rows: list[dict]) -> list[dict]:
@@ -111,7 +118,7 @@ def mechanism(tables) -> str:
         p = [q for q in (_order(s, hs) for s in seeds.values()) if math.isfinite(q)]
         if len(p) >= 2:
             spreads.append(max(p) - min(p))
-    band = max(spreads, default=0.0)
+    band = max(spreads, default=0)
     measured = {n: (_ok(series[n])[-2:], _order(series[n], hs)) for n in names}
     measured = {n: m for n, m in measured.items() if math.isfinite(m[1])}
     p_study = measured[STUDY][1]

@@ -7,11 +7,22 @@ import math
 from collections.abc import Mapping
 
 from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED
+from mpm_fem.measure.claims.rules import rule
 
-#: The study's one convergence threshold: an observed order at or above CONVERGING_ORDER counts as
-#: converging, one below FLOOR_ORDER as a floor (the error no longer falls with h). Every claim that
-#: reads an order uses these two, and counts an order only when its interval over seeds lies on one side.
-CONVERGING_ORDER, FLOOR_ORDER = 0.7, 0.5
+#: The study's one convergence threshold (the rule book): an observed order at or above CONVERGING_ORDER
+#: counts as converging, one below FLOOR_ORDER as a floor (the error no longer falls with h), one below
+#: GROWTH_ORDER as a growing error. Every claim that reads an order uses these, and counts an order only
+#: when its interval over seeds lies on one side. An observed order is a stated order n within
+#: ORDER_TOLERANCE (:func:`first_order`, :func:`in_band`).
+CONVERGING_ORDER, FLOOR_ORDER, GROWTH_ORDER = rule("CONVERGING_ORDER"), rule("FLOOR_ORDER"), rule("GROWTH_ORDER")
+ORDER_TOLERANCE = rule("ORDER_TOLERANCE")
+#: 'first order' in a convergence claim: an order at least this (the one definition, rules.ORDER_TOLERANCE)
+FIRST_ORDER = 1 - ORDER_TOLERANCE
+
+
+def in_band(order: float, lo: float, hi: float) -> bool:
+    """Whether an observed ``order`` lies in the stated band ``[lo, hi]`` widened by ORDER_TOLERANCE."""
+    return lo - ORDER_TOLERANCE <= order <= hi + ORDER_TOLERANCE
 
 
 def num(row: Mapping, key: str) -> float:
@@ -52,7 +63,7 @@ def count_verdict(hits: int, total: int, none: str = REFUTED) -> str:
     return CONFIRMED if hits == total else (PARTLY if hits else none)
 
 
-def saturation(rows: list[dict], key: str, ppc: str = "ppc", within: float = 0.05) -> int:
+def saturation(rows: list[dict], key: str, within: float, ppc: str = "ppc") -> int:
     """The fewest particles per cell whose ``key`` error is within ``within`` of the smallest one."""
     values = [(int(num(r, ppc)), num(r, key)) for r in rows if math.isfinite(num(r, key))]
     best = min(e for _, e in values)

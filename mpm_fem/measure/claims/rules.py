@@ -54,6 +54,113 @@ def rule(name: str) -> float:
         raise KeyError(f"no rule {name!r} in the rule book; rules: {', '.join(RULES)}") from None
 
 
+_STUDY = "the study's (the slides state no number)"
+
+# ---------------------------------------------------------------- orders: one meaning of each word
+_add("ORDER_TOLERANCE", 0.2,
+     "an observed order counts as a stated order n (first order: n = 1) when within this distance of it; a band "
+     "[a, b] of the slides widens by it on each side; 'first order' in a convergence claim: an order at least "
+     "1 minus it (C1, C5-C10, C13 share this one definition)",
+     _STUDY + ": the slides state orders as whole numbers (O(dt), O(h^p) with 1 <= p <= 2) without a tolerance. "
+     "0.2 replaces the three the criteria had (+-0.2 in C1, >= 0.7 in C13, +-0.1 in C5-C9): it is four times "
+     "the spread of the fitted first orders over the seeded layouts of the projection study (0.96-1.05) and "
+     "less than half the gap to the next half order, so a first-order error never reads as order 0.5 or 1.5",
+     ("C1", "C5", "C6", "C7", "C8", "C9", "C10", "C13"))
+_add("CONVERGING_ORDER", 0.7,
+     "an order at or above this counts as converging (the error falls with h) on a problem with a shock and a "
+     "contact, whose L1 orders stay below one",
+     _STUDY + ": the source's own Sod orders before the plateau are 0.87-0.94; 0.7 lies below them and above "
+     "the floor", ("C11", "E2", "E5"))
+_add("FLOOR_ORDER", 0.5,
+     "an order below this counts as a floor: the error no longer falls with h",
+     _STUDY + ": the source says the error 'stops converging' without a number; half the order the source "
+     "measures before the plateau", ("C11", "C13", "E2", "E5"))
+_add("GROWTH_ORDER", 0.0,
+     "an order below this: the error grows as h shrinks (a divergence, not a plateau)",
+     "the sign of the order: below zero the error is larger on the finer mesh", ("C11", "C13"))
+_add("MIN_RUNS", 6,
+     "the runs (the regular layout and five jittered seeds) an order or a ratio is judged over, on each mesh",
+     _STUDY + ": the regular layout and the five jittered seeds the convergence study runs", ("C11", "E3"))
+_add("FLOOR_MESHES", 5,
+     "the meshes with MIN_RUNS runs C11 needs: converging orders first, then a levelling",
+     "the source's Sod table has six meshes, the first three orders converging; five meshes give four orders, "
+     "room for two converging and two levelling", ("C11",))
+_add("FLOOR_STEPS", 2,
+     "the last orders C11 reads the levelling (or the growth) from",
+     _STUDY + ": the source's table levels over its last two refinements (0.00125 -> 0.000625 -> 0.0003125)",
+     ("C11",))
+_add("SAME_SIZE", 2.0,
+     "C11: the measured error at the coarsest mesh is of the source's size when within this factor of it",
+     _STUDY + ": the slides give the values, not a tolerance; a factor two separates 'the same size' from the "
+     "1.7-35x discrepancies measured", ("C11",))
+
+# ---------------------------------------------------------------- particles per cell, mass, waves, extrema
+_add("SATURATION", 0.05,
+     "C3: the fewest particles per cell whose error is within this fraction of the smallest one",
+     _STUDY + ": the slides say '4-8 particles per cell is optimal' without a tolerance", ("C3",))
+_add("LUMPING_BAND", 0.9,
+     "C15 (second reading): a consistent/lumped error ratio below this means lumping is a source of error, above "
+     "its inverse that it compensates",
+     _STUDY + ": the slides name FE + mass lumping a source without a size; a 10 % change is well outside the "
+     "spread over meshes of the FEM's own ratio (0.996-0.998)", ("C15",))
+_add("SOURCE_SHARE", 0.1,
+     "C15: the mass stage (the FE solve with the lumped mass) is an error source when its MPM form alone raises "
+     "the all-exact error by at least this fraction of the all-MPM error",
+     _STUDY + ": the slides list FE + mass lumping among four sources without a size; a tenth of MPM's error", ("C15",))
+_add("WAVE_DENSITY", 2.0,
+     "C12: the named wave regions (rarefaction edges, contact, shock front) carry the error when their error per "
+     "unit length is at least this factor times that of the smooth region between them",
+     _STUDY + ": the slides say where the error sits (rarefaction edges, contact, shock front), not how much of "
+     "it; ranking the regions by error per unit length judges that statement, and twice the smooth region's "
+     "is the study's reading of 'sits at'", ("C12",))
+_add("EXTREMA_RATIO", 2.0,
+     "C14: a crossing particle becomes a new extremum at least this many times as often as a moving one that "
+     "does not cross",
+     _STUDY + ": the slides say new extrema appear at cell crossings; twice the background rate", ("C14",))
+
+# ---------------------------------------------------------------- time
+_add("CROSSING_TOLERANCE", 0.1,
+     "C2: P1's measured jump of d^3x_p/dt^3 matches the slides' formula when every measured/predicted ratio is "
+     "within this of one", _STUDY + ": the formula is exact; 10 % allows the finite-difference estimate",
+     ("C2",))
+_add("NO_JUMP", 0.1,
+     "C2: a C1 basis has no jump when its |measured| stays below this fraction of the P1 formula",
+     _STUDY + ": the slides say the C1 bases have no jump; an order of magnitude below P1's", ("C2",))
+
+# ---------------------------------------------------------------- the error budget and the bases
+_add("SEPARATE", 0.25,
+     "E1: the stages separate when the interactions, in total magnitude, are at most this fraction of the gap "
+     "|v(all MPM) - v(all exact)|", _STUDY + ": a quarter of the gap leaves each main effect readable", ("E1",))
+_add("ATTRIBUTABLE", 1.0,
+     "E1: a dominant stage is named only where the interactions are at most this multiple of the gap",
+     _STUDY + ": where the interactions exceed the gap itself, any attribution to one stage is an artefact of "
+     "the order of replacement", ("E1",))
+
+# ---------------------------------------------------------------- MPM against the fixed-mesh FEM
+_add("E3_FACTOR", 1.5,
+     "E3: MPM's error over the fixed-mesh FEM's stays within a constant factor when its change from the "
+     "coarsest mesh to the finest lies within [1/this, this]", _STUDY, ("E3",))
+
+# ---------------------------------------------------------------- the remedies
+_add("FV_DRIFT", 1.5,
+     "E5: a remedy's error stays within a constant factor of the FV's when its ratio to the FV error at the "
+     "finest mesh is at most this times that at the coarsest", _STUDY, ("E5",))
+_add("FV_FACTOR", 1.5,
+     "E5: the goal on Sod, within this factor of the finite-volume error at every h",
+     "the goal set for the remedies (the brief)", ("E5",))
+_add("BURGERS_ORDER", 1.0,
+     "E5: the goal on Burgers (4 per cell), a fitted order at least this at the nodes and at the particles",
+     "the goal set for the remedies (the brief): first order, as the slides state for Burgers", ("E5",))
+
+# ---------------------------------------------------------------- the mechanism (drift study, C11's explanation)
+_add("REDUCED", 0.5,
+     "C11's mechanism: a variant whose error still grows reduces the growth when its order is at least this "
+     "times the study settings' (both negative: at most half as fast)", _STUDY, ("C11",))
+_add("SAME_NODES", 1e-3,
+     "C11's mechanism: nodal errors within this relative distance count as the same motion",
+     _STUDY + ": far above round-off, far below the changes a variant makes", ("C11",))
+
+
 # ----------------------------------------------------------------------------- identification (issue 42, A)
 
 _add("IDENTIFICATION_BAND", 0.05,

@@ -7,14 +7,15 @@ import math
 
 from mpm_fem.measure.claims.base import DIFFERS, REFUTED
 from mpm_fem.measure.claims.rows import count_verdict, saturation, span
+from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.source import OPTIMAL_PPC
 
 #: C3: the fewest particles per cell within SATURATION of the smallest error.
-SATURATION = 0.05
+SATURATION = rule("SATURATION")
 #: C15: the error with the consistent mass over the error with the lumped mass, all else equal, of one
 #: method on one mesh: lumping is a source of error where the consistent mass is clearly better (ratio
 #: below LUMPING_BAND), compensating where it is clearly worse (above 1 / LUMPING_BAND), neutral between.
-LUMPING_BAND = 0.9
+LUMPING_BAND = rule("LUMPING_BAND")
 
 
 def ppc_claim(groups: dict[str, list[dict]], keys: tuple[str, ...]) -> tuple[str, str]:
