@@ -100,7 +100,7 @@ def source_matching(tables: Tables, problem: str, row: str | None = None) -> lis
 
 def _percent(m: float) -> str:
     """A misfit as the mean factor's excess, in per cent: ``exp(misfit) - 1``."""
-    return f"{100 * math.expm1(m):.0f} %" if math.isfinite(m) else "no finite factor"
+    return format(math.expm1(m), ".0%").replace("%", " %") if math.isfinite(m) else "no finite factor"
 
 
 def _setting(problem: str, r: Mapping) -> str:
