@@ -35,6 +35,16 @@ solve(exact)``) amplify it, so the budget's numbers carry a round-off spread, an
 measures it: P1's Sod budget runs a second time on the numpy step (the reference arithmetic), and
 each Shapley share is given from both with the change in percentage points.
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125.
+
+Particle layouts (issue 42): the budget and E2 above run the study's own particles (Sod 16 per cell,
+Burgers 4, the regular layout); beside them both run at 4, 8 and 16 per cell on the regular layout
+and on the Sod study's five jittered ones (seeds 1-5), every row of the tables naming its ``ppc``,
+``layout`` and ``seed``: the full tier P1's budget on the two coarsest meshes of each problem (Sod
+0.01, 0.005; Burgers 0.04, 0.02) and E2's three bases on h = 0.01 ... 0.0025; the deep tier adds
+the other three bases' budgets on those meshes, P1's on Sod h = 0.0025 and Burgers h = 0.01, and
+E2's on h = 0.00125 and 0.000625 (:data:`LAYOUT_H`, :data:`BASES_LAYOUT_H`). The coarse budgets
+cost mostly per step (the numpy grid stage of the exact-stage runs), hardly per particle, so 4 per
+cell costs about 0.7x 16 per cell there (:data:`BUDGET_STEP_MS`).
 """
 
 from __future__ import annotations

@@ -32,6 +32,13 @@ Burgers h = 0.04 ... 0.005 (the viscous step limit makes a halving of h cost 8x)
 
 XPIC(m) (:mod:`mpm_fem.core.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline, on every
 mesh of both problems.
+
+Particle layouts (issue 42): beside the runs above (Sod 16 per cell, Burgers 4, the regular layout)
+every remedy runs at 4, 8 and 16 per cell on the regular layout and on the Sod study's five jittered
+ones (seeds 1-5): the full tier on the two coarsest meshes of each problem (Sod 0.01, 0.005; Burgers
+0.04, 0.02), the deep tier on three (:data:`LAYOUT_H`); ``errors.csv`` names each row's ``ppc``,
+``layout`` and ``seed`` and takes the orders within one setting; ``orders.csv``, ``cost.csv`` and the
+figures hold the study's own setting.
 """
 
 from __future__ import annotations
@@ -249,7 +256,7 @@ def _summary(rows) -> list[dict]:
     rows = [r for r in rows if _is_study_setting(r)]
     out = []
     for problem in ("sod", "burgers"):
-        finest = min(r["h"] for r in rows if r["problem"] == problem)
+        finest = min((r["h"] for r in rows if r["problem"] == problem), default=None)
         for name in dict.fromkeys(r["remedy"] for r in rows if r["problem"] == problem):
             series = [r for r in rows if r["problem"] == problem and r["remedy"] == name]
             if len(series) < 2:
