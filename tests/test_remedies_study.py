@@ -44,7 +44,10 @@ def test_quick_run_writes_tables_figures_and_the_e5_verdict(tmp_path):
     for name in ("errors.csv", "orders.csv", "cost.csv", "cost.png", "errors.png"):
         assert (folder / name).exists(), name
     errors = read_table(folder / "errors.csv")
-    sod = {r["remedy"]: r for r in errors if r["problem"] == "sod" and r["h"] == "0.01"}
+    sod = {r["remedy"]: r for r in errors if r["problem"] == "sod" and r["h"] == "0.01" and r["seed"] == "0"}
+    jittered = [r for r in errors if r["problem"] == "sod" and r["h"] == "0.01" and r["layout"] == "jittered"]
+    assert {r["seed"] for r in jittered} == {"1", "2", "3", "4", "5"}  # the quick tier's layout runs
+    assert all(1.0 < float(r["nodes_L1"]) / float(sod["MPM"]["nodes_L1"]) < 1.5 for r in jittered)
     assert float(sod["MPM"]["nodes_L1"]) == pytest.approx(0.0083452, rel=1e-4)  # the Sod study's value
     ratio = float(sod["MPM"]["nodes_L1"]) / float(sod["MPM"]["fv_L1"])
     assert float(sod["MPM"]["ratio_fv_nodes_L1"]) == pytest.approx(ratio, rel=1e-4) and 1.0 < ratio < 2.0
