@@ -35,6 +35,16 @@ solve(exact)``) amplify it, so the budget's numbers carry a round-off spread, an
 measures it: P1's Sod budget runs a second time on the numpy step (the reference arithmetic), and
 each Shapley share is given from both with the change in percentage points.
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125.
+
+Particle layouts (issue 42): the budget and E2 above run the study's own particles (Sod 16 per cell,
+Burgers 4, the regular layout); beside them both run at 4, 8 and 16 per cell on the regular layout
+and on the Sod study's five jittered ones (seeds 1-5), every row of the tables naming its ``ppc``,
+``layout`` and ``seed``: the full tier P1's budget on the two coarsest meshes of each problem (Sod
+0.01, 0.005; Burgers 0.04, 0.02) and E2's three bases on h = 0.01 ... 0.0025; the deep tier adds
+the other three bases' budgets on those meshes, P1's on Sod h = 0.0025 and Burgers h = 0.01, and
+E2's on h = 0.00125 and 0.000625 (:data:`LAYOUT_H`, :data:`BASES_LAYOUT_H`). The coarse budgets
+cost mostly per step (the numpy grid stage of the exact-stage runs), hardly per particle, so 4 per
+cell costs about 0.7x 16 per cell there (:data:`BUDGET_STEP_MS`).
 """
 
 from __future__ import annotations
@@ -63,6 +73,8 @@ STAGES = ("projection", "mass", "interpolation", "time")
 EXACT_FORM = {"projection": {"projection": "exact"}, "mass": {"mass": "exact"},
               "interpolation": {"interpolation": "exact"}}
 K = 2  # time exact: dt -> 0 from dt and dt / K
+#: what a case may change of the study's settings: the step (``roundoff.csv``), the particles (E1, E2 over layouts)
+CASE_SETTINGS = ("kernel", "ppc", "layout", "seed")
 SOD = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", scheme="usl", layout="regular", seed=0)
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
                scheme="usl", layout="regular", seed=0)
@@ -87,6 +99,38 @@ COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:
 
 # ---------------------------------------------------------------- the plan
 
+#: E1 and E2 over the particle layouts (issue 42): particles per cell, and the Sod study's jittered layouts
+#: (``studies.sod.SEEDS``) beside the regular one (seed 0), every particle count with every layout
+LAYOUT_PPC = (4, 8, 16)
+SEEDS = (1, 2, 3, 4, 5)
+LAYOUTS = (("regular", 0),) + tuple(("jittered", s) for s in SEEDS)
+#: per tier, ``{(problem, basis): meshes}`` of the budgets run at every LAYOUT_PPC and layout. The full tier: P1 on
+#: the two coarsest meshes of each problem (:data:`BUDGET_STEP_MS`: a Sod budget at h = 0.005 costs 15-25 CPU-s a
+#: setting, the other bases 1.3-2x more, hence deep); the deep tier adds the other bases on those meshes and P1's on
+#: the next finer one. The quick tier: P1's Burgers budget at its coarsest mesh, 4 per cell, with the seeds.
+LAYOUT_H = {"quick": {("burgers", "mpm"): (0.04,)},
+            "full": {("sod", "mpm"): H["sod"][:2], ("burgers", "mpm"): H["burgers"][:2]},
+            "deep": {**{("sod", b): H["sod"][:2] for b in BUDGET_BASES}, ("sod", "mpm"): H["sod"][:3],
+                     **{("burgers", b): H["burgers"][:2] for b in BUDGET_BASES}, ("burgers", "mpm"): H["burgers"]}}
+#: per tier, the meshes of E2's bases run at every LAYOUT_PPC and layout (the full tier: the three coarsest, two
+#: refinements; the deep tier two more)
+BASES_LAYOUT_H = {"quick": (), "full": BASES_H[:3], "deep": BASES_H[:5]}
+QUICK_LAYOUT_PPC = {"burgers": (BURGERS["ppc"],)}
+
+
+def _layout_changes(problem: str, ppc: int, layout: str, seed: int) -> dict:
+    """The settings a budget case adds to the study's own (:data:`SOD`, :data:`BURGERS`): none for the
+    study's particle count on the regular layout, so that the study's case is the same case."""
+    default = SOD if problem == "sod" else BURGERS
+    return {**({"ppc": ppc} if ppc != default["ppc"] else {}), **({"layout": layout, "seed": seed} if seed else {})}
+
+
+def setting_of(problem: str, case: dict) -> dict:
+    """``{ppc, layout, seed}`` of a case (the study's own where the case names none)."""
+    default = SOD if problem == "sod" else BURGERS
+    return {k: case.get(k, default[k]) for k in ("ppc", "layout", "seed")}
+
+
 def plan(tier: str) -> dict:
     quick = tier == "quick"
     hs, bases = (QUICK["h"], QUICK["bases"]) if quick else (H, BUDGET_BASES)
@@ -97,21 +141,43 @@ def plan(tier: str) -> dict:
           for h in (QUICK["bases_h"] if quick else BASES_H) for b in BASES}
     roundoff = {key: {**case, "kernel": "numpy"} for key, case in budget.items()
                 if key[::2] == ROUNDOFF and not quick and (tier == "deep" or key[1] in ROUNDOFF_H)}
-    return {"budget": budget, "bases": e2, "roundoff": roundoff}
+    layouts = {(p, h, b, n, lay, s): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K,
+                                       **_layout_changes(p, n, lay, s)}
+               for (p, b), meshes in LAYOUT_H[tier].items() for h in meshes
+               for n in (QUICK_LAYOUT_PPC[p] if quick else LAYOUT_PPC) for lay, s in LAYOUTS}
+    bases_layouts = {(h, b, n, lay, s): {"kind": "bases", "h": h, "basis": b, **_layout_changes("sod", n, lay, s)}
+                     for h in BASES_LAYOUT_H[tier] for b in BASES for n in LAYOUT_PPC for lay, s in LAYOUTS}
+    return {"budget": budget, "bases": e2, "roundoff": roundoff, "layouts": layouts, "bases_layouts": bases_layouts}
 
 
-#: CPU time of a case relative to P1's (the four exact-stage runs of the docstring, fused, Sod, h = 0.005)
-STEP_COST = {"mpm": 1.0, "gimp": 1.4, "bspline": 2.4, "bspline_gimp": 2.5}  # measured: the cases' cpu_s
+#: CPU milliseconds per step of a budget run, ``a + b N`` for ``N`` particles, per (problem, basis): a least-squares
+#: fit to the full tier's runs (``runs.csv`` of 2026-11-26, 2-core machine); the ``a`` of Sod is the numpy grid stage
+#: of the exact-stage runs, of Burgers the numpy step
+BUDGET_STEP_MS = {("sod", "mpm"): (0.29, 7.9e-5), ("sod", "gimp"): (0.06, 1.8e-4), ("sod", "bspline"): (0.16, 2.0e-4),
+                  ("sod", "bspline_gimp"): (0.08, 2.1e-4), ("burgers", "mpm"): (0.53, 1.9e-3),
+                  ("burgers", "gimp"): (0.74, 3.1e-3), ("burgers", "bspline"): (0.68, 2.7e-3),
+                  ("burgers", "bspline_gimp"): (0.89, 2.9e-3)}
+#: the same for E2's runs (MPM stages only, the fused step: ``bases.csv`` of 2026-11-26)
+BASES_STEP_MS = {"mpm": (0.016, 3.9e-5), "gimp": (0.016, 6.8e-5), "bspline": (0.016, 5.8e-5)}
 NUMPY_STEP_COST = 1.7  # a roundoff.csv case (the numpy step) against the same case fused
 
 
+def _steps(problem: str, h: float) -> float:
+    """Steps of one run at dt: Sod's CFL step (943 at h = 0.01), Burgers' viscous one (dt = CFL h^2 / (2 eps))."""
+    return 9.5 / h if problem == "sod" else burgers.BurgersSettings.T * 2 * BURGERS["eps"] / (BURGERS["cfl"] * h**2)
+
+
 def cost(case: dict) -> float:
-    """Particle-steps of a case, weighted by its basis's step cost, to start the longest first (16
-    runs, half of them at dt / K)."""
+    """Estimated CPU milliseconds of a case, from the measured cost per step (:data:`BUDGET_STEP_MS`,
+    :data:`BASES_STEP_MS`): 24 steps' worth per step at dt for a budget (its 16 runs, half of them at dt / K)."""
+    problem = "sod" if case["kind"] == "bases" else case["problem"]
+    n = case.get("ppc", (SOD if problem == "sod" else BURGERS)["ppc"]) / case["h"]
     if case["kind"] == "bases":
-        return SOD["ppc"] / case["h"] ** 2
-    steps = SOD["ppc"] / case["h"] ** 2 if case["problem"] == "sod" else 0.08 * BURGERS["ppc"] / case["h"] ** 3
-    return 24 * STEP_COST[case["basis"]] * steps * (NUMPY_STEP_COST if case.get("kernel") == "numpy" else 1.0)
+        a, b = BASES_STEP_MS[case["basis"]]
+        return _steps("sod", case["h"]) * (a + b * n)
+    a, b = BUDGET_STEP_MS[(problem, case["basis"])]
+    numpy = NUMPY_STEP_COST if case.get("kernel") == "numpy" else 1.0
+    return 24 * _steps(problem, case["h"]) * (a + b * n) * numpy
 
 
 # ---------------------------------------------------------------- one case
@@ -169,8 +235,8 @@ def budget_case(case: dict) -> dict:
     """One (problem, h, basis): v(S) per norm and subset, the runs, the Shapley error fields
     (sampled for the figure) and, for Sod, their L1 by region."""
     problem, h, basis = case["problem"], case["h"], case["basis"]
-    kernel = {"kernel": case["kernel"]} if "kernel" in case else None
-    fields, weights, points, runs = subset_fields(problem, h, basis, kernel)
+    changes = {k: case[k] for k in CASE_SETTINGS if k in case}
+    fields, weights, points, runs = subset_fields(problem, h, basis, changes)
     if fields is None:
         return {"ok": False, "runs": runs}
     out = {"ok": True, "runs": runs, "subsets": {norm: {label(S): float(np.sum(w * np.abs(f[norm])))
@@ -192,7 +258,8 @@ def _sod_waves() -> dict:
 
 def bases_case(case: dict) -> dict:
     """E2: Sod with the MPM stages and one basis: density errors and the plateau velocity noise."""
-    return _run("sod", _settings("sod", case["h"], case["basis"], {}), np.linspace(0, 1, 11))[0]
+    changes = {k: case[k] for k in CASE_SETTINGS if k in case}
+    return _run("sod", _settings("sod", case["h"], case["basis"], changes), np.linspace(0, 1, 11))[0]
 
 
 def run_case(case: dict) -> dict:
@@ -206,40 +273,79 @@ def run(options: StudyOptions) -> None:
     got = options.sweep_plan(NAME, run_case, plan(options.tier), cost=cost)
     folder = options.folder(NAME)
     settings = {"sod": SOD, "burgers": BURGERS, "K": K, "stages": STAGES, "exact_form": EXACT_FORM,
-                "region_half_width": REGION_HALF_WIDTH, "quick": options.quick}
-    ok = {key: r for key, r in got["budget"].items() if r["ok"]}  # in the plan's order
+                "region_half_width": REGION_HALF_WIDTH, "quick": options.quick,
+                "layouts": {"ppc": list(LAYOUT_PPC), "regular": [0], "jittered": list(SEEDS),
+                            "budgets": {f"{p} {b}": list(hs) for (p, b), hs in LAYOUT_H[options.tier].items()},
+                            "bases_h": list(BASES_LAYOUT_H[options.tier])}}
+    study = {key: r for key, r in got["budget"].items() if r["ok"]}  # the study's settings, in the plan's order
+    every = {_full_key(key): r for key, r in got["budget"].items()}
+    for key, r in got["layouts"].items():
+        every.setdefault(key, r)
+    ok = {key: r for key, r in every.items() if r["ok"]}
     rows = subset_rows(ok)
     shapley, interactions = decomposition_rows(rows)
-    reference = decomposition_rows(subset_rows({k: r for k, r in got["roundoff"].items() if r["ok"] and k in ok}))[0]
+    own = [r for r in shapley if _is_study_setting(r)]
+    reference = decomposition_rows(subset_rows({k: r for k, r in got["roundoff"].items() if r["ok"] and k in study}))[0]
+    bases = {(h, b, SOD["ppc"], "regular", 0): r for (h, b), r in got["bases"].items()}
+    for key, r in got["bases_layouts"].items():
+        bases.setdefault(key, r)
     publish(folder, {schema.BUDGET_SUBSETS: rows, schema.BUDGET_SHAPLEY: shapley, "interactions": interactions,
                      "regions": region_rows(ok),
-                     "runs": [{"problem": p, "h": h, "basis": b, **x}
-                              for (p, h, b), r in got["budget"].items() for x in r["runs"]],
-                     schema.BUDGET_BASES: [{"h": h, "basis": b, **r} for (h, b), r in got["bases"].items()],
-                     schema.BUDGET_ROUNDOFF: share_changes(shapley, reference)}, settings, figures=(BASES_PLOT,))
-    for problem in sorted({r["problem"] for r in shapley}):
-        shapley_figure(folder / f"shapley_{problem}.png", [r for r in shapley if r["problem"] == problem])
-        finest = {b: min(h for p, h, bb in ok if p == problem and bb == b) for p, _, b in ok if p == problem}
+                     "runs": [{**_key_columns(key), **x} for key, r in every.items() for x in r["runs"]],
+                     schema.BUDGET_BASES: [{"h": h, "basis": b, "ppc": n, "layout": lay, "seed": s, **r}
+                                           for (h, b, n, lay, s), r in bases.items()],
+                     schema.BUDGET_ROUNDOFF: share_changes(own, reference)}, settings, figures=(BASES_PLOT,))
+    for problem in sorted({r["problem"] for r in own}):
+        shapley_figure(folder / f"shapley_{problem}.png", [r for r in own if r["problem"] == problem])
+        finest = {b: min(h for p, h, bb in study if p == problem and bb == b) for p, _, b in study if p == problem}
         fields_figure(folder / f"fields_{problem}.png", problem,
-                      {b: (h, ok[(problem, h, b)]["fields"]) for b, h in finest.items()})
+                      {b: (h, study[(problem, h, b)]["fields"]) for b, h in finest.items()})
+
+
+#: the columns of a budget's particle setting (its key's last three entries; the study's own for a key of three)
+SETTING_COLUMNS = ("ppc", "layout", "seed")
+
+
+def _full_key(key: tuple) -> tuple:
+    """``(problem, h, basis, ppc, layout, seed)`` of a plan key of the study's settings, ``(problem, h, basis)``."""
+    p, h, b = key
+    default = SOD if p == "sod" else BURGERS
+    return (p, h, b, default["ppc"], "regular", 0)
+
+
+def _is_study_setting(row: dict) -> bool:
+    """Whether a row is at the study's own particle setting (every row without the setting columns is)."""
+    default = SOD if row["problem"] == "sod" else BURGERS
+    return all(str(row.get(c, default[c])) == str(default[c]) for c in SETTING_COLUMNS)
+
+
+def _key_columns(key: tuple) -> dict:
+    """The columns of a budget key: problem, h, basis and, for a key of six, ppc, layout, seed."""
+    return dict(zip(("problem", "h", "basis", *SETTING_COLUMNS), key, strict=False))
 
 
 def subset_rows(got: dict) -> list[dict]:
-    """``subsets.csv``: v(S) for every problem, h, basis, norm and subset S of the MPM stages."""
-    return [{"problem": p, "h": h, "basis": b, "norm": norm, "mpm_stages": subset, "error": v}
-            for (p, h, b), r in got.items() for norm, values in r["subsets"].items() for subset, v in values.items()]
+    """``subsets.csv``: v(S) for every problem, h, basis (particle setting, when the keys name it), norm and subset S
+    of the MPM stages."""
+    return [{**_key_columns(key), "norm": norm, "mpm_stages": subset, "error": v}
+            for key, r in got.items() for norm, values in r["subsets"].items() for subset, v in values.items()]
 
 
 def decomposition_rows(rows: list[dict]) -> tuple[list, list]:
     """``shapley.csv`` and ``interactions.csv`` from ``subsets.csv``: the decomposition of each
-    (problem, h, basis, norm) group; shares are of v(all MPM) - v(all exact)."""
-    groups = {}
+    (problem, h, basis, particle setting where the rows have one, norm) group; shares are of
+    v(all MPM) - v(all exact)."""
+    groups, keys = {}, {}
     for r in rows:
-        groups.setdefault((r["problem"], r["h"], r["basis"], r["norm"]), {})[r["mpm_stages"]] = float(r["error"])
+        key = {"problem": r["problem"], "h": r["h"], "basis": r["basis"],
+               **{c: r[c] for c in SETTING_COLUMNS if c in r}, "norm": r["norm"]}
+        group = tuple(key.values())
+        keys[group] = key
+        groups.setdefault(group, {})[r["mpm_stages"]] = float(r["error"])
     shapley, interactions = [], []
-    for (p, h, b, norm), values in groups.items():
+    for group, values in groups.items():
         v = {S: values[label(S)] for S in subsets(STAGES)}
-        d, key, full = decompose(v, STAGES), {"problem": p, "h": h, "basis": b, "norm": norm}, frozenset(STAGES)
+        d, key, full = decompose(v, STAGES), keys[group], frozenset(STAGES)
         shapley += [{**key, "stage": s, "shapley": d.shapley[s], "share": d.shapley[s] / d.gap,
                      "removed": v[full] - v[full - {s}], "alone": d.moebius[frozenset({s})],
                      "mpm_error": d.total, "exact_error": d.floor} for s in STAGES]
@@ -250,16 +356,17 @@ def decomposition_rows(rows: list[dict]) -> tuple[list, list]:
 
 def region_rows(got: dict) -> list[dict]:
     """``regions.csv``: L1 of each Shapley error field (particles) and its share in each region of C12."""
-    return [{"problem": p, "h": h, "basis": b, "field": name, "L1": sum(parts),
+    return [{**_key_columns(key), "field": name, "L1": sum(parts),
              **{f"share_{n.replace(' ', '_')}": x / sum(parts) for n, x in zip(REGION_NAMES, parts, strict=True)}}
-            for (p, h, b), r in got.items() for name, parts in r.get("regions", {}).items()]
+            for key, r in got.items() for name, parts in r.get("regions", {}).items()]
 
 
 # ---------------------------------------------------------------- figures
 
-BASES_PLOT = Plot("bases.png", "E2: Sod density L1 with each basis, MPM stages", schema.BUDGET_BASES.stem, "h", (
-    Curve("{basis}, nodes", "nodes_L1", "o-", {"ok": True}, group=("basis",)),
-    Curve("{basis}, particles", "particles_L1", "s--", {"ok": True}, group=("basis",))),
+BASES_PLOT = Plot("bases.png", f"E2: Sod density L1 with each basis, MPM stages, {SOD['ppc']} per cell, regular "
+                 "layout", schema.BUDGET_BASES.stem, "h", (
+    Curve("{basis}, nodes", "nodes_L1", "o-", {"ok": True, "ppc": SOD["ppc"], "seed": 0}, group=("basis",)),
+    Curve("{basis}, particles", "particles_L1", "s--", {"ok": True, "ppc": SOD["ppc"], "seed": 0}, group=("basis",))),
     ylabel="density L1", slopes=(1,))
 
 
@@ -312,9 +419,9 @@ def fields_figure(path: Path, problem: str, fields: dict) -> None:
                             + (", waves dotted" if problem == "sod" else ""))
 
 
-#: The cost model of :mod:`mpm_fem.app.estimate`: CPU seconds per unit of :func:`cost`, from the full
-#: tier's cases on the 2-core machine (2026-11-26, from-scratch run: CHANGES.md).
-PLAN, COST, SECONDS_PER_COST = plan, cost, 7.6e-7
+#: The cost model of :mod:`mpm_fem.app.estimate`: :func:`cost` is in CPU milliseconds, from the full tier's runs
+#: on the 2-core machine (2026-11-26, from-scratch run: CHANGES.md).
+PLAN, COST, SECONDS_PER_COST = plan, cost, 1e-3
 
 if __name__ == "__main__":
     sys.exit(script_main(NAME))

@@ -32,6 +32,13 @@ Burgers h = 0.04 ... 0.005 (the viscous step limit makes a halving of h cost 8x)
 
 XPIC(m) (:mod:`mpm_fem.core.xpic`) runs alone (m = 2, 5) and with the particle-domain B-spline, on every
 mesh of both problems.
+
+Particle layouts (issue 42): beside the runs above (Sod 16 per cell, Burgers 4, the regular layout)
+every remedy runs at 4, 8 and 16 per cell on the regular layout and on the Sod study's five jittered
+ones (seeds 1-5): the full tier on the two coarsest meshes of each problem (Sod 0.01, 0.005; Burgers
+0.04, 0.02), the deep tier on three (:data:`LAYOUT_H`); ``errors.csv`` names each row's ``ppc``,
+``layout`` and ``seed`` and takes the orders within one setting; ``orders.csv``, ``cost.csv`` and the
+figures hold the study's own setting.
 """
 
 from __future__ import annotations
@@ -118,6 +125,30 @@ def run_case(case: dict) -> dict:
             "wall_s": time.perf_counter() - start}
 
 
+#: E5 over the particle layouts (issue 42): every remedy at these particles per cell, on the regular layout and
+#: the Sod study's jittered ones (``studies.sod.SEEDS``; seed 0 the regular layout)
+LAYOUT_PPC = (4, 8, 16)
+SEEDS = (1, 2, 3, 4, 5)
+LAYOUTS = (("regular", 0),) + tuple(("jittered", s) for s in SEEDS)
+#: per tier, the meshes of the layout runs ``{problem: meshes}``: the full tier the two coarsest of each problem
+#: (every remedy there costs about 2 CPU-min in all), the deep tier one mesh more; the quick tier plain MPM at the
+#: study's particles per cell (``QUICK_LAYOUT``) on its two meshes
+LAYOUT_H = {"quick": {"sod": QUICK["SOD_H"], "burgers": QUICK["BURGERS_H"]},
+            "full": {"sod": SOD_H[:2], "burgers": BURGERS_H[:2]},
+            "deep": {"sod": SOD_H[:3], "burgers": BURGERS_H[:3]}}
+QUICK_LAYOUT = {"remedies": ("MPM",), "ppc": {"sod": (SOD_MPM["ppc"],), "burgers": (BURGERS["ppc"],)}}
+
+
+def _layout_case(problem: str, h: float, name: str, ppc: int, layout: str, seed: int, kernel: dict) -> dict:
+    """The case of a remedy at a particle setting: the study's own case at its particles per cell on the regular
+    layout (Burgers' names no layout then, as the study's own case)."""
+    if problem == "sod":
+        return {"solver": "sod", "h": h, **SOD_MPM, "ppc": ppc, "layout": layout, "seed": seed, **REMEDIES[name],
+                **kernel}
+    jitter = {"layout": layout, "seed": seed} if seed else {}
+    return {"solver": "burgers", "h": h, **BURGERS, "ppc": ppc, **jitter, **REMEDIES[name], **kernel}
+
+
 def _plan(tier: str) -> dict:
     quick = tier == "quick"
     q = QUICK if quick else {}
@@ -125,6 +156,7 @@ def _plan(tier: str) -> dict:
     sod_h, burgers_h = q.get("SOD_H", SOD_H), q.get("BURGERS_H", BURGERS_H)
     meshes, kernel = DEEP_SOD_MESHES if tier == "deep" else SOD_MESHES, QUICK_KERNEL if quick else {}
     sod_h = sod_h[:max(meshes[n] for n in names)]
+    layout_names = QUICK_LAYOUT["remedies"] if quick else names
     return {
         "sod": {(n, h): {"solver": "sod", "h": h, **SOD_MPM, **REMEDIES[n], **kernel}
                 for n in names for h in sod_h[:meshes[n]]},
@@ -132,7 +164,16 @@ def _plan(tier: str) -> dict:
                     for n in names for h in burgers_h},
         "fem": {h: {"solver": "fem", "h": h} for h in sod_h},
         "fv": {h: {"solver": "fv", "h": h} for h in sod_h},
+        **{f"{problem}_layouts": {(n, h, ppc, lay, s): _layout_case(problem, h, n, ppc, lay, s, kernel)
+                                  for n in layout_names for h in hs
+                                  for ppc in (QUICK_LAYOUT["ppc"][problem] if quick else LAYOUT_PPC)
+                                  for lay, s in LAYOUTS}
+           for problem, hs in LAYOUT_H[tier].items()},
     }
+
+
+#: the seconds every case costs beyond its particle-steps (the worker's call, the cache), in units of :func:`_cost`
+CASE_OVERHEAD = 2e6
 
 
 def _cost(case: dict) -> float:
@@ -142,8 +183,8 @@ def _cost(case: dict) -> float:
         return 1.0 / h**2
     slow = (4.0 if case.get("basis") == "bspline_gimp" else 1.0) * (1.0 + 0.3 * case.get("xpic", 0))
     if case["solver"] == "burgers":
-        return slow * 4 * 0.09 / h**3
-    return slow * case["ppc"] / (h**2 * case["cfl"])
+        return CASE_OVERHEAD + slow * case["ppc"] * 0.09 / h**3
+    return CASE_OVERHEAD + slow * case["ppc"] / (h**2 * case["cfl"])
 
 
 # ---------------------------------------------------------------- the study
@@ -163,16 +204,31 @@ def _l(result, where, norm):
     return result[where][norm] if result.get("ok") and where in result else float("nan")
 
 
+def _study_setting(problem: str) -> tuple:
+    """``(ppc, layout, seed)`` of the study's own runs of ``problem``."""
+    return ((SOD_MPM if problem == "sod" else BURGERS)["ppc"], "regular", 0)
+
+
+def _series(got, problem: str) -> dict:
+    """``{(remedy, ppc, layout, seed): {h: result}}``: the study's own runs first, then the layout runs."""
+    out = {}
+    for (name, h), r in got[problem].items():
+        out.setdefault((name, *_study_setting(problem)), {})[h] = r
+    for (name, h, *setting), r in got.get(f"{problem}_layouts", {}).items():
+        out.setdefault((name, *setting), {}).setdefault(h, r)
+    return out
+
+
 def _errors(got) -> list[dict]:
+    """``errors.csv``: one row per problem, remedy, particle setting (``ppc``, ``layout``, ``seed``) and mesh, the
+    orders against the next coarser mesh of the same remedy and setting."""
     rows = []
     for problem in ("sod", "burgers"):
-        names = list(dict.fromkeys(n for n, _ in got[problem]))
-        for name in names:
-            hs = sorted((h for n, h in got[problem] if n == name), reverse=True)
+        for (name, ppc, layout, seed), by_h in _series(got, problem).items():
             series = []
-            for h in hs:
-                r = got[problem][(name, h)]
-                row = {"problem": problem, "remedy": name, "h": h,
+            for h in sorted(by_h, reverse=True):
+                r = by_h[h]
+                row = {"problem": problem, "remedy": name, "ppc": ppc, "layout": layout, "seed": seed, "h": h,
                        "quantity": "density" if problem == "sod" else "velocity"}
                 for where in ("nodes", "particles"):
                     for norm in ("L1", "L2"):
@@ -191,10 +247,16 @@ def _errors(got) -> list[dict]:
     return rows
 
 
+def _is_study_setting(row: dict) -> bool:
+    return (row["ppc"], row["layout"], row["seed"]) == _study_setting(row["problem"])
+
+
 def _summary(rows) -> list[dict]:
+    """``orders.csv``: per problem and remedy, at the study's own particle setting."""
+    rows = [r for r in rows if _is_study_setting(r)]
     out = []
     for problem in ("sod", "burgers"):
-        finest = min(r["h"] for r in rows if r["problem"] == problem)
+        finest = min((r["h"] for r in rows if r["problem"] == problem), default=None)
         for name in dict.fromkeys(r["remedy"] for r in rows if r["problem"] == problem):
             series = [r for r in rows if r["problem"] == problem and r["remedy"] == name]
             if len(series) < 2:
@@ -221,7 +283,8 @@ def _cost_rows(got) -> list[dict]:
     return rows
 
 
-_SOD, _FV = {"problem": "sod"}, {"problem": "sod", "remedy": "MPM"}
+_SOD = {"problem": "sod", "ppc": SOD_MPM["ppc"], "seed": 0}
+_FV, _BURGERS = {**_SOD, "remedy": "MPM"}, {"problem": "burgers", "ppc": BURGERS["ppc"], "seed": 0}
 PLOTS = (
     Plot("errors.png", "E5: L1 error against h for each remedy; Sod density with the FV reference, Burgers velocity",
          REMEDIES_ERRORS.stem, "h", (
@@ -229,7 +292,7 @@ PLOTS = (
              Curve("FV reference", "fv_L1", "k--", where=_FV, panel="Sod density, grid nodes"),
              Curve("{remedy}", "particles_L1", where=_SOD, panel="Sod density, particles", group=("remedy",)),
              Curve("FV reference", "fv_L1", "k--", where=_FV, panel="Sod density, particles"),
-             Curve("{remedy}", "particles_L1", where={"problem": "burgers"}, panel="Burgers velocity, particles",
+             Curve("{remedy}", "particles_L1", where=_BURGERS, panel="Burgers velocity, particles",
                    group=("remedy",))),
          ylabel="L1 error", size=(4.6, 3.8), ncols=3),
 )

@@ -136,7 +136,7 @@ def run(options: StudyOptions) -> None:
     rows, local_rows = time_rows(got["time"])
     crossings = crossing_rows(got["crossing"])
     publish(folder, {TIME_ORDER: rows, TIME_LOCAL_ERROR: local_rows, "crossing": crossings,
-                     TIME_CROSSING_SUMMARY: crossing_summary(crossings)}, settings)
+                     TIME_CROSSING_SUMMARY: crossing_summary(crossings, rows)}, settings)
     draw(folder, TIME_PLOT, rows + [{**r, "quantity": "local " + r["quantity"]} for r in local_rows])
     crossing_figure(folder / "crossing.png", got["crossing"], crossings)
 
@@ -172,16 +172,33 @@ def crossing_rows(got: dict) -> list[dict]:
             for (basis, acc), r in got.items() for row in r["rows"]]
 
 
-def crossing_summary(rows: list[dict]) -> list[dict]:
-    """Per basis and acceleration: the crossings, the median and worst measured/predicted ratio,
-    and the median size of the measured jump."""
+def crossing_summary(rows: list[dict], time_order: list[dict] = ()) -> list[dict]:
+    """Per basis and acceleration: the crossings, the median and worst measured/predicted ratio, the
+    median size of the measured jump and C2's second half beside it: ``jump_ratio``, the median over the
+    crossings of |measured jump| / |the slides' P1 formula| (P1 with the exact acceleration: about 1; a C1
+    basis: its jump relative to P1's), and, from ``time_order`` (the global error of the particle velocity
+    at fixed h, :func:`time_rows`), the basis's least-squares global order in dt on the pulse and on
+    Burgers (calculated acceleration) and the widest range of its successive orders in dt over the two
+    problems (``order_dt_spread``: how unevenly the error falls as dt is refined); empty where
+    ``time_order`` has no such rows."""
+    fits, spread = {}, {}
+    for r in time_order:
+        if r["quantity"] == "velocity":
+            fits[(r["basis"], r["problem"])] = r["fitted_order"]
+            orders = spread.setdefault(r["basis"], {}).setdefault(r["problem"], [])
+            orders += [r["order"]] if r["order"] != "" else []
     out = []
     for basis, acc in dict.fromkeys((r["basis"], r["acceleration"]) for r in rows):
         sub = [r for r in rows if (r["basis"], r["acceleration"]) == (basis, acc)]
         ratio = np.array([r["ratio"] for r in sub])
+        widths = [max(o) - min(o) for o in spread.get(basis, {}).values() if o]
         out.append({"basis": basis, "acceleration": acc, "crossings": len(sub), "median_ratio": float(np.median(ratio)),
                     "max_ratio_error": float(np.max(np.abs(ratio - 1))), "max_abs_ratio": float(np.max(np.abs(ratio))),
-                    "median_abs_measured": float(np.median(np.abs([r["measured"] for r in sub])))})
+                    "median_abs_measured": float(np.median(np.abs([r["measured"] for r in sub]))),
+                    "jump_ratio": float(np.median(np.abs(ratio))),
+                    "order_dt_pulse": fits.get((basis, "pulse"), ""),
+                    "order_dt_burgers": fits.get((basis, "burgers"), ""),
+                    "order_dt_spread": float(max(widths)) if widths else ""})
     return out
 
 

@@ -278,3 +278,74 @@ def test_the_roundoff_table_compares_the_two_arithmetics():
     text = _roundoff_text({"budget/roundoff": [{k: str(v) for k, v in r.items()} for r in rows]}, "sod")
     assert "at most 2 percentage points at h = 0.01" in text
     assert _roundoff_text({}, "sod") == "" and _roundoff_text({"budget/roundoff": rows}, "burgers") == ""
+
+
+# ---------------------------------------------------------------- E1, E2 over particle layouts (issue 42)
+
+def test_the_layout_budgets_cover_every_particle_count_and_seed_on_the_two_coarsest_meshes():
+    """Full tier: P1's budget on the two coarsest meshes of each problem and E2's bases on the three coarsest, at
+    4, 8 and 16 per cell on the regular layout and the Sod study's five jittered seeds; the study's own setting is
+    the study's own case (the same dict, run once); the deep tier holds the full one's; the quick tier only
+    P1's Burgers budget at its coarsest mesh, 4 per cell, with the seeds."""
+    from studies import sod as sod_study
+
+    assert study.SEEDS == sod_study.SEEDS and study.LAYOUT_PPC == (4, 8, 16)
+    full, deep, quick = (study.plan(t) for t in ("full", "deep", "quick"))
+    settings = {(n, lay, s) for n in study.LAYOUT_PPC for lay, s in study.LAYOUTS}
+    assert len(settings) == 18 and ("regular", 0) in study.LAYOUTS
+    for problem in ("sod", "burgers"):
+        meshes = study.H[problem][:2]
+        got = {(h, n, lay, s) for p, h, b, n, lay, s in full["layouts"] if (p, b) == (problem, "mpm")}
+        assert got == {(h, *x) for h in meshes for x in settings}, problem
+        own = study.SOD if problem == "sod" else study.BURGERS
+        for h in meshes:
+            assert full["layouts"][(problem, h, "mpm", own["ppc"], "regular", 0)] == full["budget"][(problem, h, "mpm")]
+    assert {(h, b) for h, b, *_ in full["bases_layouts"]} == {(h, b) for h in study.BASES_H[:3] for b in study.BASES}
+    assert full["bases_layouts"][(0.01, "gimp", 16, "regular", 0)] == full["bases"][(0.01, "gimp")]
+    case = full["layouts"][("sod", 0.01, "mpm", 4, "jittered", 3)]
+    assert (case["ppc"], case["layout"], case["seed"]) == (4, "jittered", 3)
+    assert set(full["layouts"]) <= set(deep["layouts"]) and set(full["bases_layouts"]) <= set(deep["bases_layouts"])
+    assert set(quick["layouts"]) == {("burgers", 0.04, "mpm", 4, lay, s) for lay, s in study.LAYOUTS}
+    assert not quick["bases_layouts"]
+
+
+def test_the_cost_model_reproduces_the_measured_budgets():
+    """The per-step model (BUDGET_STEP_MS) against the full tier's measured budgets (runs.csv of 2026-11-26): P1's
+    Sod budget at h = 0.01 took 8.3 CPU-s, at 0.00125 258; Burgers at 0.01 28.8. Within 30 %."""
+    for key, seconds in ((("sod", 0.01, "mpm"), 8.3), (("sod", 0.00125, "mpm"), 258.0),
+                         (("burgers", 0.01, "mpm"), 28.8), (("sod", 0.005, "gimp"), 32.0)):
+        got = study.cost(study.plan("full")["budget"][key]) * study.SECONDS_PER_COST
+        assert 0.7 < got / seconds < 1.3, (key, got, seconds)
+    cheaper = study.cost({"kind": "budget", "problem": "sod", "h": 0.01, "basis": "mpm", "ppc": 4})
+    assert 0.6 < cheaper / study.cost({"kind": "budget", "problem": "sod", "h": 0.01, "basis": "mpm"}) < 0.9
+
+
+@pytest.fixture(scope="module")
+def jittered_budget():
+    """Sod's small budget (h = 0.05, 4 per cell, the study's CFL) on the regular layout and on the jittered one of
+    seed 1, through the study's case function."""
+    h = SMALL["sod"][0]
+    cases = {("sod", h, "mpm", 4, lay, s): {"kind": "budget", "problem": "sod", "h": h, "basis": "mpm", "K": study.K,
+                                            "ppc": 4, **({"layout": lay, "seed": s} if s else {})}
+             for lay, s in (("regular", 0), ("jittered", 1))}
+    return {key: study.budget_case(case) for key, case in cases.items()}
+
+
+def test_a_jittered_budget_runs_every_subset_and_its_rows_name_the_setting(jittered_budget):
+    """The case function takes the particle setting (the jittered run differs from the regular one, within a
+    factor 3 in v(all MPM)); the subset and Shapley rows carry ppc, layout and seed, the declared columns."""
+    from mpm_fem.measure.schema import BUDGET_SHAPLEY, BUDGET_SUBSETS
+
+    assert all(r["ok"] for r in jittered_budget.values())
+    rows = study.subset_rows(jittered_budget)
+    BUDGET_SUBSETS.check(rows)
+    assert {(r["ppc"], r["layout"], r["seed"]) for r in rows} == {(4, "regular", 0), (4, "jittered", 1)}
+    shapley, _ = study.decomposition_rows(rows)
+    BUDGET_SHAPLEY.check(shapley)
+    mpm = {(r["layout"], r["norm"]): r["mpm_error"] for r in shapley if r["stage"] == "mass"}
+    for norm in ("particles", "nodes"):
+        ratio = mpm[("jittered", norm)] / mpm[("regular", norm)]
+        assert ratio != 1.0 and 1 / 3 < ratio < 3, (norm, ratio)
+    for layout in ("regular", "jittered"):
+        group = [r for r in shapley if r["layout"] == layout and r["norm"] == "particles"]
+        assert sum(r["share"] for r in group) == pytest.approx(1.0, abs=1e-12)

@@ -174,3 +174,30 @@ def test_study_case_and_tables_on_a_tiny_sweep():
     assert (("E_F", "advected", "volume", "mpm", "L1") in orders
             and ("E_F", "random", "volume", "mpm", "L1") not in orders)
     assert all(r["holds"] == "yes" for r in t["bounds"]), [r for r in t["bounds"] if r["holds"] != "yes"]
+
+
+@pytest.mark.parametrize("quick", [True, False])
+def test_the_regular_layout_has_rows_of_its_own_in_every_tier(quick):
+    """C5-C10 (issue 42): the regular layout the simulations use (``seed_positions``, sub-cell midpoints) is a
+    layout of the projection study in every tier, beside the jittered, random and advected ones."""
+    from mpm_fem.app.study import StudyOptions
+    from studies.projection import cases
+
+    layouts = {c["layout"] for c in cases(StudyOptions(quick=quick))}
+    assert layouts == {"regular", "jittered", "random", "advected"}
+    assert {c["seed"] for c in cases(StudyOptions(quick=quick)) if c["layout"] == "regular"} == {0}
+
+
+def test_the_regular_layout_orders_row_is_measured():
+    """The regular layout's own rows of ``orders``: on smooth periodic fields its sub-cell midpoints are a midpoint
+    rule, the mass projection error third order (2.99 in the record), the velocity gradient's first order
+    (0.99), far from the jittered layouts' orders."""
+    from studies.projection import case, tables
+
+    cs = [{"layout": lay, "ppc": 4, "cells": k, "seed": 0} for lay in ("regular", "jittered") for k in (10, 20, 40, 80)]
+    t = tables([(c, case(c)) for c in cs])
+    orders = {(r["quantity"], r["layout"]): r["order"] for r in t["orders"]
+              if (r["weights"], r["basis"], r["norm"]) == ("cell", "mpm", "L1")}
+    assert 2.6 <= orders[("E_m", "regular")] <= 3.2, orders[("E_m", "regular")]
+    assert 0.9 <= orders[("E_VG", "regular")] <= 1.1, orders[("E_VG", "regular")]
+    assert orders[("E_m", "jittered")] < orders[("E_m", "regular")] - 0.5

@@ -44,7 +44,10 @@ def test_quick_run_writes_tables_figures_and_the_e5_verdict(tmp_path):
     for name in ("errors.csv", "orders.csv", "cost.csv", "cost.png", "errors.png"):
         assert (folder / name).exists(), name
     errors = read_table(folder / "errors.csv")
-    sod = {r["remedy"]: r for r in errors if r["problem"] == "sod" and r["h"] == "0.01"}
+    sod = {r["remedy"]: r for r in errors if r["problem"] == "sod" and r["h"] == "0.01" and r["seed"] == "0"}
+    jittered = [r for r in errors if r["problem"] == "sod" and r["h"] == "0.01" and r["layout"] == "jittered"]
+    assert {r["seed"] for r in jittered} == {"1", "2", "3", "4", "5"}  # the quick tier's layout runs
+    assert all(1.0 < float(r["nodes_L1"]) / float(sod["MPM"]["nodes_L1"]) < 1.5 for r in jittered)
     assert float(sod["MPM"]["nodes_L1"]) == pytest.approx(0.0083452, rel=1e-4)  # the Sod study's value
     ratio = float(sod["MPM"]["nodes_L1"]) / float(sod["MPM"]["fv_L1"])
     assert float(sod["MPM"]["ratio_fv_nodes_L1"]) == pytest.approx(ratio, rel=1e-4) and 1.0 < ratio < 2.0
@@ -52,3 +55,46 @@ def test_quick_run_writes_tables_figures_and_the_e5_verdict(tmp_path):
     assert list(cost[0])[-1] == "wall_s"
     verdict, evidence = judge("E5", load_tables(tmp_path))
     assert verdict in ("confirmed", "partly", "refuted") and "FV error" in evidence
+
+
+def test_every_remedy_runs_at_4_8_16_per_cell_on_the_regular_and_jittered_layouts():
+    """E5 over the particle layouts (issue 42): the full tier runs every remedy at 4, 8 and 16 per cell on the
+    regular layout and the Sod study's five jittered seeds, on the two coarsest meshes of each problem (the deep
+    tier one more); the study's own setting is the study's own case (run once); the quick tier plain MPM at the
+    study's particles per cell, with the seeds, on its two meshes."""
+    assert remedies.SEEDS == sod.SEEDS and remedies.LAYOUT_PPC == (4, 8, 16)
+    full, deep, quick = (remedies._plan(t) for t in ("full", "deep", "quick"))
+    for problem, meshes in (("sod", remedies.SOD_H[:2]), ("burgers", remedies.BURGERS_H[:2])):
+        got = full[f"{problem}_layouts"]
+        assert set(got) == {(n, h, ppc, lay, s) for n in remedies.REMEDIES for h in meshes
+                            for ppc in (4, 8, 16) for lay, s in remedies.LAYOUTS}
+        own = 16 if problem == "sod" else 4
+        assert all(got[(n, h, own, "regular", 0)] == full[problem][(n, h)] for n in remedies.REMEDIES for h in meshes)
+        assert set(got) < set(deep[f"{problem}_layouts"])
+        case = got[("Taylor + volume", meshes[0], 8, "jittered", 2)]
+        assert (case["ppc"], case["layout"], case["seed"], case["reconstruct"]) == (8, "jittered", 2, "taylor")
+        assert {(n, ppc) for n, _, ppc, *_ in quick[f"{problem}_layouts"]} == {("MPM", own)}
+        assert all(c["kernel"] == "numpy" for c in quick[f"{problem}_layouts"].values())
+
+
+def test_the_error_rows_carry_the_particle_setting_and_orders_within_each_setting():
+    """errors.csv: one series per remedy and particle setting, its orders against the next coarser mesh of the same
+    setting; orders.csv (the study's verdict table) reads the study's own setting only."""
+    from mpm_fem.measure.schema import REMEDIES_ERRORS
+
+    def result(e):
+        return {"ok": True, "nodes": {"L1": e, "L2": e}, "particles": {"L1": 2 * e, "L2": 2 * e}, "steps": 10,
+                "n_p": 100, "volume_drift": 0.0}
+
+    got = {"sod": {("MPM", 0.02): result(0.02), ("MPM", 0.01): result(0.01)}, "burgers": {},
+           "fv": {0.02: {"ok": True, "nodes": {"L1": 0.015}}, 0.01: {"ok": True, "nodes": {"L1": 0.008}}},
+           "sod_layouts": {("MPM", 0.02, 16, "regular", 0): result(0.5), ("MPM", 0.02, 4, "jittered", 3): result(0.04),
+                           ("MPM", 0.01, 4, "jittered", 3): result(0.02)}}
+    rows = remedies._errors(got)
+    REMEDIES_ERRORS.check(rows)
+    assert [(r["ppc"], r["layout"], r["seed"], r["h"]) for r in rows] == [
+        (16, "regular", 0, 0.02), (16, "regular", 0, 0.01), (4, "jittered", 3, 0.02), (4, "jittered", 3, 0.01)]
+    assert rows[0]["nodes_L1"] == 0.02  # the study's own run, not a duplicate of it
+    assert rows[1]["order_nodes_L1"] == pytest.approx(1.0) and rows[3]["order_nodes_L1"] == pytest.approx(1.0)
+    summary = remedies._summary(rows)
+    assert len(summary) == 1 and summary[0]["finest_nodes_L1"] == 0.01

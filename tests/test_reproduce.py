@@ -23,9 +23,16 @@ TABLES = {
     "sod/seeds.csv": (("ppc", "cfl", "h", "layout", "seed"), ("particles_L1", "nodes_L1", "energy_L1")),
     "burgers/errors.csv": (("solution", "method", "eps", "h"), ("particles_L1", "particles_max", "nodes_L1")),
     "projection/errors.csv": (("quantity", "layout", "weights", "basis", "N_p", "h", "norm", "seeds"), ("value",)),
-    "budget/subsets.csv": (("problem", "h", "basis", "norm", "mpm_stages"), ("error",)),
+    "budget/subsets.csv": (("problem", "h", "basis", "ppc", "layout", "seed", "norm", "mpm_stages"), ("error",)),
 }
 RTOL = 1e-5
+#: the value of a key column in a table written before the column was (the study's own particle setting, issue 42)
+MISSING = {"layout": lambda row: "regular", "seed": lambda row: "0",
+           "ppc": lambda row: "16" if row["problem"] == "sod" else "4"}
+
+
+def _key(row: dict, keys: tuple) -> tuple:
+    return tuple(row[k] if k in row else MISSING[k](row) for k in keys)
 
 
 @pytest.fixture(scope="module")
@@ -46,10 +53,10 @@ def test_quick_report_covers_every_claim_and_says_it_is_quick(quick):
 def test_quick_run_reproduces_the_committed_numbers(quick, table):
     keys, values = TABLES[table]
     committed = read_table(FIGURES / table)
-    index = {tuple(r[k] for k in keys): r for r in committed}
+    index = {_key(r, keys): r for r in committed}
     matched, differ = 0, []
     for row in read_table(quick / table):
-        partner = index.get(tuple(row[k] for k in keys))
+        partner = index.get(_key(row, keys))
         if partner is None:
             continue
         matched += 1

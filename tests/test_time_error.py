@@ -73,3 +73,39 @@ def test_c1_bases_have_no_jump_at_node_crossings(tracks, basis):
     assert len(rows) == len(tracks["mpm"])
     worst = max(abs(r["measured"]) / abs(r["predicted"]) for r in rows)
     assert worst < 0.02, f"largest |measured|/|P1 formula| = {worst:.4f}"
+
+
+def test_the_crossing_summary_puts_the_jump_beside_the_global_order_in_dt():
+    """C2's second half (studies/time.py): per basis, the median |measured jump| / |P1 formula| and the basis's
+    global orders in dt (time_order's fitted orders of the particle velocity) and the spread of its successive
+    orders, in the declared columns."""
+    from mpm_fem.measure.schema import TIME_CROSSING_SUMMARY
+    from studies.time import crossing_summary
+
+    crossings = [{"basis": b, "acceleration": "exact", "measured": m, "predicted": 2.0}
+                 for b, ms in (("mpm", (2.0, 1.9, 2.1)), ("gimp", (0.004, -0.002, 0.001))) for m in ms]
+    for r in crossings:
+        r["ratio"] = r["measured"] / r["predicted"]
+    time_order = [{"problem": p, "basis": b, "quantity": "velocity", "order": o, "fitted_order": f}
+                  for p, b, orders, f in (("pulse", "mpm", ("", 0.6, 0.9), 0.72),
+                                          ("burgers", "mpm", ("", 0.8, 1.2), 1.0),
+                                          ("pulse", "gimp", ("", 1.0, 1.1), 1.04))
+                  for o in orders]
+    rows = {r["basis"]: r for r in crossing_summary(crossings, time_order)}
+    TIME_CROSSING_SUMMARY.check(list(rows.values()))
+    assert rows["mpm"]["jump_ratio"] == pytest.approx(1.0) and rows["gimp"]["jump_ratio"] == pytest.approx(0.001)
+    assert (rows["mpm"]["order_dt_pulse"], rows["mpm"]["order_dt_burgers"]) == (0.72, 1.0)
+    assert rows["mpm"]["order_dt_spread"] == pytest.approx(0.4)
+    assert rows["gimp"]["order_dt_spread"] == pytest.approx(0.1)
+    assert rows["gimp"]["order_dt_burgers"] == ""
+
+
+def test_the_crossing_summary_of_real_tracks_puts_gimp_and_bspline_far_below_p1(tracks):
+    """The measured crossings (exact acceleration) through the study's summary: P1's jump ratio within 10 % of the
+    slides' formula, GIMP's and the B-spline's below 2 % of it (the record: 0.994, 0.0028, 0.00032)."""
+    from studies.time import crossing_rows, crossing_summary
+
+    got = {(basis, "exact"): {"rows": rows} for basis, rows in tracks.items()}
+    ratio = {r["basis"]: r["jump_ratio"] for r in crossing_summary(crossing_rows(got))}
+    assert abs(ratio["mpm"] - 1) < 0.1, ratio
+    assert ratio["gimp"] < 0.02 * ratio["mpm"] and ratio["bspline"] < 0.02 * ratio["mpm"], ratio

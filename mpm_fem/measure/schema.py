@@ -147,30 +147,42 @@ BURGERS_DIAGNOSIS = Table("burgers/diagnosis", (
 TIME_ORDER = Table("time/time_order", (
     "problem", "basis", "quantity", "refine", "dt", "error", "order", "fitted_order"))
 TIME_LOCAL_ERROR = Table("time/local_error", ("problem", "basis", "quantity", "dt", "error", "order", "fitted_order"))
+#: Per basis and acceleration; C2's second half beside the jump (optional: absent from tables written before it):
+#: ``jump_ratio`` (median |measured jump| / |the slides' P1 formula|), the basis's global orders in dt of the particle
+#: velocity (``order_dt_pulse``, ``order_dt_burgers``: ``time_order``) and ``order_dt_spread`` (the widest range of
+#: its successive orders in dt).
 TIME_CROSSING_SUMMARY = Table("time/crossing_summary", (
-    "basis", "acceleration", "crossings", "median_ratio", "max_ratio_error", "max_abs_ratio", "median_abs_measured"))
+    "basis", "acceleration", "crossings", "median_ratio", "max_ratio_error", "max_abs_ratio", "median_abs_measured"),
+    optional=("jump_ratio", "order_dt_pulse", "order_dt_burgers", "order_dt_spread"))
 
 # ----------------------------------------------------------------------------- budget (E1, E2; E5)
 
+#: The particle setting of a run (issue 42): particles per cell, ``"regular"`` or ``"jittered"``, the seed (0 for the
+#: regular layout). Optional in the budget's and the remedies' tables: those written before it lack them (every row
+#: then has the study's own setting); every row of a table written since has them.
+PARTICLE_SETTING = ("ppc", "layout", "seed")
+
 #: v(S), the error with the stages of ``mpm_stages`` (``+``-joined, ``none`` for the empty set) in
 #: MPM form and the others exact: the raw measurements of the budget, which E1 reads.
-BUDGET_SUBSETS = Table("budget/subsets", ("problem", "h", "basis", "norm", "mpm_stages", "error"))
+BUDGET_SUBSETS = Table("budget/subsets", ("problem", "h", "basis", "norm", "mpm_stages", "error"),
+                       optional=PARTICLE_SETTING)
 BUDGET_SHAPLEY = Table("budget/shapley", (
-    "problem", "h", "basis", "norm", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error"))
+    "problem", "h", "basis", "norm", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error"),
+    optional=PARTICLE_SETTING)
 BUDGET_ROUNDOFF = Table("budget/roundoff", (
     "problem", "h", "basis", "norm", "stage", "share", "share_numpy", "change_pp", "mpm_error", "mpm_error_numpy",
     "exact_error", "exact_error_numpy"))
 #: ``error`` only when a run failed (its row then has no errors).
 BUDGET_BASES = Table("budget/bases", (
     "h", "basis", "ok", "steps", "wall_s", "particles_L1", "nodes_L1", "plateau_noise", "plateau_offset"),
-    optional=("error",))
+    optional=("error", *PARTICLE_SETTING))
 
 # ----------------------------------------------------------------------------- remedies (E5)
 
 REMEDIES_ERRORS = Table("remedies/errors", (
     "problem", "remedy", "h", "quantity", "nodes_L1", "nodes_L2", "particles_L1", "particles_L2", "fv_L1",
     "ratio_fv_nodes_L1", "ratio_fv_particles_L1", "steps", "n_p", "volume_drift", "error", "order_nodes_L1",
-    "order_particles_L1"))
+    "order_particles_L1"), optional=PARTICLE_SETTING)
 
 # ----------------------------------------------------------------------------- drift (C11's mechanism)
 
