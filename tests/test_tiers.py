@@ -68,8 +68,8 @@ def test_a_study_runs_one_tier():
 
 
 @pytest.mark.parametrize("argv, tier", [(["reproduce"], "quick"), (["reproduce", "--full"], "full"),
-                                        (["reproduce", "--deep"], "deep"), (["study", "sod"], "full"),
-                                        (["study", "sod", "--quick"], "quick"), (["study", "sod", "--deep"], "deep")])
+                                        (["reproduce", "--deep"], "deep"), (["study", "sod"], "quick"),
+                                        (["study", "sod", "--full"], "full"), (["study", "sod", "--deep"], "deep")])
 def test_the_command_line_picks_the_tier_and_its_folder(argv, tier, monkeypatch, tmp_path):
     monkeypatch.chdir(tmp_path)
     options = study_options(build_parser().parse_args(argv))
@@ -122,5 +122,7 @@ def test_the_quick_reproduction_leaves_out_the_plateau_studies_and_says_so(tmp_p
     monkeypatch.setattr("mpm_fem.app.estimate.tasks", lambda name, options: [])
     report.reproduce(StudyOptions(quick=True, out=tmp_path, jobs=1, progress=False))
     assert started == list(study.reproduced("quick"))
-    text = "\n".join(report.caveats({"versions": [{"table": "sod/convergence", "code": "x", "quick": "True"}]}, "x"))
+    text = "\n".join(report.caveats({"versions": [{"table": "sod/convergence", "code": "x", "tier": "quick"}]}, "x"))
     assert "leaves out the studies remedies and drift" in text
+    # every verdict the quick tier does not judge, with the tier that does
+    assert "The quick tier does not judge E2 (the full tier does: " in text and "; E5 (the full tier does: " in text
