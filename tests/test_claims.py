@@ -115,7 +115,8 @@ def _stamped(code: str):
 
     listed = {r["table"] for r in TABLES["versions"]}
     needed = sorted({name for c in CLAIMS for name in c.tables if name not in BUILT} - listed)
-    versions = TABLES["versions"] + [{"table": name, "code": code, "quick": "False"} for name in needed]
+    versions = TABLES["versions"] + [{"table": name, "code": code, "quick": "False", "tier": "full"}
+                                    for name in needed]
     return mutate({**TABLES, "versions": versions}, "versions", code=code)
 
 
@@ -128,7 +129,8 @@ def test_e4_is_confirmed_only_for_tables_of_the_current_code():
     assert evidence.startswith(f"the figures lag the code: tables from code 0123456789ab, the current code is "
                                f"{code_version()}")
     n = len(current["versions"])
-    assert judge("E4", current)[1] == f"{n} of {n} tables from code {code_version()}, the current code"
+    assert judge("E4", current)[1] == (f"{n} of {n} tables from code {code_version()}, the current code, {n} of the "
+                                       "full tier")
 
 
 def test_e4_refutes_tables_from_several_code_versions_and_is_partly_with_a_table_missing():
@@ -138,3 +140,13 @@ def test_e4_refutes_tables_from_several_code_versions_and_is_partly_with_a_table
     assert judge("E4", failing)[0] == "refuted" and "sod/extrema" in judge("E4", failing)[1]
     missing = {**current, "versions": [r for r in current["versions"] if r["table"] != "sod/extrema"]}
     assert judge("E4", missing)[0] == "partly" and "missing: sod/extrema" in judge("E4", missing)[1]
+
+
+@pytest.mark.parametrize("tier", ["quick", "deep", "unstamped"])
+def test_e4_refutes_a_folder_of_mixed_tiers(tier):
+    """One table of another tier (or none recorded) beside the others: not the output of one command."""
+    current = _stamped(code_version())
+    mixed = mutate(current, "versions", {"table": "sod/extrema"}, tier=tier)
+    assert_flips("E4", mixed, current)
+    verdict, evidence = judge("E4", mixed)
+    assert verdict == "refuted" and f"other tiers: sod/extrema ({tier})" in evidence

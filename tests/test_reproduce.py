@@ -7,14 +7,16 @@ key columns) must carry the same numbers to the 6 significant digits the CSV fil
 was not committed.
 """
 
+import os
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from mpm_fem.app.report import reproduce
-from mpm_fem.app.study import StudyOptions, read_table
-from mpm_fem.measure.claims import STATEMENTS
+from mpm_fem.app.study import NOT_JUDGED, StudyOptions, read_table
+from mpm_fem.measure.claims import CLAIMS, STATEMENTS
+from mpm_fem.measure.tables import load_tables
 
 FIGURES = Path(__file__).resolve().parent.parent / "figures"
 TABLES = {
@@ -37,9 +39,27 @@ def _key(row: dict, keys: tuple) -> tuple:
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
-    out = tmp_path_factory.mktemp("quick")
-    reproduce(StudyOptions(quick=True, out=out, jobs=2, progress=False))
+    """The quick reproduction from a folder without ``figures/`` (as after deleting it)."""
+    out, elsewhere = tmp_path_factory.mktemp("quick"), tmp_path_factory.mktemp("no-figures")
+    here = os.getcwd()
+    os.chdir(elsewhere)
+    try:
+        reproduce(StudyOptions(quick=True, out=out, jobs=2, progress=False))
+    finally:
+        os.chdir(here)
     return out
+
+
+def test_quick_judges_the_headline_claims_and_lists_what_it_does_not_judge(quick):
+    """C11 and C13 are judged from the quick tier's own runs; every verdict it does not judge is one the
+    report lists with the tier that judges it (mpm_fem.app.study.NOT_JUDGED)."""
+    tables = load_tables(quick)
+    verdicts = {c.label: c.verdict(tables)[0] for c in CLAIMS}
+    assert verdicts["C11"] != "not measured" and verdicts["C13"] != "not measured"
+    assert {label for label, v in verdicts.items() if v == "not measured"} == set(NOT_JUDGED["quick"])
+    text = (quick / "REPORT.md").read_text()
+    assert all(f"{c} (the {tier} tier does: " in text for c, (tier, _) in NOT_JUDGED["quick"].items())
+    assert {r["tier"] for r in tables["versions"]} == {"quick"}
 
 
 def test_quick_report_covers_every_claim_and_says_it_is_quick(quick):

@@ -68,8 +68,8 @@ def test_a_study_runs_one_tier():
 
 
 @pytest.mark.parametrize("argv, tier", [(["reproduce"], "quick"), (["reproduce", "--full"], "full"),
-                                        (["reproduce", "--deep"], "deep"), (["study", "sod"], "full"),
-                                        (["study", "sod", "--quick"], "quick"), (["study", "sod", "--deep"], "deep")])
+                                        (["reproduce", "--deep"], "deep"), (["study", "sod"], "quick"),
+                                        (["study", "sod", "--full"], "full"), (["study", "sod", "--deep"], "deep")])
 def test_the_command_line_picks_the_tier_and_its_folder(argv, tier, monkeypatch, tmp_path):
     monkeypatch.chdir(tmp_path)
     options = study_options(build_parser().parse_args(argv))
@@ -122,5 +122,190 @@ def test_the_quick_reproduction_leaves_out_the_plateau_studies_and_says_so(tmp_p
     monkeypatch.setattr("mpm_fem.app.estimate.tasks", lambda name, options: [])
     report.reproduce(StudyOptions(quick=True, out=tmp_path, jobs=1, progress=False))
     assert started == list(study.reproduced("quick"))
-    text = "\n".join(report.caveats({"versions": [{"table": "sod/convergence", "code": "x", "quick": "True"}]}, "x"))
+    text = "\n".join(report.caveats({"versions": [{"table": "sod/convergence", "code": "x", "tier": "quick"}]}, "x"))
     assert "leaves out the studies remedies and drift" in text
+    # every verdict the quick tier does not judge, with the tier that does
+    assert "The quick tier does not judge E2 (the full tier does: " in text and "; E5 (the full tier does: " in text
+
+
+# ----------------------------------------------------------------------------- quick answers the question
+
+def test_the_quick_plan_runs_c11s_setting_on_the_meshes_and_runs_c11_needs():
+    """The cheapest setting the source states (4 per cell, CFL 0.1) on at least FLOOR_MESHES meshes with
+    MIN_RUNS runs each (the rule book's numbers, the same for every tier), and no other setting of the
+    source's 4-8 per cell whose fewer meshes would leave its verdict not measured."""
+    from mpm_fem.measure.claims.sod import FLOOR_MESHES, MIN_RUNS, _prescribed
+
+    sod = importlib.import_module("studies.sod")
+    plan = sod._plan("quick")
+    c11 = (4, 0.1)
+    assert {k[:2] for k in plan["settings"] if _prescribed(k[0])} == {c11}
+    meshes = {h: 1 for n, cfl, h in plan["settings"] if (n, cfl) == c11}
+    for n, cfl, h, _ in plan["seeds"]:
+        if (n, cfl) == c11:
+            meshes[h] += 1
+    assert sum(runs >= MIN_RUNS for runs in meshes.values()) >= FLOOR_MESHES
+    assert max(meshes) == 0.01 and min(meshes) == 0.000625
+    assert set(meshes) <= set(plan["fem_lumped"]) and set(meshes) <= set(plan["fv"])  # E3 and the figure
+
+
+def test_the_quick_plan_runs_c13s_settings_on_every_seed():
+    burgers = importlib.import_module("studies.burgers")
+    plan = burgers._plan("quick")
+    judged = {"mpm_calculated", "mpm_calculated_8", "mpm_exact_dt_h"}  # the source's 4-8 per cell and exact a
+    for method in judged:
+        runs = [k for k in plan["seeds"] if k[0] == method]
+        meshes = {k[2] for k in runs}
+        assert len(meshes) >= 2 and len(runs) == len(meshes) * (1 + len(burgers.SEEDS)), method
+
+
+def test_the_criteria_never_read_the_tier():
+    """The rule book is the same for every tier: no criterion but E4 (which checks that every table is of
+    one tier) names the tier, and flipping every table's tier leaves every other verdict as it was."""
+    import ast
+
+    from claim_mutations import TABLES
+
+    from mpm_fem.measure.claims import CLAIMS
+
+    package = Path(importlib.import_module("mpm_fem.measure.claims").__file__).parent
+    for path in sorted(package.glob("*.py")):
+        if path.name == "reproduce.py":
+            continue
+        tree = ast.parse(path.read_text())
+        docstrings = {id(n.body[0].value) for n in ast.walk(tree) if isinstance(n, (ast.Module, ast.FunctionDef,
+                                                                                   ast.ClassDef))
+                      and n.body and isinstance(n.body[0], ast.Expr)}
+        words = [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)
+                 and id(n) not in docstrings and n.value in ("tier", "quick", "full", "deep")]
+        names = [n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and "tier" in n.id.lower()]
+        names += [n.attr for n in ast.walk(tree) if isinstance(n, ast.Attribute) and "tier" in n.attr.lower()]
+        assert not words and not names, (path.name, words, names)
+    flipped = {**TABLES, "versions": [{**r, "tier": "quick", "quick": "True"} for r in TABLES["versions"]],
+               "settings": [{**r, "value": {"tier": "quick", "quick": "True"}.get(r["key"], r["value"])}
+                            for r in TABLES["settings"]]}
+    assert flipped["versions"] != TABLES["versions"]
+    for c in CLAIMS:
+        if c.id != "E4":
+            assert c.verdict(flipped) == c.verdict(TABLES), c.label
+
+
+# ----------------------------------------------------------------------------- tiers are safe
+
+def _folder(tmp_path, tier: str, *tables: str) -> Path:
+    from mpm_fem.app.study import write_table
+
+    for table in tables:
+        study, name = table.split("/")
+        (tmp_path / study).mkdir(parents=True, exist_ok=True)
+        write_table(tmp_path / study, name, [{"h": 0.01, "error": 1.0}], {"x": 1}, tier=tier)
+    return tmp_path
+
+
+def _hashes(folder: Path) -> dict:
+    import hashlib
+
+    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_every_table_records_the_tier_of_the_study_that_wrote_it(tmp_path, monkeypatch):
+    import json
+    import sys
+    import types
+
+    from mpm_fem.app import study
+    from mpm_fem.measure.tables import load_tables
+
+    fake = types.ModuleType("studies.fake")
+    fake.run = lambda options: study.publish(options.folder("fake"), {"t": [{"a": 1}]}, {})
+    monkeypatch.setitem(sys.modules, "studies.fake", fake)
+    for tier in ("quick", "full", "deep"):
+        out = tmp_path / tier
+        study.run_study("fake", StudyOptions(quick=tier == "quick", deep=tier == "deep", out=out))
+        assert json.loads((out / "fake" / "t.json").read_text())["tier"] == tier
+        assert load_tables(out)["versions"][0]["tier"] == tier
+    study.write_table(tmp_path, "outside", [{"a": 1}], {})  # outside a study run: no tier recorded
+    assert "tier" not in json.loads((tmp_path / "outside.json").read_text())
+
+
+def test_a_table_written_before_the_stamp_reads_its_tier_from_its_settings_or_counts_as_another():
+    from mpm_fem.measure.tables import UNSTAMPED, table_tier
+
+    assert table_tier({"settings": {"quick": False}}) == "full"  # the committed record's tables
+    assert table_tier({"settings": {"quick": True}}) == "quick"
+    assert table_tier({"settings": {"quick": False, "tier": "deep"}}) == "deep"
+    assert table_tier({"tier": "quick", "settings": {"quick": False}}) == "quick"
+    assert table_tier({"settings": {}}) == table_tier({}) == UNSTAMPED
+
+
+def test_the_committed_record_reads_as_one_tier():
+    from mpm_fem.measure.tables import tiers
+
+    figures = Path(__file__).resolve().parent.parent / "figures"
+    assert set(tiers(figures).values()) == {"full"}
+    assert set(tiers(figures / "deep").values()) <= {"deep", "full"}
+
+
+def test_a_folder_with_a_flipped_tier_makes_e4_refuted(tmp_path):
+    import json
+
+    from claim_mutations import claim_named
+
+    from mpm_fem.measure.tables import load_tables
+
+    folder = _folder(tmp_path, "full", "sod/convergence", "sod/seeds", "burgers/orders")
+    verdict, evidence = claim_named("E4").verdict(load_tables(folder))
+    assert verdict == "partly" and "3 of the full tier" in evidence  # one tier; other tables missing
+    path = folder / "sod" / "seeds.json"
+    meta = json.loads(path.read_text())
+    path.write_text(json.dumps({**meta, "tier": "quick"}))
+    verdict, evidence = claim_named("E4").verdict(load_tables(folder))
+    assert verdict == "refuted" and "other tiers: sod/seeds (quick)" in evidence
+
+
+@pytest.mark.parametrize("argv", [["study", "sod", "--quick"], ["study", "sod"], ["reproduce"],
+                                  ["reproduce", "--deep"]])
+def test_writing_into_a_folder_of_another_tier_is_refused_in_one_line_and_changes_nothing(argv, tmp_path, capsys):
+    """A copy of the committed record (full tier): the quick and deep tiers are refused before any case
+    runs (no cache folder appears), exit status 2, every file as it was."""
+    import shutil
+
+    from mpm_fem.app.cli import main
+
+    figures = Path(__file__).resolve().parent.parent / "figures"
+    copy = tmp_path / "figures"
+    shutil.copytree(figures, copy, ignore=shutil.ignore_patterns(".cache", "*.png", "deep"))
+    before = _hashes(copy)
+    assert main([*argv, "--out", str(copy)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "tier" in err and "--overwrite" in err, err
+    assert _hashes(copy) == before and not (copy / "sod" / ".cache").exists()
+
+
+def test_overwrite_replaces_the_tables_of_the_other_tier_and_keeps_the_cases(tmp_path):
+    from mpm_fem.app.guard import UsageError
+    from mpm_fem.app.study import check_folder
+    from mpm_fem.measure.tables import tiers
+
+    folder = _folder(tmp_path, "full", "sod/convergence", "sod/plateau", "burgers/orders")
+    (folder / "sod" / ".cache").mkdir()
+    (folder / "sod" / ".cache" / "case.json").write_text("{}")
+    check_folder(StudyOptions(out=folder))  # the same tier: nothing to say
+    with pytest.raises(UsageError, match="holds 3 tables of the full tier"):
+        check_folder(StudyOptions(quick=True, out=folder))
+    check_folder(StudyOptions(quick=True, out=folder, overwrite=True), ("sod",))
+    assert tiers(folder) == {"burgers/orders": "full"}  # the study's own folder only
+    assert (folder / "sod" / ".cache" / "case.json").exists()
+    check_folder(StudyOptions(quick=True, out=folder, overwrite=True))  # reproduce: every study's
+    assert tiers(folder) == {}
+
+
+def test_study_prints_its_estimate_before_it_starts(tmp_path, monkeypatch, capsys):
+    from mpm_fem.app import study
+
+    started = []
+    monkeypatch.setattr(study, "run_study", lambda name, options: started.append(name) or "done")
+    assert study.start_study("budget", StudyOptions(quick=True, out=tmp_path)) == "done"
+    err = capsys.readouterr().err
+    assert started == ["budget"] and err.startswith("estimated ~") and "budget: " in err and "cases to run" in err

@@ -24,7 +24,7 @@ import numpy as np
 from mpm_fem.app import guard, output
 from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.guard import UsageError
-from mpm_fem.app.study import add_study_options, add_tier_options, run_study, study_options
+from mpm_fem.app.study import add_study_options, add_tier_options, start_study, study_options
 from mpm_fem.core.grid import GridError
 from mpm_fem.core.particles import LAYOUTS
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS
@@ -130,15 +130,21 @@ def build_parser() -> argparse.ArgumentParser:
 
     from mpm_fem.app.study import STUDIES
 
-    study = sub.add_parser("study", help="run one study: tables and figures into figures/<name>/ "
-                           "(figures/quick/<name>/ with --quick)",
-                           description="Run one study of the error analysis; results are cached per case.")
+    study = sub.add_parser("study", help="run one study: tables and figures into figures/quick/<name>/ (the quick "
+                           "tier, the default), figures/<name>/ (--full) or figures/deep/<name>/ (--deep)",
+                           description="Run one study of the error analysis, in the quick tier unless --full or "
+                           "--deep, into figures/quick/<name>/ (figures/<name>/ with --full, figures/deep/<name>/ "
+                           "with --deep, or --out DIR); prints the estimate first; results are cached per case. A "
+                           "folder holds one tier: a folder with tables of another tier is refused unless "
+                           "--overwrite.")
     study.add_argument("name", choices=STUDIES, help="which study")
     add_study_options(study)
     reproduce = sub.add_parser("reproduce", help="run every study and write REPORT.md: into figures/quick/ (--quick, "
                                "the default), figures/ (--full) or figures/deep/ (--deep)",
                                description="Regenerate every table and figure and REPORT.md, into figures/quick/ with "
-                               "--quick (the default), figures/ with --full, figures/deep/ with --deep (or --out DIR).")
+                               "--quick (the default), figures/ with --full, figures/deep/ with --deep (or --out DIR); "
+                               "prints the estimate first. A folder holds one tier: a folder with tables of another "
+                               "tier is refused unless --overwrite.")
     add_tier_options(reproduce, "quick")
     add_study_options(reproduce, quick_flag=False,
                        out_help="figures folder (default: figures/quick, figures or figures/deep by tier)")
@@ -280,7 +286,7 @@ def cmd_burgers(args) -> dict:
 
 
 def cmd_study(args) -> dict:
-    return {"line": run_study(args.name, study_options(args))}
+    return {"line": start_study(args.name, study_options(args))}
 
 
 def cmd_reproduce(args) -> dict:

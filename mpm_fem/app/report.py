@@ -27,7 +27,7 @@ from mpm_fem.app.output import write_atomic
 from mpm_fem.app.pages import PAGES, Page, View  # noqa: F401  (View: part of this module's interface)
 from mpm_fem.app.paper import Found, judge, key_text
 from mpm_fem.app.plots import CAPTIONS
-from mpm_fem.app.study import QUICK_LEAVES_OUT
+from mpm_fem.app.study import NOT_JUDGED, QUICK_LEAVES_OUT
 from mpm_fem.measure.claims import STATEMENTS, Claim, select
 from mpm_fem.measure.tables import Tables, load_tables
 from mpm_fem.measure.version import code_version as current_code
@@ -46,7 +46,16 @@ def code_version(tables: Tables) -> str:
 
 
 def is_quick(tables: Tables) -> bool:
-    return any(r["quick"] == "True" for r in tables.get("versions", []))
+    return any(r.get("tier") == "quick" for r in tables.get("versions", []))
+
+
+def not_judged(tables: Tables) -> list[str]:
+    """A caveat line per tier of the tables: the verdicts it does not judge (:data:`NOT_JUDGED`) and
+    the tier that judges each."""
+    found = dict.fromkeys(r.get("tier") for r in tables.get("versions", []))
+    return [f"- The {tier} tier does not judge " + "; ".join(f"{c} (the {by} tier does: {why})"
+                                                            for c, (by, why) in NOT_JUDGED[tier].items()) + "."
+            for tier in found if NOT_JUDGED.get(tier)]
 
 
 def anchor(claim: Claim) -> str:
@@ -127,8 +136,8 @@ def stamps_appendix(letter: str, tables: Tables) -> list[str]:
     lines = ['<a id="appendix-stamps"></a>', "", f"## Appendix {letter}: the code version of each table", ""]
     if not rows:
         return lines + ["No table in this folder.", ""]
-    return lines + [f"The stamp of each of the {len(rows)} tables (E4).", "",
-                    *markdown_table(rows, ("table", "code", "quick")), ""]
+    return lines + [f"The stamp (code version and tier) of each of the {len(rows)} tables (E4).", "",
+                    *markdown_table(rows, ("table", "code", "tier")), ""]
 
 
 def deep_appendix(letter: str, deep: Tables | None, deep_found: Found | None) -> list[str]:
@@ -163,6 +172,7 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
                "(`mpm-fem reproduce --full`), which reaches finer meshes. The quick tier leaves out the studies "
                f"{' and '.join(QUICK_LEAVES_OUT)}: their questions are about the plateau of Sod's particle error, "
                "below its meshes." if is_quick(tables) else "- These tables come from `mpm-fem reproduce --full`.")
+    out += not_judged(tables)
     written = code_version(tables)
     rows = tables.get("versions", [])
     behind = sorted({r["table"].split("/")[0] for r in rows if r["code"] != current})
@@ -236,15 +246,17 @@ def write_report(out: Path, pages: list[Page] | None = None) -> Path:
 
 
 def reproduce(options) -> Path:
-    """Run every study with ``options`` (:class:`mpm_fem.app.study.StudyOptions`), then write the report.
+    """Run every study with ``options`` (:class:`mpm_fem.app.study.StudyOptions`), then write the report;
+    a folder holding tables of another tier is refused first (:func:`mpm_fem.app.study.check_folder`).
     The cases of all studies run in one pool, the longest first (so no worker idles at the end of a
     study while another has cases left); as soon as the last case of a study is in, a worker writes
     that study's tables and figures from the cache, ahead of the cases still waiting (this process
     does, with one job or a Dask scheduler: :func:`mpm_fem.app.sweep.run_tasks`)."""
     from mpm_fem.app.estimate import describe, estimate, tasks
-    from mpm_fem.app.study import reproduced, run_study
+    from mpm_fem.app.study import check_folder, reproduced, run_study
     from mpm_fem.app.sweep import default_jobs, run_tasks
 
+    check_folder(options)
     studies = reproduced(options.tier)
     if options.progress is not False:
         workers = options.jobs or default_jobs()

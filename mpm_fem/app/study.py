@@ -5,8 +5,13 @@ The run options are parsed here (:func:`add_study_options`, :func:`study_options
 never goes through the command line module.
 
 A study writes ``figures/<name>/<table>.csv`` (one row per measurement), a ``<table>.json`` with
-the exact settings and the package versions beside it, and its ``.png`` figures. The cache of
-finished cases lives in ``figures/<name>/.cache/`` (git-ignored).
+the exact settings, the package versions, the code version and the tier beside it, and its ``.png``
+figures. The cache of finished cases lives in ``figures/<name>/.cache/`` (git-ignored).
+
+A figures folder holds one tier (:data:`TIERS`): a command that would write a study into a folder
+holding tables of another tier is refused before any case runs (:func:`check_folder`), unless
+``--overwrite``, which removes those tables first; the case cache is shared between tiers (a case is
+the same run in every tier).
 """
 
 from __future__ import annotations
@@ -16,6 +21,7 @@ import csv
 import importlib
 import io
 import sys
+from contextvars import ContextVar
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +29,7 @@ from mpm_fem.app import guard
 from mpm_fem.app.output import ensure_writable_dir, versions, write_atomic, write_json
 from mpm_fem.app.sweep import code_version, run_cases
 from mpm_fem.measure.schema import Table
-from mpm_fem.measure.tables import read_table  # noqa: F401  (re-exported: the studies' and tests' reader)
+from mpm_fem.measure.tables import read_table, tiers  # noqa: F401  (read_table: the studies' and tests' reader)
 
 #: The tiers of a reproduction: ``quick`` (the README's command, a subset of meshes), ``full`` (the
 #: committed record in ``figures/``), ``deep`` (the full plan and the finest meshes and long sweeps,
@@ -31,6 +37,8 @@ from mpm_fem.measure.tables import read_table  # noqa: F401  (re-exported: the s
 TIERS = ("quick", "full", "deep")
 #: Where each tier writes by default.
 TIER_FOLDERS = {"quick": Path("figures/quick"), "full": Path("figures"), "deep": Path("figures/deep")}
+#: The tier of the study being written (:func:`run_study`), stamped on every table it writes.
+_WRITING: ContextVar[str | None] = ContextVar("tier", default=None)
 
 
 @dataclass(frozen=True)
@@ -38,7 +46,8 @@ class StudyOptions:
     """``quick`` / ``deep``: the tier (:data:`TIERS`; neither: ``full``); ``jobs``: worker processes;
     ``scheduler``: a Dask scheduler address; ``out``: the figures folder (``figures/``);
     ``cache``: the folder whose ``<study>/.cache/`` holds the finished cases (default ``out``; the
-    deep tier reads the full tier's, so that it runs only the cases the full tier has not)."""
+    deep tier reads the full tier's, so that it runs only the cases the full tier has not);
+    ``overwrite``: replace the tables of another tier in ``out`` (:func:`check_folder`)."""
 
     quick: bool = False
     jobs: int | None = None
@@ -47,6 +56,7 @@ class StudyOptions:
     progress: bool | None = None
     deep: bool = False
     cache: Path | None = None
+    overwrite: bool = False
 
     def __post_init__(self):
         if self.quick and self.deep:
@@ -83,9 +93,10 @@ class StudyOptions:
         return {g: {label: results[key(c)] for label, c in group.items()} for g, group in plan.items()}
 
 
-def write_table(folder: Path, table: str | Table, rows: list[dict], settings: dict) -> Path:
+def write_table(folder: Path, table: str | Table, rows: list[dict], settings: dict, tier: str | None = None) -> Path:
     """``<folder>/<table>.csv`` from ``rows`` (dicts with the same keys) and ``<table>.json``
-    holding ``settings``, the package versions and the code hash. Returns the CSV path. ``table`` is
+    holding the ``tier`` (default: that of the study :func:`run_study` is writing; none outside it),
+    ``settings``, the package versions and the code hash. Returns the CSV path. ``table`` is
     the file's name, or a table declared in :mod:`mpm_fem.measure.schema`: then the rows' columns
     must be the declared ones (:class:`mpm_fem.measure.schema.ColumnsError` otherwise, nothing written)."""
     if not rows:
@@ -103,7 +114,9 @@ def write_table(folder: Path, table: str | Table, rows: list[dict], settings: di
         writer.writerow({k: _fmt(v) for k, v in row.items()})
     path = Path(folder) / f"{table}.csv"
     write_atomic(path, buffer.getvalue())
-    write_json(Path(folder) / f"{table}.json", {"settings": settings, "versions": versions(), "code": code_version()})
+    tier = tier or _WRITING.get()
+    write_json(Path(folder) / f"{table}.json", {**({"tier": tier} if tier else {}), "settings": settings,
+                                                "versions": versions(), "code": code_version()})
     return path
 
 
@@ -137,31 +150,36 @@ def _fmt(value):
     return value
 
 
-def add_tier_options(parser: argparse.ArgumentParser, default: str) -> None:
-    """``--quick | --full | --deep``, into ``args.tier`` (``default`` when none is given)."""
+def add_tier_options(parser: argparse.ArgumentParser, default: str = "quick") -> None:
+    """``--quick | --full | --deep``, into ``args.tier`` (``default`` when none is given), and
+    ``--overwrite`` (replace the tables of another tier in the folder)."""
     size = parser.add_mutually_exclusive_group()
     size.add_argument("--quick", dest="tier", action="store_const", const="quick",
-                      help="the subset of meshes of the quick reproduction (about a minute on 2 cores; "
-                           "reproduce leaves out the remedies and drift studies there)")
+                      help="the quick tier, the default: a subset of meshes that judges C11 and C13, into "
+                           "figures/quick (about a minute on 2 cores; reproduce leaves out the remedies and drift "
+                           "studies there)")
     size.add_argument("--full", dest="tier", action="store_const", const="full",
                       help="every table of the committed record, figures/ (about 45 min on 2 cores)")
     size.add_argument("--deep", dest="tier", action="store_const", const="deep",
                       help="the full plan and the finest meshes and long sweeps, figures/deep/ (reuses the full "
                            "tier's finished cases; hours on 2 cores, or a Dask cluster with --scheduler)")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="a folder holds one tier: writing into a folder that holds tables of another tier is "
+                             "refused unless --overwrite, which removes those tables first (the cases stay cached)")
     parser.set_defaults(tier=default)
 
 
 def add_study_options(parser: argparse.ArgumentParser, quick_flag: bool = True, out_help: str | None = None) -> None:
-    """The options of a study run: the tier (``--quick``, ``--full``, ``--deep``; full by default),
-    ``--jobs``, ``--scheduler``, ``--out``, ``--quiet``."""
+    """The options of a study run: the tier (``--quick``, ``--full``, ``--deep``; quick by default) and
+    ``--overwrite``, ``--jobs``, ``--scheduler``, ``--out``, ``--quiet``."""
     if quick_flag:
-        add_tier_options(parser, "full")
+        add_tier_options(parser, "quick")
     parser.add_argument("--jobs", type=int, default=None,
                         help="worker processes, at most the number of cores (default: the cores, at most 8)")
     parser.add_argument("--scheduler", default=None,
                         help="address of a running Dask scheduler, tcp://HOST:PORT (checked with a 3 s connect)")
     parser.add_argument("--out", default=None,
-                        help=out_help or "figures folder (default: figures, figures/quick or figures/deep by tier)")
+                        help=out_help or "figures folder (default: figures/quick, figures or figures/deep by tier)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
 
 
@@ -178,16 +196,22 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
     except PermissionError as err:
         raise guard.UsageError(str(err)) from None
     return StudyOptions(quick=tier == "quick", deep=tier == "deep", jobs=jobs, scheduler=scheduler, out=out,
-                        cache=cache, progress=False if args.quiet else None)
+                        cache=cache, progress=False if args.quiet else None, overwrite=args.overwrite)
 
 
 #: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
 #: layer and import it, never the other way round).
 STUDIES = ("projection", "sod", "burgers", "identification", "budget", "time", "remedies", "drift")
 #: The studies the quick reproduction leaves out: their questions (E5, and the mechanism of C11) are
-#: about the plateau of Sod's particle error, which appears only below the quick tier's meshes (C11
-#: itself is not measured there). ``mpm-fem study NAME --quick`` still runs them.
+#: about the plateau of Sod's particle error, which the quick tier's meshes reach at one setting only
+#: (C11's). ``mpm-fem study NAME --quick`` still runs them.
 QUICK_LEAVES_OUT = ("remedies", "drift")
+#: The verdicts a tier does not judge, ``{tier: {claim: (the tier that judges it, why)}}``: the report
+#: lists them (``tests/test_reproduce.py`` checks the quick tier's against its report).
+NOT_JUDGED = {"quick": {
+    "E2": ("full", "the bases' budget (budget/bases) runs on the full tier's meshes only"),
+    "E5": ("full", "the quick reproduction leaves out the remedies study"),
+}}
 
 
 def reproduced(tier: str) -> tuple[str, ...]:
@@ -197,9 +221,47 @@ def reproduced(tier: str) -> tuple[str, ...]:
 
 
 def run_study(name: str, options: StudyOptions) -> str:
-    """Run ``studies/<name>.py`` with ``options``; returns the line reporting where it wrote."""
-    importlib.import_module(f"studies.{name}").run(options)
+    """Run ``studies/<name>.py`` with ``options``, every table it writes stamped with ``options.tier``;
+    returns the line reporting where it wrote. Checks no folder: :func:`start_study` does."""
+    token = _WRITING.set(options.tier)
+    try:
+        importlib.import_module(f"studies.{name}").run(options)
+    finally:
+        _WRITING.reset(token)
     return f"study {name} written to {options.folder(name)}"
+
+
+def check_folder(options: StudyOptions, studies: tuple[str, ...] | None = None) -> None:
+    """Before any case runs: a folder holds one tier. If ``options.out`` holds tables of another tier
+    than ``options.tier`` (an unstamped table counts as another tier), raise
+    :class:`mpm_fem.app.guard.UsageError` (one line, exit status 2) and change nothing, unless
+    ``options.overwrite``: then remove those tables (CSV and JSON) of the study folders ``studies``
+    (``None``: every one) and keep the cached cases."""
+    other = {table: tier for table, tier in tiers(options.out).items() if tier != options.tier}
+    if not other:
+        return
+    if not options.overwrite:
+        found = sorted(set(other.values()))
+        raise guard.UsageError(
+            f"{options.out} holds {len(other)} tables of the {' and '.join(found)} tier (e.g. {next(iter(other))}), "
+            f"and a folder holds one tier: the {options.tier} tier is not written there; pass --overwrite to "
+            "replace them, or --out another folder")
+    for table in other:
+        if studies is None or table.split("/")[0] in studies:
+            for suffix in (".csv", ".json"):
+                (Path(options.out) / f"{table}{suffix}").unlink(missing_ok=True)
+
+
+def start_study(name: str, options: StudyOptions) -> str:
+    """``mpm-fem study <name>``: check the folder (:func:`check_folder`), print the estimate (unless
+    ``options.progress`` is ``False``), then :func:`run_study`."""
+    from mpm_fem.app.estimate import describe, estimate
+    from mpm_fem.app.sweep import default_jobs
+
+    check_folder(options, (name,))
+    if options.progress is not False:
+        print(describe({name: estimate(name, options)}, options.jobs or default_jobs()), file=sys.stderr, flush=True)
+    return run_study(name, options)
 
 
 def script_main(name: str, argv=None) -> int:
@@ -210,7 +272,7 @@ def script_main(name: str, argv=None) -> int:
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)
 
     def command():
-        line = run_study(name, study_options(args))
+        line = start_study(name, study_options(args))
         if not args.quiet:
             print(line)
 

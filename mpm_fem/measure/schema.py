@@ -204,7 +204,9 @@ IDENTIFICATION_BURGERS = Table("identification/burgers", ("problem", "candidate"
 
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
-VERSIONS = Table("versions", ("table", "code", "quick"))
+#: One row per table: the code version that wrote it and its tier (:func:`mpm_fem.measure.tables.table_tier`;
+#: ``quick``: the legacy flag, ``True``/``False`` as recorded in its settings).
+VERSIONS = Table("versions", ("table", "code", "quick", "tier"))
 SETTINGS = Table("settings", ("table", "key", "value"))
 
 #: Every declared table a study writes, by name.
