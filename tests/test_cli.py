@@ -233,6 +233,23 @@ def test_the_time_left_is_the_mean_time_of_the_cases_run_so_far():
     assert time_left(5.0, 0, 4) == "time left unknown" and time_left(5.0, 4, 0) == "done"
 
 
+def test_the_time_left_weighs_the_cases_by_their_cost(capsys, monkeypatch):
+    """The costly case first (as a sweep starts them): by case count the time left would be the first
+    case's time again; weighed by the cost models' estimate it is a tenth of it."""
+    from mpm_fem.app import sweep
+
+    monkeypatch.setattr(sweep.sys.stderr, "isatty", lambda: False, raising=False)
+    clock = iter([0.0, 100.0, 200.0])
+    monkeypatch.setattr(sweep.time, "perf_counter", lambda: next(clock))
+    weighed = sweep._Progress(2, 0, "cases", True, to_run=11.0)
+    weighed.update({}, 10.0)
+    assert capsys.readouterr().err.splitlines()[-1] == "[cases] 1/2 done, 100 s, about 10 s left"
+    clock = iter([0.0, 100.0])
+    counted = sweep._Progress(2, 0, "cases", True)
+    counted.update({})
+    assert capsys.readouterr().err.splitlines()[-1] == "[cases] 1/2 done, 100 s, about 100 s left"
+
+
 def test_plain_progress_lines_show_the_time_left(capsys, monkeypatch):
     from mpm_fem.app import sweep
     from mpm_fem.app.convergence import measured

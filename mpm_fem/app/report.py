@@ -276,7 +276,7 @@ def reproduce(options) -> Path:
         return None
 
     run_tasks([t for _, _, t in planned], jobs=options.jobs, desc=f"reproduce --{options.tier}",
-              scheduler=options.scheduler, progress=options.progress, done=done)
+              scheduler=options.scheduler, progress=options.progress, done=done, costs=[s for s, _, _ in planned])
     for name in (n for n in studies if n not in published):  # a study without a cost model, or no case
         run_study(name, options)
     return write_report(options.out)

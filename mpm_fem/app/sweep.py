@@ -32,6 +32,7 @@ import sys
 import threading
 import time
 from collections import deque
+from collections.abc import Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from functools import partial
@@ -171,6 +172,7 @@ def run_tasks(
     scheduler: str | None = None,
     progress: bool | None = None,
     done: Callable[[int], Callable[[], object] | None] | None = None,
+    costs: Sequence[float] | None = None,
 ) -> list[dict]:
     """``[t.fn(t.case) for t in tasks]``, in parallel, each cached in its task's folder; results in the
     order of ``tasks``, which is also the order they start in; a task listed twice (the same function and
@@ -181,7 +183,10 @@ def run_tasks(
     workers go on with the others. It may return a follow-up, a picklable function of no arguments
     (a study's tables and figures once its last case is in): a worker of the pool runs it ahead of the
     cases not yet started; without a pool (one job) or on a Dask cluster (whose workers need not share
-    this file system) this process runs it at once."""
+    this file system) this process runs it at once.
+    ``costs`` (one per task, e.g. the cost models' CPU seconds) weigh the progress's time left: the
+    time so far times the cost still to run over the cost run so far; without them each case weighs
+    the same."""
     if jobs is not None and jobs < 1:
         raise ValueError(f"jobs must be >= 1, got {jobs}")
     jobs = jobs or default_jobs()
@@ -201,7 +206,11 @@ def run_tasks(
                 first[path] = k
             todo.append((k, path))
     pooled = scheduler is None and jobs > 1
-    reporter = _Progress(len(tasks), len(tasks) - len(todo), desc, progress)
+    weights = list(costs) if costs is not None else [1.0] * len(tasks)
+    if len(weights) != len(tasks):
+        raise ValueError(f"costs: {len(weights)} for {len(tasks)} tasks")
+    reporter = _Progress(len(tasks), len(tasks) - len(todo), desc, progress,
+                         to_run=sum(weights[k] for k, _ in todo))
 
     def follow(k: int):
         """``done(k)``'s follow-up, for the pool to run; run here when there is no pool."""
@@ -222,7 +231,7 @@ def run_tasks(
         thens = []
         for j in (k, *twins.get(k, ())):
             results[j] = result
-            reporter.update(tasks[j].case)
+            reporter.update(tasks[j].case, weights[j] if j == k else 0.0)
             thens.append(follow(j))
         thens = tuple(t for t in thens if t is not None)
         return None if not thens else thens[0] if len(thens) == 1 else partial(_run_all, thens)
@@ -281,10 +290,13 @@ PLAIN_EVERY = 60.0
 class _Progress:
     """A tqdm bar on a terminal (elapsed and left); on other streams a plain line every ~10 % of the
     cases or every :data:`PLAIN_EVERY` seconds, whichever comes first, with the time left at the
-    rate of the cases run so far (:func:`time_left`)."""
+    rate of the cases run so far, each weighed by its cost (:func:`time_left`; ``to_run``: the cost
+    of every case to run)."""
 
-    def __init__(self, total: int, done: int, desc: str, progress: bool | None):
+    def __init__(self, total: int, done: int, desc: str, progress: bool | None, to_run: float | None = None):
         self.total, self.done, self.desc, self.cached = total, done, desc, done
+        self.to_run = float(total - done) if to_run is None else float(to_run)
+        self.ran = 0.0
         self.start = self.last = time.perf_counter()
         tty = sys.stderr.isatty()
         self.enabled = progress if progress is not None else True
@@ -294,15 +306,17 @@ class _Progress:
         if self.plain:
             print(f"[{desc}] {total - done} of {total} cases to run ({done} cached)", file=sys.stderr, flush=True)
 
-    def update(self, case: dict) -> None:
+    def update(self, case: dict, cost: float = 1.0) -> None:
         self.done += 1
+        self.ran += cost
         if self.bar is not None:
             self.bar.update(1)
         elif self.plain:
             now = time.perf_counter()
             if self.done % self.step == 0 or self.done == self.total or now - self.last >= PLAIN_EVERY:
                 self.last = now
-                left = time_left(now - self.start, self.done - self.cached, self.total - self.done)
+                left = time_left(now - self.start, self.ran, self.to_run - self.ran) if self.done < self.total \
+                    else "done"
                 print(f"[{self.desc}] {self.done}/{self.total} done, {now - self.start:.0f} s, {left}", file=sys.stderr,
                       flush=True)
 
@@ -311,12 +325,12 @@ class _Progress:
             self.bar.close()
 
 
-def time_left(elapsed: float, run: int, left: int) -> str:
-    """``"about N s left"`` for ``left`` cases at the mean time of the ``run`` cases so far (tqdm's
-    estimate; the longest cases start first, so it errs long), ``"done"`` when none is left."""
+def time_left(elapsed: float, run: float, left: float) -> str:
+    """``"about N s left"``: ``elapsed * left / run``, the cost ``left`` to run at the rate of the cost
+    ``run`` so far (costs in any unit: cases, or the cost models' seconds), ``"done"`` when none is left."""
     if left <= 0:
         return "done"
-    seconds = elapsed / run * left if run else float("nan")
+    seconds = elapsed / run * left if run > 0 else float("nan")
     if seconds != seconds:
         return "time left unknown"
     return f"about {seconds:.0f} s left" if seconds < 120 else f"about {seconds / 60:.0f} min left"
