@@ -137,6 +137,12 @@ LAYOUT_H = {"quick": {"sod": QUICK["SOD_H"], "burgers": QUICK["BURGERS_H"]},
             "full": {"sod": SOD_H[:2], "burgers": BURGERS_H[:2]},
             "deep": {"sod": SOD_H[:3], "burgers": BURGERS_H[:3]}}
 QUICK_LAYOUT = {"remedies": ("MPM",), "ppc": {"sod": (SOD_MPM["ppc"],), "burgers": (BURGERS["ppc"],)}}
+#: the remedies of the layout runs per tier beyond quick: the full tier plain MPM only, the deep tier every
+#: remedy of a point-mass basis. A particle-domain B-spline run on a jittered Sod layout stopped with a
+#: particle 2e-7 beyond the right wall (``OutsideGridError``), which the case function does not record as a
+#: failed run; until the walls of the particle-domain bases are fixed those runs stay out of the plan.
+LAYOUT_REMEDIES = {"full": ("MPM",),
+                   "deep": tuple(n for n, r in REMEDIES.items() if r.get("basis") != "bspline_gimp")}
 
 
 def _layout_case(problem: str, h: float, name: str, ppc: int, layout: str, seed: int, kernel: dict) -> dict:
@@ -156,7 +162,7 @@ def _plan(tier: str) -> dict:
     sod_h, burgers_h = q.get("SOD_H", SOD_H), q.get("BURGERS_H", BURGERS_H)
     meshes, kernel = DEEP_SOD_MESHES if tier == "deep" else SOD_MESHES, QUICK_KERNEL if quick else {}
     sod_h = sod_h[:max(meshes[n] for n in names)]
-    layout_names = QUICK_LAYOUT["remedies"] if quick else names
+    layout_names = QUICK_LAYOUT["remedies"] if quick else LAYOUT_REMEDIES[tier]
     return {
         "sod": {(n, h): {"solver": "sod", "h": h, **SOD_MPM, **REMEDIES[n], **kernel}
                 for n in names for h in sod_h[:meshes[n]]},
