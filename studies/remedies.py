@@ -34,9 +34,10 @@ XPIC(m) (:mod:`mpm_fem.core.xpic`) runs alone (m = 2, 5) and with the particle-d
 mesh of both problems.
 
 Particle layouts (issue 42): beside the runs above (Sod 16 per cell, Burgers 4, the regular layout)
-every remedy runs at 4, 8 and 16 per cell on the regular layout and on the Sod study's five jittered
-ones (seeds 1-5): the full tier on the two coarsest meshes of each problem (Sod 0.01, 0.005; Burgers
-0.04, 0.02), the deep tier on three (:data:`LAYOUT_H`); ``errors.csv`` names each row's ``ppc``,
+plain MPM (the full tier) and every remedy of a point-mass basis (the deep tier; :data:`LAYOUT_REMEDIES`)
+run at 4, 8 and 16 per cell on the regular layout and on the Sod study's five jittered ones (seeds
+1-5): the full tier on the two coarsest meshes of each problem (Sod 0.01, 0.005; Burgers 0.04, 0.02),
+the deep tier on three (:data:`LAYOUT_H`); ``errors.csv`` names each row's ``ppc``,
 ``layout`` and ``seed`` and takes the orders within one setting; ``orders.csv``, ``cost.csv`` and the
 figures hold the study's own setting.
 """
