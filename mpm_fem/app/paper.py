@@ -57,7 +57,8 @@ def said(c: Claim, f: Finding, link: bool = False) -> str:
     plain sentence, or the statement and the evidence's first clause."""
     label = f"[{c.label}](#{anchor_of(c.label)})" if link else c.label
     if f.sentence:
-        return f"{f.sentence.strip().rstrip('.')} ({label})."
+        text = f.sentence.strip().rstrip(".")
+        return f"{text[:1].upper()}{text[1:]} ({label})."
     statement = c.statement[0].upper() + c.statement[1:]
     return f"{statement} ({label}): {first_clause(f)}."
 
