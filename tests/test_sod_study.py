@@ -219,7 +219,8 @@ def test_smoke_a_tiny_plan_writes_every_table_and_figure(tmp_path, monkeypatch):
     """The fast version of the slow check: the same run on the two coarsest meshes, few particles."""
     from mpm_fem.app.study import StudyOptions
 
-    tiny = dict(H=(0.04, 0.02), PPC_H=(0.04,), CONSISTENT_H=(0.04,), PLATEAU_H=(), SEED_H=(0.04, 0.02))
+    tiny = dict(H=(0.04, 0.02), PPC_H=(0.04,), CONSISTENT_H=(0.04,), PLATEAU_H=(),
+                SETTINGS={setting: ((0.04, 0.02), (0.04, 0.02)) for setting in study.SETTINGS})
     monkeypatch.setattr(study, "QUICK", tiny)
     monkeypatch.setattr(study, "PROFILE_H", (0.04,))
     monkeypatch.setattr(study, "PPC", (4, 8))
