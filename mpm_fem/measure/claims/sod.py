@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import math
 
+import mpm_fem.measure.claims.shape as shape
 from baselines.exact.riemann import wave_positions
-from mpm_fem.measure.claims import shape
 from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Finding, Tables, claim
 from mpm_fem.measure.claims.drift import mechanism
 from mpm_fem.measure.claims.identification import source_matching
