@@ -198,6 +198,11 @@ def identification_section(tables: Tables) -> list[str]:
 
 # ----------------------------------------------------------------------------- the sections
 
+def _has_tables(tables: Tables, study: str) -> bool:
+    """Whether ``tables`` hold a table of ``study`` (its appendix is written only then)."""
+    return any(rows for name, rows in tables.items() if name.startswith(study + "/"))
+
+
 def abstract(tables: Tables, found: Found) -> list[str]:
     """Four to six plain sentences: what was reproduced and at which settings, where the source's
     tables are reproduced (when the identification tables are there), what differs (C11, C13), the
@@ -291,7 +296,8 @@ def results(tables: Tables, found: Found, pages: list[Page], captions: dict, sum
              *summary("C"), "", "*The extensions.*", "", *summary("E"), ""]
     shown = [p for p in [*pages, REPRODUCTION] if claims_of(p.name)]
     for page in shown:
-        present = any(tables.get(t) for c in claims_of(page.name) for t in c.tables)
+        present = any(tables.get(t) for c in claims_of(page.name) for t in c.tables) \
+            and (page is REPRODUCTION or _has_tables(tables, page.name))
         lines += [f'<a id="{page.name}"></a>', "", f"### {page.title}", "",
                   *prose(page.caption if present else
                          f"No table of the study `{page.name}` in this folder: its claims are not measured here.")]
