@@ -18,6 +18,7 @@ import json
 from mpm_fem.app.markdown import anchor_of, bullets, figure, markdown_table, prose, sentences, split_outside
 from mpm_fem.app.pages import Page
 from mpm_fem.measure.claims import CLAIMS, STATEMENTS, Claim, Finding, claims_of, identification, num, select, span
+from mpm_fem.measure.claims.base import DIFFERS, PARTLY, REFUTED
 from mpm_fem.measure.claims.drift import STUDY, mechanism
 from mpm_fem.measure.claims.rules import RULES, VERDICT_MEANING
 from mpm_fem.measure.tables import Tables
@@ -29,7 +30,7 @@ ABSTRACT = ("C11", "C13", "E1 (sod)", "E5")
 CONCLUSIONS = ("C11", "C13", "C12", "C15 (sod)", "E1 (sod)", "E1 (burgers)", "E3", "E5", "C10", "C3 (sod)")
 MAX_CONCLUSIONS = 8
 #: Verdicts that depart from the source's statement: the discussion takes each in turn.
-DEPARTS = ("partly", "differs", "refuted")
+DEPARTS = (PARTLY, DIFFERS, REFUTED)
 #: Where the discussion measures a discrepancy's mechanism in a section of its own.
 MEASURED_ELSEWHERE = {"C11": "[The drift study](#drift) below measures what makes the particle error grow."}
 #: The results' section of the claims on the record itself (E4): they read the tables' stamps.
