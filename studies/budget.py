@@ -107,15 +107,14 @@ LAYOUTS = (("regular", 0),) + tuple(("jittered", s) for s in SEEDS)
 #: per tier, ``{(problem, basis): meshes}`` of the budgets run at every LAYOUT_PPC and layout. The full tier: P1 on
 #: the two coarsest meshes of each problem (:data:`BUDGET_STEP_MS`: a Sod budget at h = 0.005 costs 15-25 CPU-s a
 #: setting, the other bases 1.3-2x more, hence deep); the deep tier adds the other bases on those meshes and P1's on
-#: the next finer one. The quick tier: P1's Burgers budget at its coarsest mesh, 4 per cell, with the seeds.
-LAYOUT_H = {"quick": {("burgers", "mpm"): (0.04,)},
+#: the next finer one. The quick tier runs none (its budget of 45 s warm: the layouts' budgets cost 9 CPU-s there).
+LAYOUT_H = {"quick": {},
             "full": {("sod", "mpm"): H["sod"][:2], ("burgers", "mpm"): H["burgers"][:2]},
             "deep": {**{("sod", b): H["sod"][:2] for b in BUDGET_BASES}, ("sod", "mpm"): H["sod"][:3],
                      **{("burgers", b): H["burgers"][:2] for b in BUDGET_BASES}, ("burgers", "mpm"): H["burgers"]}}
 #: per tier, the meshes of E2's bases run at every LAYOUT_PPC and layout (the full tier: the three coarsest, two
 #: refinements; the deep tier two more)
 BASES_LAYOUT_H = {"quick": (), "full": BASES_H[:3], "deep": BASES_H[:5]}
-QUICK_LAYOUT_PPC = {"burgers": (BURGERS["ppc"],)}
 
 
 def _layout_changes(problem: str, ppc: int, layout: str, seed: int) -> dict:
@@ -144,7 +143,7 @@ def plan(tier: str) -> dict:
     layouts = {(p, h, b, n, lay, s): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K,
                                        **_layout_changes(p, n, lay, s)}
                for (p, b), meshes in LAYOUT_H[tier].items() for h in meshes
-               for n in (QUICK_LAYOUT_PPC[p] if quick else LAYOUT_PPC) for lay, s in LAYOUTS}
+               for n in LAYOUT_PPC for lay, s in LAYOUTS}
     bases_layouts = {(h, b, n, lay, s): {"kind": "bases", "h": h, "basis": b, **_layout_changes("sod", n, lay, s)}
                      for h in BASES_LAYOUT_H[tier] for b in BASES for n in LAYOUT_PPC for lay, s in LAYOUTS}
     return {"budget": budget, "bases": e2, "roundoff": roundoff, "layouts": layouts, "bases_layouts": bases_layouts}

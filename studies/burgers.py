@@ -76,11 +76,15 @@ DIAGNOSIS = {  # label: changes to the calculated-acceleration run
 }
 #: The quick tier: the compared solution at the first eps on the two coarsest meshes (the third, h =
 #: 0.0025, cost a third of the study), C15's masses on the coarsest mesh (the consistent mass costs most there);
-#: C13 at its settings (SEEDED but 16 per cell, which its verdict does not read: the regular layout and every
-#: seed of SEEDS) on those two meshes; no time-step table (no verdict reads it)
+#: C13 where the quick identification can place it (``C13``: its solutions, 4 per cell, the calculated
+#: acceleration and the exact one with dt ~ h, at every eps on those two meshes: the identification's own
+#: cases, so none runs twice) and its 4-per-cell settings on the regular layout and every seed of SEEDS
+#: (``seeded``; 8 and 16 per cell, which the quick identification does not pick, are left to the full tier);
+#: no time-step table (no verdict reads it)
 QUICK = dict(solutions=(DEFAULT,), eps=EPS[:1], H=H[:2], skip=_MORE[1:], PPC=(2, 4, 8, 16), PPC_H=(0.01,),
              TIME_H=0.01, time_eps=(0.045,), time_methods=(), lumping_H=H[:1],
-             diagnosis_H=(), seeds=SEEDS, seeds_H=H[:2])
+             diagnosis_H=(), seeds=SEEDS, seeds_H=H[:2], seeded=("mpm_calculated", "mpm_exact_dt_h"),
+             C13=(("rarefaction", "cole_hopf"), ("mpm_calculated", "mpm_exact_dt_h")))
 
 
 def run_case(case: dict) -> dict:
@@ -136,11 +140,14 @@ def _plan(tier: str) -> dict:
     eps_list, skip, time_h = q.get("eps", EPS), q.get("skip", ()), q.get("TIME_H", TIME_H)
     fem = ("fem_consistent", "fem_lumped")
     kept = lambda m, h: m not in skip and not (quick and h not in q["H"])  # noqa: E731
+    c13_solutions, c13_methods = q.get("C13", ((), ()))
     return {
-        "table": {(s, m, e, h): method_case(m, s, e, h) for s in q.get("solutions", SOLUTIONS)
-                  for m, hs in meshes["default" if s == DEFAULT else "other"].items() for e in eps_list
-                  for h in (meshes.get("headline", {}).get(m, hs) if (s, e) == (DEFAULT, EPS[0]) else hs)
-                  if kept(m, h)},
+        "table": {**{(s, m, e, h): method_case(m, s, e, h) for s in q.get("solutions", SOLUTIONS)
+                     for m, hs in meshes["default" if s == DEFAULT else "other"].items() for e in eps_list
+                     for h in (meshes.get("headline", {}).get(m, hs) if (s, e) == (DEFAULT, EPS[0]) else hs)
+                     if kept(m, h)},
+                  **{(s, m, e, h): method_case(m, s, e, h) for s in c13_solutions for m in c13_methods
+                     for e in EPS for h in q.get("H", ())}},
         "profile": {(m, e): {**method_case(m, DEFAULT, e, PROFILE_H), "profile": True}
                     for e in (EPS[0], EPS[-1]) if e in eps_list for m in METHODS if m not in skip},
         "timestep": {(m, e, k): method_case(m, DEFAULT, e, time_h, **({"refine": k} if k > 1 else {}))
@@ -155,7 +162,8 @@ def _plan(tier: str) -> dict:
         "diagnosis": {(label, h): method_case("mpm_calculated", DEFAULT, EPS[0], h, **changes)
                       for h in q.get("diagnosis_H", H[:3]) for label, changes in DIAGNOSIS.items()},
         "seeds": {(m, EPS[0], h, layout, seed): method_case(m, DEFAULT, EPS[0], h, layout=layout, seed=seed)
-                  for m, hs in meshes["seeds"].items() for h in q.get("seeds_H", hs) if h in hs and kept(m, h)
+                  for m, hs in meshes["seeds"].items() if m in q.get("seeded", SEEDED)
+                  for h in q.get("seeds_H", hs) if h in hs and kept(m, h)
                   for layout, seed in (("regular", 0), *(("jittered", k) for k in q.get("seeds", SEEDS)))},
     }
 

@@ -285,8 +285,7 @@ def test_the_roundoff_table_compares_the_two_arithmetics():
 def test_the_layout_budgets_cover_every_particle_count_and_seed_on_the_two_coarsest_meshes():
     """Full tier: P1's budget on the two coarsest meshes of each problem and E2's bases on the three coarsest, at
     4, 8 and 16 per cell on the regular layout and the Sod study's five jittered seeds; the study's own setting is
-    the study's own case (the same dict, run once); the deep tier holds the full one's; the quick tier only
-    P1's Burgers budget at its coarsest mesh, 4 per cell, with the seeds."""
+    the study's own case (the same dict, run once); the deep tier holds the full one's; the quick tier none."""
     from studies import sod as sod_study
 
     assert study.SEEDS == sod_study.SEEDS and study.LAYOUT_PPC == (4, 8, 16)
@@ -305,8 +304,7 @@ def test_the_layout_budgets_cover_every_particle_count_and_seed_on_the_two_coars
     case = full["layouts"][("sod", 0.01, "mpm", 4, "jittered", 3)]
     assert (case["ppc"], case["layout"], case["seed"]) == (4, "jittered", 3)
     assert set(full["layouts"]) <= set(deep["layouts"]) and set(full["bases_layouts"]) <= set(deep["bases_layouts"])
-    assert set(quick["layouts"]) == {("burgers", 0.04, "mpm", 4, lay, s) for lay, s in study.LAYOUTS}
-    assert not quick["bases_layouts"]
+    assert not quick["layouts"] and not quick["bases_layouts"]
 
 
 def test_the_cost_model_reproduces_the_measured_budgets():

@@ -212,6 +212,16 @@ def test_a_task_listed_twice_runs_once_and_ends_both(jobs, tmp_path):
     assert len(list(Path(tmp_path).glob("*.json"))) == 2
 
 
+def test_the_progress_of_a_task_listed_twice_ends_at_the_total(tmp_path, capsys):
+    """The progress line counts each task once: a twin is counted when its first is in, never before."""
+    tasks = [Task(_count, {"x": 1}, tmp_path), Task(_count, {"x": 2}, tmp_path), Task(_count, {"x": 1}, tmp_path)]
+    run_tasks(tasks, jobs=1, progress=True)
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if " done, " in line]
+    assert "3 of 3 cases to run (0 cached)" in err and lines and lines[-1].startswith("[cases] 3/3 done")
+    assert all(int(line.split("]")[1].split("/")[0]) <= 3 for line in lines)
+
+
 # ----------------------------------------------------------------------------- one small real run
 
 def test_a_small_real_identification():

@@ -149,14 +149,25 @@ def test_the_quick_plan_runs_c11s_setting_on_the_meshes_and_runs_c11_needs():
     assert set(meshes) <= set(plan["fem_lumped"]) and set(meshes) <= set(plan["fv"])  # E3 and the figure
 
 
-def test_the_quick_plan_runs_c13s_settings_on_every_seed():
+def test_the_quick_plan_runs_c13s_settings_on_every_seed_and_every_eps():
+    """The settings the quick identification can pick for C13 (its particles per cell, calculated a, and exact
+    a with dt ~ h) run on every seed at the compared solution and at every eps on each solution it compares, on
+    the identification's meshes (its own cases: nothing runs twice)."""
     burgers = importlib.import_module("studies.burgers")
+    identification = importlib.import_module("studies.identification")
     plan = burgers._plan("quick")
-    judged = {"mpm_calculated", "mpm_calculated_8", "mpm_exact_dt_h"}  # the source's 4-8 per cell and exact a
+    ppc = identification.QUICK["burgers_ppc"]
+    judged = {burgers.CALCULATED[n] for n in ppc} | {"mpm_exact_dt_h"}
     for method in judged:
         runs = [k for k in plan["seeds"] if k[0] == method]
         meshes = {k[2] for k in runs}
         assert len(meshes) >= 2 and len(runs) == len(meshes) * (1 + len(burgers.SEEDS)), method
+        for solution in identification.QUICK["solutions"]:
+            got = {(e, h) for s, m, e, h in plan["table"] if (s, m) == (solution, method)}
+            assert got == {(e, h) for e in burgers.EPS for h in identification.BURGERS_MESHES["quick"]}
+    candidates = identification.plans("quick")["burgers"]["candidates"].values()
+    assert all(c in candidates for (s, m, *_), c in plan["table"].items()
+               if s == "cole_hopf" and m in judged)
 
 
 def test_the_criteria_never_read_the_tier():

@@ -209,7 +209,8 @@ def run_tasks(
     weights = list(costs) if costs is not None else [1.0] * len(tasks)
     if len(weights) != len(tasks):
         raise ValueError(f"costs: {len(weights)} for {len(tasks)} tasks")
-    reporter = _Progress(len(tasks), len(tasks) - len(todo), desc, progress,
+    waiting = len(todo) + sum(len(js) for js in twins.values())  # a twin is done when its first is
+    reporter = _Progress(len(tasks), len(tasks) - waiting, desc, progress,
                          to_run=sum(weights[k] for k, _ in todo))
 
     def follow(k: int):

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, Finding, Tables, claim
 from mpm_fem.measure.claims.identification import source_matching
 from mpm_fem.measure.claims.mass import MASS_RULE, mass_finding
 from mpm_fem.measure.claims.rows import FIRST_ORDER, FLOOR_ORDER, GROWTH_ORDER, num, saturation, select, span
@@ -145,6 +145,11 @@ def _c13(t: Tables) -> Finding:
     shrinks; it names no cause beyond what these changes show."""
     judged, whence = _judged_settings(t)
     found = [(s, *_setting_order(t, s)) for s in judged]
+    unmeasured = [f"{s['row']} row ({s['solution']}, {label}, {s['norm']})" for s, o, label in found
+                  if o["side"] == "unknown"]
+    if unmeasured:  # an order without an interval over runs judges nothing
+        return Finding(NOT_MEASURED, f"judged at {whence}: no interval over runs for the "
+                       + "; ".join(unmeasured))
     exact = [o for s, o, _ in found if s["row"] == "exact"]
     calc = [o for s, o, _ in found if s["row"] == "calculated"]
     verdicts = {_pair_verdict(exact[0]["side"], o["side"]) for o in calc}
