@@ -25,7 +25,6 @@ TABLES = {
     "sod/seeds.csv": (("ppc", "cfl", "h", "layout", "seed"), ("particles_L1", "nodes_L1", "energy_L1")),
     "burgers/errors.csv": (("solution", "method", "eps", "h"), ("particles_L1", "particles_max", "nodes_L1")),
     "projection/errors.csv": (("quantity", "layout", "weights", "basis", "N_p", "h", "norm", "seeds"), ("value",)),
-    "budget/subsets.csv": (("problem", "h", "basis", "ppc", "layout", "seed", "norm", "mpm_stages"), ("error",)),
 }
 RTOL = 1e-5
 #: the value of a key column in a table written before the column was (the study's own particle setting, issue 42)

@@ -167,11 +167,12 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
     """What a reader must know before the numbers, as a list: the tier, the study's settings that differ
     from the source's, and whether the figures lag the code (``current``: the code version now, if known)."""
     out = []
-    out.append("- These tables come from `mpm-fem reproduce --quick`: a subset of the meshes of each study. A "
-               "verdict judged on the finest mesh a study has can differ from the full record's "
-               "(`mpm-fem reproduce --full`), which reaches finer meshes. The quick tier leaves out the studies "
-               f"{' and '.join(QUICK_LEAVES_OUT)}: their questions are about the plateau of Sod's particle error, "
-               "below its meshes." if is_quick(tables) else "- These tables come from `mpm-fem reproduce --full`.")
+    quick = ("- These tables come from `mpm-fem reproduce --quick`: a subset of the meshes of each study. A "
+             "verdict judged on the finest mesh a study has can differ from the full record's "
+             "(`mpm-fem reproduce --full`), which reaches finer meshes. The quick tier leaves out the studies "
+             f"{', '.join(QUICK_LEAVES_OUT)}: the first two ask about the plateau of Sod's particle error, below "
+             "its meshes; the budget's exact-stage kernels take about a minute to compile.")
+    out.append(quick if is_quick(tables) else "- These tables come from `mpm-fem reproduce --full`.")
     out += not_judged(tables)
     written = code_version(tables)
     rows = tables.get("versions", [])
