@@ -249,8 +249,10 @@ def write_report(out: Path, pages: list[Page] | None = None) -> Path:
 def reproduce(options) -> Path:
     """Run every study with ``options`` (:class:`mpm_fem.app.study.StudyOptions`), then write the report;
     a folder holding tables of another tier is refused first (:func:`mpm_fem.app.study.check_folder`).
-    The cases of all studies run in one pool, the longest first (so no worker idles at the end of a
-    study while another has cases left); as soon as the last case of a study is in, a worker writes
+    The cases of all studies run in one pool, the studies in order of their estimated cost and each one's
+    cases the longest first (so no worker idles at the end of a study while another has cases left, and a
+    cheap study's tables are written while the costly ones run); as soon as the last case of a study is in, a
+    worker writes
     that study's tables and figures from the cache, ahead of the cases still waiting (this process
     does, with one job or a Dask scheduler: :func:`mpm_fem.app.sweep.run_tasks`)."""
     from mpm_fem.app.estimate import describe, estimate, tasks
@@ -262,7 +264,11 @@ def reproduce(options) -> Path:
     if options.progress is not False:
         workers = options.jobs or default_jobs()
         print(describe({name: estimate(name, options) for name in studies}, workers), file=sys.stderr, flush=True)
-    planned = sorted(((s, name, t) for name in studies for s, t in tasks(name, options) or ()), key=lambda p: -p[0])
+    found = {name: tasks(name, options) or [] for name in studies}
+    total = {name: sum(s for s, _ in found[name]) for name in studies}
+    # the studies in order of their total cost, each one's cases the longest first: a cheap study's tables and
+    # figures are written while the costly studies' cases run, not after the last case
+    planned = sorted(((s, name, t) for name in studies for s, t in found[name]), key=lambda p: (total[p[1]], -p[0]))
     left = {name: sum(1 for _, n, _ in planned if n == name) for name in studies}
     published = []
     # a study's tables and figures, in a worker: every case is in the cache by then, so it runs none
