@@ -23,10 +23,10 @@ terms and Shapley values (:mod:`mpm_fem.measure.decomposition`) decompose ``v(al
 exactly; applied to the fields they give each stage's signed error field, which adds up to
 ``e_MPM - e_exact`` at every point.
 
-Meshes: Sod h = 0.01 ... 0.00125 for P1, 0.01 ... 0.0025 for GIMP and the two B-splines (three meshes
-or more give each basis's budget a trend, not only a change; a budget of theirs at 0.00125 costs 1.4
-(GIMP) to 3 (B-splines) P1 ones, so the full tier leaves it to the deep tier, :data:`FINEST`), the
-deep tier adds those and P1 at h = 0.000625 (:data:`DEEP`); Burgers 0.04 ... 0.01. A Sod case
+Meshes: Sod h = 0.01 ... 0.0025 for every basis (three meshes give each basis's budget a trend, not
+only a change; a budget at 0.00125 costs 4 CPU-min for P1 and 1.4 (GIMP) to 3 (B-splines) times that
+for the others, so the full tier leaves it to the deep tier, :data:`FINEST`), the deep tier adds h =
+0.00125 for every basis and P1 at h = 0.000625 (:data:`DEEP`); Burgers 0.04 ... 0.01. A Sod case
 is 16 runs, all on the fused step (:mod:`mpm_fem.fused`): the fourteen with an exact stage run its
 compiled particle passes around the numpy step's grid stage (:mod:`mpm_fem.exact_stages`). What each
 run cost is in ``runs.csv`` (``wall_s``); ``docs/performance.md`` has the measured costs.
@@ -79,11 +79,12 @@ SOD = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", sch
 BURGERS = dict(solution="rarefaction", eps=0.045, ppc=4, cfl=0.5, acceleration="calculated", mass="lumped",
                scheme="usl", layout="regular", seed=0)
 H = {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}
-#: the deep tier's further budgets, (problem, h, basis): P1's Sod one mesh finer
-DEEP = (("sod", 0.000625, "mpm"), ("sod", 0.00125, "gimp"), ("sod", 0.00125, "bspline"),
+#: the deep tier's further budgets, (problem, h, basis): every basis on Sod's finest mesh of H, P1 one mesh finer
+DEEP = (("sod", 0.00125, "mpm"), ("sod", 0.000625, "mpm"), ("sod", 0.00125, "gimp"), ("sod", 0.00125, "bspline"),
         ("sod", 0.00125, "bspline_gimp"))
-#: (problem, basis): the finest mesh of the full tier's budget of a basis that stops above H's finest
-FINEST = {("sod", "gimp"): 0.0025, ("sod", "bspline"): 0.0025, ("sod", "bspline_gimp"): 0.0025}
+#: (problem, basis): the finest mesh of the full tier's budget of a basis that stops above H's finest (P1's Sod
+#: budget at h = 0.00125 cost 4 of the full tier's CPU-min: moved to the deep tier on 2026-11-28)
+FINEST = {("sod", b): 0.0025 for b in ("mpm", "gimp", "bspline", "bspline_gimp")}
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
 FIELD_POINTS = 2001  # the Shapley fields kept for the figure

@@ -15,18 +15,18 @@ combinations that promise most, errors over grid nodes and over particles:
   time, for MPM with each remedy, fixed-mesh P1 FEM (lumped mass) and FV. Wall time is the last
   column: it varies from run to run and no verdict uses it.
 
-Meshes: Sod h = 0.01 ... 0.0003125 (the convergence study's first six) in the full tier for plain MPM
-and the three remedies that remove the plateau on those meshes (the record of 2026-11-26)
-(``FINEST``: the B-spline domain, alone, with Taylor + volume and with XPIC(5)), and h = 0.01 ...
-0.000625 for the others, which do not remove it there already; the deep tier takes every remedy one
-mesh further (the FINEST ones to h = 0.00015625). E5 counts a remedy as removing the plateau only if
+Meshes: Sod h = 0.01 ... 0.000625 (the convergence study's first five) in the full tier for every
+remedy; the deep tier takes plain MPM and the three remedies that removed the plateau to h = 0.0003125
+in the record of 2026-11-26 (``FINEST``: the B-spline domain, alone, with Taylor + volume and with
+XPIC(5)) to h = 0.00015625, and the others to 0.0003125. E5 counts a remedy as removing the plateau only if
 it ran on every Sod mesh of the table, so the remedies that stop earlier count as not removing it. A
 halving of h costs about 4x (twice the particles, twice the steps), so a remedy's finest mesh costs
 about three times its coarser ones together: what moved to the deep tier to keep the full one
-within its budget. Every remedy of the full and deep tiers runs the fused
-compiled step (:mod:`mpm_fem.fused.step`, equal to the numpy step), all of them in its compiled loop
-(the Taylor reconstruction, XPIC(m) and the grid volume included); the quick tier runs the numpy step
-(``QUICK_KERNEL``), which on its two coarse meshes costs less than compiling the remedies' variants.
+within its budget (the FINEST ones' h = 0.0003125 cost 11 CPU-min, moved on 2026-11-28). Every remedy of
+the full and deep tiers runs the fused compiled step (:mod:`mpm_fem.fused.step`, equal to the numpy
+step), all of them in its compiled loop (the Taylor reconstruction, XPIC(m) and the grid volume
+included); the quick tier runs the numpy step (``QUICK_KERNEL``), which on its two coarse meshes costs
+less than compiling the remedies' variants.
 What each run cost is in ``cost.csv`` (``wall_s``, measured in the run that wrote it).
 Burgers h = 0.04 ... 0.005 (the viscous step limit makes a halving of h cost 8x).
 
@@ -81,7 +81,7 @@ REMEDIES = {
     "B-spline domain + XPIC(5)": {"basis": "bspline_gimp", "xpic": 5},
 }
 FINEST = ("MPM", "B-spline domain", "B-spline domain + Taylor + volume", "B-spline domain + XPIC(5)")
-SOD_MESHES = {name: 6 if name in FINEST else 5 for name in REMEDIES}  # the full tier (docstring)
+SOD_MESHES = {name: 5 for name in REMEDIES}  # the full tier (docstring)
 DEEP_SOD_MESHES = {name: 7 if name in FINEST else 6 for name in REMEDIES}
 QUICK = dict(SOD_H=(0.02, 0.01), BURGERS_H=BURGERS_H[:2],
              REMEDIES=("MPM", "Taylor LS", "grid volume", "FLIP 0.99", "Taylor + volume", "XPIC(5)"))

@@ -312,7 +312,7 @@ def test_the_cost_model_reproduces_the_measured_budgets():
     Sod budget at h = 0.01 took 8.3 CPU-s, at 0.00125 258; Burgers at 0.01 28.8. Within 30 %."""
     for key, seconds in ((("sod", 0.01, "mpm"), 8.3), (("sod", 0.00125, "mpm"), 258.0),
                          (("burgers", 0.01, "mpm"), 28.8), (("sod", 0.005, "gimp"), 32.0)):
-        got = study.cost(study.plan("full")["budget"][key]) * study.SECONDS_PER_COST
+        got = study.cost(study.plan("deep")["budget"][key]) * study.SECONDS_PER_COST
         assert 0.7 < got / seconds < 1.3, (key, got, seconds)
     cheaper = study.cost({"kind": "budget", "problem": "sod", "h": 0.01, "basis": "mpm", "ppc": 4})
     assert 0.6 < cheaper / study.cost({"kind": "budget", "problem": "sod", "h": 0.01, "basis": "mpm"}) < 0.9

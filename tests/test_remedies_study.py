@@ -15,18 +15,19 @@ from studies import remedies, sod
 def test_plan_runs_every_remedy_on_the_stated_meshes(tier):
     plan = remedies._plan(tier)
     assert remedies.SOD_H == sod.H[:7]  # the convergence study's meshes to h = 0.00015625
-    meshes = set(remedies.SOD_H) if tier == "deep" else set(remedies.SOD_H[:6])
+    meshes = set(remedies.SOD_H) if tier == "deep" else set(remedies.SOD_H[:5])
     assert {h for _, h in plan["sod"]} == meshes
     assert set(plan["fv"]) == meshes  # the FV reference on every mesh any remedy runs
     assert {n for n, _ in plan["burgers"]} == set(remedies.REMEDIES)
     sod_meshes = {n: {h for m, h in plan["sod"] if m == n} for n in remedies.REMEDIES}
     finest = {"MPM", "B-spline domain", "B-spline domain + Taylor + volume", "B-spline domain + XPIC(5)"}
-    for name in remedies.REMEDIES:  # the four to h = 0.0003125 (deep: 0.00015625), the others one mesh coarser
-        n = (6 if name in finest else 5) + (tier == "deep")
+    # full: every remedy to h = 0.000625; deep: the four to 0.00015625, the others to 0.0003125
+    for name in remedies.REMEDIES:
+        n = (7 if name in finest else 6) if tier == "deep" else 5
         expected = set(remedies.SOD_H[:n])
         assert sod_meshes[name] == expected, name
         assert supported(IdealGas(), Stages(**remedies.REMEDIES[name])) is None, name
-    assert plan["sod"][("B-spline domain + XPIC(5)", 0.0003125)]["xpic"] == 5
+    assert plan["sod"][("B-spline domain + XPIC(5)", 0.000625)]["xpic"] == 5
     assert all(case["ppc"] == 16 and case["cfl"] == 0.05 for case in plan["sod"].values())
     assert all(case["ppc"] == 4 and case["acceleration"] == "calculated" for case in plan["burgers"].values())
     assert all("kernel" not in case for part in ("sod", "burgers") for case in plan[part].values())  # fused

@@ -153,7 +153,8 @@ def test_one_set_of_settings_for_every_mesh():
     keys = set(study.MPM)
     for h, case in plan["mpm"].items():
         assert {k: case[k] for k in keys} == study.MPM, f"h={h} uses other settings"
-    assert set(plan["mpm"]) == set(study.H) >= set(study.SOURCE), "every mesh of the source's table is run"
+    assert set(plan["mpm"]) == set(study.FULL_H) == set(study.SOURCE), "every mesh of the source's table is run"
+    assert set(study._plan("deep")["mpm"]) == set(study.H + study.DEEP_H)
 
 
 @pytest.mark.parametrize("tier", ["full", "deep"])
@@ -165,7 +166,7 @@ def test_every_setting_runs_on_every_mesh_with_the_regular_and_five_jittered_lay
     plan = study._plan(tier)
     assert {(4, 0.05), (8, 0.05), (16, 0.05), (4, SodSettings.cfl)} == set(study.SETTINGS)
     assert SodSettings.cfl == 0.1 and len(study.SEEDS) >= 5
-    meshes = study.H + (study.DEEP_H if tier == "deep" else ())
+    meshes = study.H + study.DEEP_H if tier == "deep" else study.FULL_H
     other = study.H if tier == "deep" else tuple(h for h in study.H if h >= 0.0003125)
     every = {(16, 0.05), (4, 0.05)} if tier == "deep" else {(16, 0.05)}
     assert set(plan["settings"]) == ({(n, c, h) for n, c in study.SETTINGS if (n, c) not in every for h in other}
