@@ -107,6 +107,10 @@ def test_the_estimate_counts_the_cached_cases_and_grows_with_the_tier(tmp_path):
     line = describe({"budget": again, "other": None}, 2)
     assert "budget: 49 of 50 cases to run" in line.replace(f"{again.cases - 1} of {again.cases}", "49 of 50")
     assert "other: no cost model" in line
+    assert again.measured == 0.0 and "took" not in line  # a cache file without its CPU time counts nothing
+    (cache / f"{case_key(module.run_case, case)}.json").write_text('{"cpu_s": 90.0}')
+    line = describe({"budget": estimate("budget", full)}, 2)
+    assert "the cached cases took 1.5 CPU-min when they ran" in line and "(the 1 cached took 1.5 CPU-min" in line
 
 
 def test_the_quick_reproduction_leaves_out_the_plateau_studies_and_says_so(tmp_path, monkeypatch):

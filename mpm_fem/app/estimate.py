@@ -36,12 +36,15 @@ from mpm_fem.app.sweep import Task
 
 @dataclass(frozen=True)
 class Estimate:
-    """``cases`` in the plan, ``cached`` of them done, ``seconds`` of CPU for the rest, ``longest`` case."""
+    """``cases`` in the plan, ``cached`` of them done, ``seconds`` of CPU for the rest, ``longest`` case;
+    ``measured``: the CPU seconds the cached cases took when they ran (each case's ``cpu_s`` in the cache,
+    a case shared with another study counted by the study that owns it)."""
 
     cases: int
     cached: int
     seconds: float
     longest: float
+    measured: float = 0.0
 
     def wall(self, workers: int) -> float:
         """Seconds on ``workers`` workers: the larger of the shared total and the longest case."""
@@ -92,18 +95,41 @@ def estimate(name: str, options) -> Estimate | None:
     if found is None:
         return None
     seconds = [s for s, task in found if not task.path.exists()]
-    return Estimate(len(found), len(found) - len(seconds), sum(seconds), max(seconds, default=0.0))
+    owned = _owned(name, options)
+    measured = sum(_cpu_s(task.path) for _, task in found if task.path.exists() and _key(task.case) not in owned)
+    return Estimate(len(found), len(found) - len(seconds), sum(seconds), max(seconds, default=0.0), measured)
+
+
+def _owned(name: str, options) -> set[str]:
+    """The keys of the cases of study ``name`` that another study's plan holds at the same tier (``SWEEPS``)."""
+    module = importlib.import_module(f"studies.{name}")
+    if not hasattr(module, "SWEEPS"):
+        return set()
+    return {_key(c) for study, owner in module.SWEEPS.items() for group in owner.PLAN(options.tier).values()
+            for c in group.values()}
+
+
+def _cpu_s(path) -> float:
+    """The CPU seconds a cached case took when it ran (0 for a cache file without them)."""
+    import json
+
+    try:
+        return float(json.loads(path.read_text()).get("cpu_s", 0.0))
+    except (OSError, ValueError):
+        return 0.0
 
 
 def describe(estimates: dict[str, Estimate | None], workers: int) -> str:
     """One line per study and a total: cases to run, CPU minutes, and the wall time on ``workers``."""
-    lines, total, longest = [], 0.0, 0.0
+    lines, total, longest, measured = [], 0.0, 0.0, 0.0
     for name, e in estimates.items():
         if e is None:
             lines.append(f"  {name}: no cost model")
             continue
-        lines.append(f"  {name}: {e.cases - e.cached} of {e.cases} cases to run, ~{e.seconds / 60:.1f} CPU-min")
-        total, longest = total + e.seconds, max(longest, e.longest)
+        ran = f" (the {e.cached} cached took {e.measured / 60:.1f} CPU-min when they ran)" if e.cached else ""
+        lines.append(f"  {name}: {e.cases - e.cached} of {e.cases} cases to run, ~{e.seconds / 60:.1f} CPU-min{ran}")
+        total, longest, measured = total + e.seconds, max(longest, e.longest), measured + e.measured
     wall = max(total / max(workers, 1), longest)
+    ran = f"; the cached cases took {measured / 60:.1f} CPU-min when they ran" if measured else ""
     return "\n".join([f"estimated ~{total / 60:.1f} CPU-min, ~{wall / 60:.1f} min on {workers} worker(s) "
-                      "(the model of each study: mpm_fem.app.estimate)", *lines])
+                      f"(the model of each study: mpm_fem.app.estimate){ran}", *lines])
