@@ -126,7 +126,7 @@ def describe(estimates: dict[str, Estimate | None], workers: int) -> str:
         if e is None:
             lines.append(f"  {name}: no cost model")
             continue
-        ran = f" (the {e.cached} cached took {e.measured / 60:.1f} CPU-min when they ran)" if e.cached else ""
+        ran = f" (the {e.cached} cached took {e.measured / 60:.1f} CPU-min when they ran)" if e.measured else ""
         lines.append(f"  {name}: {e.cases - e.cached} of {e.cases} cases to run, ~{e.seconds / 60:.1f} CPU-min{ran}")
         total, longest, measured = total + e.seconds, max(longest, e.longest), measured + e.measured
     wall = max(total / max(workers, 1), longest)
