@@ -326,3 +326,19 @@ def test_study_prints_its_estimate_before_it_starts(tmp_path, monkeypatch, capsy
     assert study.start_study("budget", StudyOptions(quick=True, out=tmp_path)) == "done"
     err = capsys.readouterr().err
     assert started == ["budget"] and err.startswith("estimated ~") and "budget: " in err and "cases to run" in err
+
+
+def test_the_report_names_what_the_full_tier_leaves_to_the_deep_one():
+    """The runs moved out of the full tier to keep it within its hour are in the deep tier's additions, and the
+    report's Method says so from the plans (mpm_fem.app.estimate.added)."""
+    from mpm_fem.app.estimate import added
+    from mpm_fem.app.paper import deep_text
+
+    found = added(STUDIES)
+    assert 0.00015625 in found["sod"].meshes and 0.0003125 in found["remedies"].meshes
+    assert 0.00125 in found["budget"].meshes and found["budget"].cases > 0
+    assert all(a.seconds > 0 for a in found.values())
+    text = deep_text()
+    assert text.startswith("To keep the full tier within an hour") and "sod, 12 cases" in text.replace(
+        f"sod, {found['sod'].cases} cases", "sod, 12 cases")
+    assert added(STUDIES, "full", "full") == {}

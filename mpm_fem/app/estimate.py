@@ -133,3 +133,45 @@ def describe(estimates: dict[str, Estimate | None], workers: int) -> str:
     ran = f"; the cached cases took {measured / 60:.1f} CPU-min when they ran" if measured else ""
     return "\n".join([f"estimated ~{total / 60:.1f} CPU-min, ~{wall / 60:.1f} min on {workers} worker(s) "
                       f"(the model of each study: mpm_fem.app.estimate){ran}", *lines])
+
+
+@dataclass(frozen=True)
+class Added:
+    """What a tier adds to a lower one in a study: ``cases``, their estimated CPU ``seconds`` and the
+    ``meshes`` (distinct ``h``, largest first) they run on."""
+
+    cases: int
+    seconds: float
+    meshes: tuple[float, ...]
+
+
+def _plan_cases(name: str, tier: str) -> list[tuple[float, dict]]:
+    """``(estimated CPU seconds, case)`` of every case of study ``name`` at ``tier``, once each; a study of
+    other studies' cases (``SWEEPS``) counts only those its owners' plans do not hold at that tier."""
+    module = importlib.import_module(f"studies.{name}")
+    if hasattr(module, "SWEEPS"):
+        out = []
+        for study, plan in module.PLANS(tier).items():
+            owner = module.SWEEPS[study]
+            owned = {_key(c) for group in owner.PLAN(tier).values() for c in group.values()}
+            unique = {_key(c): c for group in plan.values() for c in group.values() if _key(c) not in owned}
+            out += [(owner.SECONDS_PER_COST * owner.COST(c), c) for c in unique.values()]
+        return out
+    plan, cost, rate = (getattr(module, a, None) for a in ("PLAN", "COST", "SECONDS_PER_COST"))
+    if plan is None or cost is None or rate is None:
+        return []
+    unique = {_key(c): c for group in plan(tier).values() for c in group.values()}
+    return [(rate * cost(c), c) for c in unique.values()]
+
+
+def added(names, lower: str = "full", higher: str = "deep") -> dict[str, Added]:
+    """Per study of ``names``, the cases of tier ``higher`` that tier ``lower`` does not run (what the
+    full tier leaves to the deep one to fit its time budget); studies that add none are left out."""
+    out = {}
+    for name in names:
+        below = {_key(c) for _, c in _plan_cases(name, lower)}
+        extra = [(s, c) for s, c in _plan_cases(name, higher) if _key(c) not in below]
+        if extra:
+            meshes = tuple(sorted({c["h"] for _, c in extra if "h" in c}, reverse=True))
+            out[name] = Added(len(extra), sum(s for s, _ in extra), meshes)
+    return out

@@ -252,7 +252,24 @@ def method(tables: Tables, caveats: list[str]) -> list[str]:
     else:
         lines += prose("The rule book holds no threshold yet: each criterion still reads its own constants, which "
                        "Appendix A states beside each claim's rule.")
-    return lines + ["### Seeds", "", *prose(seeds_text(tables)), "### The record", "", *caveats, ""]
+    return lines + ["### Seeds", "", *prose(seeds_text(tables)), "### The record", "", *caveats, "",
+                    *prose(deep_text())]
+
+
+def deep_text() -> str:
+    """What the deep tier adds to the full one, per study, from the studies' plans and cost models."""
+    from mpm_fem.app.estimate import added
+    from mpm_fem.app.study import STUDIES
+
+    found = added(STUDIES)
+    if not found:
+        return "The deep tier adds no case to the full tier."
+    total = sum(a.seconds for a in found.values()) / 60
+    parts = [f"{name}, {a.cases} cases (~{a.seconds / 60:.0f} CPU-min; h = {', '.join(f'{h:g}' for h in a.meshes)})"
+             for name, a in found.items()]
+    return (f"To keep the full tier within an hour on 2 cores, the deep tier (`mpm-fem reproduce --deep`) holds "
+            f"the finest meshes and the longest sweeps, about {total:.0f} CPU-min more by the cost models: "
+            + "; ".join(parts) + ".")
 
 
 def evidence(f: Finding) -> list[str]:
