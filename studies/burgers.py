@@ -177,6 +177,9 @@ def run(options: StudyOptions) -> None:
                 "compared_norm": f"{NORM} over {WHERE}",
                 "methods": {m: {"label": v[0], "solver": v[1], "settings": full[m], "source_row": v[3]}
                             for m, v in METHODS.items()},
+                "force": f"{burgers.BurgersSettings.force} (the viscous force in weak form, weights V_p = "
+                         f"{burgers.BurgersSettings.weights}); the slides' second difference and weights h/N_p^i: "
+                         "the diagnosis table",
                 "time_steps": {
                     "mpm_calculated* and mpm_exact": f"dt = CFL min(h/max|v_p|, h^2/(2 eps)), CFL {MPM['cfl']}",
                     "mpm_exact_dt_h": f"dt = CFL h/max|v_p|, CFL {MPM['cfl']} "

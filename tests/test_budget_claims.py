@@ -180,15 +180,17 @@ def _orders_by_basis(p1: float, smooth: float) -> dict:
 
 
 def test_c2_second_half_compares_p1s_order_in_dt_with_the_smooth_bases():
-    """P1 at most first order where the bases without a jump reach it: confirmed; P1 above first order,
-    or the smooth bases below it too (the integrator, not the jump, limits): partly; no smooth rows: partly,
-    said so."""
+    """P1 at most first order where the bases without a jump reach it and exceed P1's order by more than the
+    tolerance: confirmed; P1 above first order, the smooth bases below it too, or every basis first order alike
+    (the integrator, not the jump, limits): partly; no smooth rows: partly, said so."""
     from claim_mutations import claim_named
 
     passing = {**_crossing(0.02, 0.001), **_orders_by_basis(0.75, 1.05)}
     assert judge("C2", passing)[0] == "confirmed"
     assert_flips("C2", {**passing, **_orders_by_basis(1.6, 1.05)}, passing)
     assert judge("C2", {**passing, **_orders_by_basis(0.75, 0.5)})[0] == "partly"
+    alike = judge("C2", {**passing, **_orders_by_basis(0.95, 1.05)})  # first order alike: the integrator limits
+    assert alike[0] == "partly" and "above P1's by more than 0.2 on 0 of 2" in alike[1]
     missing = {**passing, "time/time_order": [r for r in passing["time/time_order"] if r["basis"] == "mpm"]}
     assert judge("C2", missing)[0] == "partly" and "second half not measured" in judge("C2", missing)[1]
     found = claim_named("C2").finding(passing)

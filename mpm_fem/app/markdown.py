@@ -137,3 +137,15 @@ def headings_without_content(markdown: str) -> list[str]:
     lines = [line for line in markdown.splitlines() if line.strip() and not line.startswith("<a id=")]
     return [line for k, line in enumerate(lines) if line.startswith("#")
             and (k + 1 == len(lines) or lines[k + 1].startswith("#"))]
+
+
+_RANGE = re.compile(r"(?<![\w.])(-?\d+(?:\.\d+)?)\.\.(-?\d+(?:\.\d+)?)(?![\w.])")
+_EXPONENT = re.compile(r"(?<![\w.])(\d(?:\.\d+)?)e\+0*(\d+)(?![\w.])")
+
+
+def readable(text: str) -> str:
+    """A sentence's numbers as prose writes them: a range ``1.00..1.45`` as ``1.00 to 1.45`` and a number in
+    exponent form of at most two significant digits, ``7.6e+02``, as ``760``; everything else unchanged."""
+    text = _RANGE.sub(r"\1 to \2", text)
+    return _EXPONENT.sub(lambda m: f"{float(m.group(0)):.0f}", text)
+

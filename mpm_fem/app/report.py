@@ -214,7 +214,8 @@ def render(tables: Tables, pages, captions: dict[str, dict] | None = None, curre
             lines += figure(study, file, captions[study])
     lines += paper.introduction(found) + paper.method(tables, caveats(tables, current))
     lines += paper.results(tables, found, pages, captions, partial(summary, found, ""))
-    lines += paper.discussion(tables, found, captions, deep_found) + paper.conclusions(found)
+    stale = bool(deep_found) and code_version(deep) != code_version(tables)
+    lines += paper.discussion(tables, found, captions, deep_found, stale) + paper.conclusions(found, tables)
     lines += rules_appendix(found)
     shown = [page for page in pages if any(t.startswith(page.name + "/") for t in tables)]
     letters = iter("BCDEFGHIJKLMNOPQRSTUVWXYZ")

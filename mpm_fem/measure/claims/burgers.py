@@ -136,8 +136,9 @@ def _solutions_table(t: Tables, judged: list[dict]) -> tuple[dict, ...]:
        study="burgers", thresholds=_C13_RULE)
 def _c13(t: Tables) -> Finding:
     """An order is the least-squares slope of the error against h, fitted per run; its interval is the
-    range over the runs of the regular and the jittered particle layouts, and only an interval on one side
-    of the threshold counts. The slides name no exact solution: the identification picks, from the
+    range over the runs of the regular and the jittered particle layouts (a solution run on the regular
+    layout alone: the range of its orders over the five eps), and only an interval on one side of the
+    threshold counts. The slides name no exact solution: the identification picks, from the
     source's own rows, the solution and settings whose errors match them, and the claim is judged there.
     With the exact acceleration and dt ~ h the O(dt) error of the time step sets the order. The last
     clause reads the diagnosis table (when the study wrote one): each change to the calculated-acceleration

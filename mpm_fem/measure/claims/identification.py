@@ -27,7 +27,10 @@ from collections.abc import Mapping, Sequence
 
 from mpm_fem.measure.claims.base import Tables
 from mpm_fem.measure.claims.rules import rule
-from mpm_fem.measure.source import OPTIMAL_PPC
+from mpm_fem.measure.source import BURGERS_H, OPTIMAL_PPC, SOD
+
+#: The source's meshes of each problem's table.
+SOURCE_H = {"sod": tuple(SOD), "burgers": BURGERS_H}
 
 #: The identification tables, by problem.
 IDENTIFICATION = {"sod": "identification/sod", "burgers": "identification/burgers"}
@@ -134,5 +137,12 @@ def identification_sentence(tables: Tables, problem: str) -> str:
                 text += (f", at the source's {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell within "
                          f"{_percent(float(stated[0]['misfit']))} at best")
         parts.append(text)
-    text = "; ".join(parts) + "."
-    return text[0].upper() + text[1:] if parts else ""
+    if not parts:
+        return ""
+    meshes = sorted({float(h) for r in rows for h in str(r.get("meshes", "")).split()}, reverse=True)
+    layout = next((r["value"] for r in tables.get("settings", []) if r["table"] == IDENTIFICATION[problem]
+                   and r["key"] == "layout"), "")
+    where = (f" ({f'the {layout} layout, ' if layout else ''}on {len(meshes)} of the source's "
+             f"{len(SOURCE_H[problem])} meshes, h = {meshes[0]:g} to {meshes[-1]:g})") if meshes else ""
+    text = "; ".join(parts) + where + "."
+    return text[0].upper() + text[1:]

@@ -191,11 +191,12 @@ def _e5(t: Tables) -> Finding:
                                                             f"{sc['min_order_particles_L1']:.2f}",
                    "largest FV ratio": f"{max(sc[f'max_fv_ratio_{m}'] for m in REMEDY_MEASURES):.2f}",
                    "Burgers goal": str(ok)} for _, n, sc, _, _, ok in scored)
-    sentence = (f"{name} keeps Sod's density error converging (lowest orders {s['min_order_nodes_L1']:.2f} at the "
-                f"nodes, {s['min_order_particles_L1']:.2f} at the particles) within "
+    over = f"h = {num(own[0], 'h'):g} to {num(own[-1], 'h'):g}"
+    sentence = (f"{name} keeps Sod's density error converging on {over} (lowest orders {s['min_order_nodes_L1']:.2f} "
+                f"at the nodes, {s['min_order_particles_L1']:.2f} at the particles) within "
                 f"{max(s[f'max_fv_ratio_{m}'] for m in REMEDY_MEASURES):.2f}x the finite-volume error"
-                if s["removes_plateau"] else f"no remedy keeps Sod's density error converging on every mesh; "
-                f"the closest is {name}") + f"; {why}"
+                if s["removes_plateau"] else f"no remedy keeps Sod's density error converging on every mesh of "
+                f"{over}; the closest is {name}")
     if s["removes_plateau"] and fv and b_ok:
         return Finding(CONFIRMED, "meets the goal: " + text + f"; {why}", sentence, table)
     if removers:

@@ -62,9 +62,10 @@ _add("ORDER_TOLERANCE", 0.2,
      "[a, b] of the slides widens by it on each side; 'first order' in a convergence claim: an order at least "
      "1 minus it (C1, C5-C10, C13 share this one definition)",
      _STUDY + ": the slides state orders as whole numbers (O(dt), O(h^p) with 1 <= p <= 2) without a tolerance. "
-     "0.2 replaces the three the criteria had (+-0.2 in C1, >= 0.7 in C13, +-0.1 in C5-C9): it is four times "
-     "the spread of the fitted first orders over the seeded layouts of the projection study (0.96-1.05) and "
-     "less than half the gap to the next half order, so a first-order error never reads as order 0.5 or 1.5",
+     "0.2 replaces the three the criteria had (+-0.2 in C1, >= 0.7 in C13, +-0.1 in C5-C9): it is about "
+     "twice the spread of the fitted first orders over the seeded layouts of the projection study (0.96-1.05, a "
+     "spread of 0.09) and less than half the gap to the next half order, so a first-order error never reads as "
+     "order 0.5 or 1.5",
      ("C1", "C5", "C6", "C7", "C8", "C9", "C10", "C13"))
 _add("CONVERGING_ORDER", 0.7,
      "an order at or above this counts as converging (the error falls with h) on a problem with a shock and a "
