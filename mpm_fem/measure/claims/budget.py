@@ -224,13 +224,17 @@ def _e2(t: Tables) -> Finding:
     sentence = (f"over the last {FLOOR_STEPS} refinements the particle density error's order is "
                 + ", ".join(f"{r['particle density orders']} with {_BASIS_NAMES.get(r['basis'], r['basis'])}"
                             for r in table))
+    failed = [r for r in t[BUDGET_BASES.name] if r.get("ok") != "True"]
+    failures = "".join(f"; {len(select(failed, basis=b))} {b} run(s) failed and are left out (e.g. "
+                       f"{select(failed, basis=b)[0].get('error', '')[:80]})"
+                       for b in dict.fromkeys(r["basis"] for r in failed))
     return Finding(verdict, (f"particle density L1 orders over the last {FLOOR_STEPS} refinements ({runs_n} run"
                              f"{'s' if runs_n > 1 else ''} each): "
                              + "; ".join(f"{r['basis']} {r['particle density orders']}"
                                          for r in table)
                              + "; nodes " + "; ".join(f"{r['basis']} {r['nodal density orders']}" for r in table)
                              + f"; plateau std(v_p) at h = {finest}: "
-                             + ", ".join(f"{b} {v}" for b, v in noise.items())),
+                             + ", ".join(f"{b} {v}" for b, v in noise.items()) + failures),
                    sentence, table)
 
 
