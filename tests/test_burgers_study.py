@@ -189,15 +189,16 @@ def test_the_reported_step_is_the_run_step_not_the_last_sliver():
 
 def test_the_calculated_acceleration_runs_at_four_eight_and_sixteen_per_cell_on_every_mesh():
     """Deep tier: every eps and mesh of the source's table at 4, 8 and 16 per cell, with the full tier's
-    seeds; full tier: every mesh but the finest at 8 and 16 per cell (16: at the seeds' eps)."""
+    seeds and 8 per cell's one mesh further; full tier: every mesh but the finest at 16 per cell (at the seeds'
+    eps), but the two finest at 8 per cell (its h = 0.00125 moved to the deep tier for the full tier's hour)."""
     deep, full = study._plan("deep"), study._plan("full")
     for n, m in study.CALCULATED.items():
         assert {(e, h) for s, mm, e, h in deep["table"] if (s, mm) == (study.DEFAULT, m)} == {
             (e, h) for e in study.EPS for h in study.H}, n
         meshes = {h for s, mm, e, h in full["table"] if (s, mm, e) == (study.DEFAULT, m, study.EPS[0])}
         meshes |= {h for mm, e, h, layout, _ in full["seeds"] if mm == m and layout == "regular"}
-        assert set(study.H[:4]) <= meshes, n
-    assert study.MESHES["deep"]["seeds"] == study.MESHES["full"]["seeds"]
+        assert set(study.H[:3 if n == 8 else 4]) <= meshes, n
+    assert study.MESHES["deep"]["seeds"] == {**study.MESHES["full"]["seeds"], "mpm_calculated_8": study.H[:4]}
     for tier, plan in (("deep", deep), ("full", full)):
         for m, hs in study.MESHES[tier]["seeds"].items():
             for h in hs:
