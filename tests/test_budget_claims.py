@@ -321,8 +321,9 @@ def test_e5_names_the_stage_that_dominates_the_closest_remedys_remaining_error()
 
 
 def test_e5_states_e1s_result_and_never_contradicts_it():
-    """E5's explanation names no budget finding; its evidence and sentence say what E1 found: that the
-    stages do not separate (then no remedy is tied to a stage), or where they separate and what dominates."""
+    """E5's explanation names no budget finding; its evidence says what E1 found: that the stages do not
+    separate (then no remedy is tied to a stage), or where they separate and what dominates. Its sentence
+    (the abstract's) names the remedy alone: E1 has a sentence of its own."""
     from claim_mutations import claim_named
 
     assert "the budget found" not in claim_named("E5").explanation
@@ -330,7 +331,7 @@ def test_e5_states_e1s_result_and_never_contradicts_it():
                "budget/subsets": _subsets({k: TANGLED_TERMS for k in _two_bases(TANGLED_TERMS)}, "sod")}
     found = claim_named("E5").finding(tangled)
     assert "the error budget's stages do not separate (E1" in found.evidence
-    assert "no remedy is tied to one stage" in found.sentence
+    assert "no remedy is tied to one stage" in found.evidence and "E1" not in found.sentence
     separate = claim_named("E5").finding({**tangled, "budget/subsets": _subsets(_two_bases(SEPARATE_TERMS), "sod")})
-    assert "separate in 2 of 2 bases and norms (E1), projection dominating there" in separate.sentence
+    assert "separate in 2 of 2 bases and norms (E1), projection dominating there" in separate.evidence
     assert judge("E1 (sod)", tangled)[0] == "refuted" and found.verdict == separate.verdict

@@ -150,7 +150,11 @@ def test_the_burgers_sentence_names_solution_norm_and_time_step():
     IDENTIFICATION_BURGERS.check(rows)
     text = identification_sentence({"identification/burgers": rows}, "burgers")
     assert text == ("The source's Burgers calculated-acceleration row is reproduced within 5 % by the cole_hopf "
-                    "solution, max norm, 4 per cell, the stable dt at CFL 0.5.")
+                    "solution, max norm, 4 per cell, the stable dt at CFL 0.5 (on 3 of the source's 5 meshes, h = "
+                    "0.01 to 0.0025).")
+    layout = {"table": "identification/burgers", "key": "layout", "value": "regular"}
+    assert identification_sentence({"identification/burgers": rows, "settings": [layout]}, "burgers").endswith(
+        "(the regular layout, on 3 of the source's 5 meshes, h = 0.01 to 0.0025).")
 
 
 # ----------------------------------------------------------------------------- the plan

@@ -14,7 +14,7 @@ def square(case):
     return {"square": case["n"] ** 2}
 
 
-def test_each_study_is_written_once_after_its_last_case_and_the_longest_cases_start_first(tmp_path, monkeypatch):
+def test_each_study_is_written_once_after_its_last_case_the_cheapest_study_first(tmp_path, monkeypatch):
     trace = tmp_path / "trace"
     cost = {"a": (3.0, 1.0), "b": (2.0,), "c": ()}  # estimated seconds of each study's cases; c has none
 
@@ -35,7 +35,8 @@ def test_each_study_is_written_once_after_its_last_case_and_the_longest_cases_st
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))
     started = [int(n) for n in trace.read_text().split()]
-    assert started == [30 + ord("a"), 20 + ord("b"), 10 + ord("a")]  # the longest first, across studies
+    # the cheaper study first (b: 2 s, a: 4 s), each study's cases the longest first
+    assert started == [20 + ord("b"), 30 + ord("a"), 10 + ord("a")]
     assert written == [("b", 1), ("a", 2), ("c", 0)]  # each once, with all its cases in; c (no case) last
     written.clear()
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))  # all cached: every study at once

@@ -339,6 +339,6 @@ def test_the_report_names_what_the_full_tier_leaves_to_the_deep_one():
     assert 0.00125 in found["budget"].meshes and found["budget"].cases > 0
     assert all(a.seconds > 0 for a in found.values())
     text = deep_text()
-    assert text.startswith("To keep the full tier within an hour") and "sod, 12 cases" in text.replace(
+    assert text.startswith("To keep the full tier within its time budget") and "sod, 12 cases" in text.replace(
         f"sod, {found['sod'].cases} cases", "sod, 12 cases")
     assert added(STUDIES, "full", "full") == {}

@@ -226,7 +226,7 @@ def _e2(t: Tables) -> Finding:
                             for r in table))
     failed = [r for r in t[BUDGET_BASES.name] if r.get("ok") != "True"]
     failures = "".join(f"; {len(select(failed, basis=b))} {b} run(s) failed and are left out (e.g. "
-                       f"{select(failed, basis=b)[0].get('error', '')[:80]})"
+                       f"{select(failed, basis=b)[0].get('error', '').split(' (')[0]})"
                        for b in dict.fromkeys(r["basis"] for r in failed))
     return Finding(verdict, (f"particle density L1 orders over the last {FLOOR_STEPS} refinements ({runs_n} run"
                              f"{'s' if runs_n > 1 else ''} each): "
