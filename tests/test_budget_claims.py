@@ -290,6 +290,12 @@ def test_c15_keeps_the_consistent_lumped_reading_beside():
     assert judge("C15 (sod)", compensating)[0] == judge("C15 (sod)", source)[0] == "confirmed"
     assert "(differs): MPM nodes: compensating (consistent/lumped 1.50" in judge("C15 (sod)", compensating)[1]
     assert "(confirmed): MPM nodes: source of error" in judge("C15 (sod)", source)[1]
+    from claim_mutations import claim_named
+
+    said = {name: claim_named("C15 (sod)").finding(t).sentence for name, t in (("compensating", compensating),
+                                                                               ("source", source))}
+    assert said["compensating"].endswith("yet with the consistent mass the error is larger (lumping compensates)")
+    assert said["source"].endswith("with the consistent mass the error is smaller on every mesh")
     without = {k: v for k, v in _mass(0.003, problem="sod").items() if k != "sod/mass"}
     assert judge("C15 (sod)", without)[0] == "confirmed" and "no table `sod/mass.csv`" in judge("C15 (sod)", without)[1]
     assert judge("C15 (sod)", {k: v for k, v in TABLES.items() if k != "budget/subsets"})[0] == "not measured"

@@ -54,6 +54,13 @@ def mass_stage(rows: list[dict]) -> dict[tuple, dict[str, Spread]]:
     return {k: {q: spread(v) for q, v in at.items()} for k, at in found.items()}
 
 
+#: C15's second reading (consistent against lumped mass) in words, by its verdict (shared.lumping_claim).
+_SECOND_READING = {CONFIRMED: "with the consistent mass the error is smaller on every mesh",
+                   PARTLY: "with the consistent mass the error is smaller on some meshes",
+                   DIFFERS: "yet with the consistent mass the error is larger (lumping compensates)",
+                   REFUTED: "and the consistent mass leaves the error as it is"}
+
+
 def mass_finding(t: Tables, problem: str, second: tuple[str, str], sentence_name: str) -> Finding:
     """C15 on ``problem`` from the budget's mass stage, with the consistent/lumped reading ``second``
     (its verdict and evidence) beside."""
@@ -87,6 +94,7 @@ def mass_finding(t: Tables, problem: str, second: tuple[str, str], sentence_name
     else:
         sentence = (f"on {sentence_name} the lumped-mass FE stage alone changes the all-exact error by {lo:.0%} to "
                     f"{hi:.0%} of MPM's error")
+    sentence += "; " + _SECOND_READING.get(second[0], "consistent against lumped mass not measured")
     return Finding(verdict, evidence, sentence, table)
 
 
