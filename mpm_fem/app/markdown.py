@@ -111,8 +111,10 @@ def prose(text: str, limit: int = MAX_WORDS) -> list[str]:
 
 
 def bullets(items: list[str], limit: int = MAX_WORDS) -> list[str]:
-    """A bullet list, an item longer than ``limit`` words continued as further items."""
-    return [f"- {p}" for item in items for p in paragraphs(item, limit)] + [""]
+    """A bullet list, an item longer than ``limit`` words continued as further items; the items apart
+    (a blank line between them), so that each is a paragraph of its own within ``limit`` words, its
+    marker counted."""
+    return [line for item in items for p in paragraphs(item, limit - 1) for line in (f"- {p}", "")]
 
 
 def _is_prose(block: str) -> bool:
@@ -121,15 +123,10 @@ def _is_prose(block: str) -> bool:
 
 def words_of_paragraphs(markdown: str) -> list[tuple[int, str]]:
     """``(words, first words)`` of every paragraph of ``markdown``: a block of lines between blank
-    lines, or one item of a list; headings, tables, figures, anchors and comments are left out."""
-    found = []
-    for block in re.split(r"\n\s*\n", markdown):
-        block = block.strip()
-        if not block or not _is_prose(block):
-            continue
-        items = re.split(r"\n(?=- )", block) if block.startswith("- ") else [block]
-        found += [(word_count(item.removeprefix("- ")), " ".join(item.split()[:8])) for item in items]
-    return found
+    lines, a list's markers counted and a tight list (items without a blank line between them) one
+    block; headings, tables, figures, anchors and comments are left out."""
+    blocks = (block.strip() for block in re.split(r"\n\s*\n", markdown))
+    return [(word_count(block), " ".join(block.split()[:8])) for block in blocks if block and _is_prose(block)]
 
 
 def headings_without_content(markdown: str) -> list[str]:

@@ -12,14 +12,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-#: One meaning per verdict word, written once; the report's Method section prints them.
-VERDICT_MEANING = {
-    "confirmed": "the source's statement holds at the source's settings",
-    "partly": "the statement holds on some settings or quantities, which the evidence names",
-    "differs": "the measured behaviour is another one, which the evidence names",
-    "refuted": "the statement's test fails",
-    "not measured": "a table the criterion reads is missing or too small to judge",
-}
+from mpm_fem.measure.claims.base import VERDICTS
+
+#: One meaning per verdict word (:data:`~mpm_fem.measure.claims.base.VERDICTS`, in their order), written
+#: once; the report's Method section prints them.
+VERDICT_MEANING = dict(zip(VERDICTS, (
+    "the source's statement holds at the source's settings",
+    "the statement holds on some settings or quantities, which the evidence names",
+    "the measured behaviour is another one, which the evidence names",
+    "the statement's test fails",
+    "a table the criterion reads is missing or too small to judge",
+), strict=True))
 
 
 @dataclass(frozen=True)
