@@ -51,41 +51,54 @@ class Estimate:
         return max(self.seconds / max(workers, 1), self.longest)
 
 
-def tasks(name: str, options) -> list[tuple[float, Task]] | None:
-    """The cases of study ``name`` at ``options.tier``, once each, as ``(estimated CPU seconds, task)``
-    with ``options``' cache; ``None`` if the study does not state its cost model."""
-    module = importlib.import_module(f"studies.{name}")
-    if hasattr(module, "SWEEPS"):
-        return _shared_tasks(module, options)
-    plan, cost, rate = (getattr(module, a, None) for a in ("PLAN", "COST", "SECONDS_PER_COST"))
-    if plan is None or cost is None or rate is None:
-        return None
-    unique = {}
-    for group in plan(options.tier).values():
-        for case in group.values():
-            unique.setdefault(repr(sorted(case.items())), case)
-    cache = options.cache_dir(name)
-    return [(rate * cost(c), Task(module.run_case, c, cache)) for c in unique.values()]
+@dataclass(frozen=True)
+class _Priced:
+    """One case of a study's plan: its estimated CPU ``seconds``, the ``study`` whose case function and cache
+    run it, that study's ``module``, and whether another study's own plan holds it (``owned``: priced there)."""
+
+    seconds: float
+    case: dict
+    study: str
+    module: object
+    owned: bool
 
 
 def _key(case: dict) -> str:
     return repr(sorted(case.items()))
 
 
-def _shared_tasks(module, options) -> list[tuple[float, Task]]:
-    """The tasks of a study that runs other studies' cases (``SWEEPS``, ``PLANS``): see the module docstring."""
-    out = []
-    for study, plan in module.PLANS(options.tier).items():
-        owner = module.SWEEPS[study]
-        owned = {_key(c) for group in owner.PLAN(options.tier).values() for c in group.values()}
-        unique = {}
-        for group in plan.values():
-            for case in group.values():
-                unique.setdefault(_key(case), case)
-        cache = options.cache_dir(study)
-        out += [(0.0 if k in owned else owner.SECONDS_PER_COST * owner.COST(c), Task(owner.run_case, c, cache))
-                for k, c in unique.items()]
-    return out
+def _unique(plan: dict) -> dict[str, dict]:
+    """The cases of ``{group: {label: case}}``, once each, by key."""
+    return {k: c for k, c in ((_key(c), c) for group in plan.values() for c in group.values())}
+
+
+def _priced(name: str, tier: str) -> list[_Priced] | None:
+    """Every case of study ``name`` at ``tier``, once each (see the module docstring); ``None`` if the study
+    states no cost model."""
+    module = importlib.import_module(f"studies.{name}")
+    if hasattr(module, "SWEEPS"):
+        out = []
+        for study, plan in module.PLANS(tier).items():
+            owner = module.SWEEPS[study]
+            owned = set(_unique(owner.PLAN(tier)))
+            out += [_Priced(owner.SECONDS_PER_COST * owner.COST(c), c, study, owner, k in owned)
+                    for k, c in _unique(plan).items()]
+        return out
+    plan, cost, rate = (getattr(module, a, None) for a in ("PLAN", "COST", "SECONDS_PER_COST"))
+    if plan is None or cost is None or rate is None:
+        return None
+    return [_Priced(rate * cost(c), c, name, module, False) for c in _unique(plan(tier)).values()]
+
+
+def tasks(name: str, options) -> list[tuple[float, Task]] | None:
+    """The cases of study ``name`` at ``options.tier``, once each, as ``(estimated CPU seconds, task)``
+    with ``options``' cache (a case another study's plan holds costs nothing here: it is counted there);
+    ``None`` if the study does not state its cost model."""
+    found = _priced(name, options.tier)
+    if found is None:
+        return None
+    return [(0.0 if p.owned else p.seconds, Task(p.module.run_case, p.case, options.cache_dir(p.study)))
+            for p in found]
 
 
 def estimate(name: str, options) -> Estimate | None:
@@ -95,18 +108,9 @@ def estimate(name: str, options) -> Estimate | None:
     if found is None:
         return None
     seconds = [s for s, task in found if not task.path.exists()]
-    owned = _owned(name, options)
+    owned = {_key(p.case) for p in _priced(name, options.tier) if p.owned}
     measured = sum(_cpu_s(task.path) for _, task in found if task.path.exists() and _key(task.case) not in owned)
     return Estimate(len(found), len(found) - len(seconds), sum(seconds), max(seconds, default=0.0), measured)
-
-
-def _owned(name: str, options) -> set[str]:
-    """The keys of the cases of study ``name`` that another study's plan holds at the same tier (``SWEEPS``)."""
-    module = importlib.import_module(f"studies.{name}")
-    if not hasattr(module, "SWEEPS"):
-        return set()
-    return {_key(c) for study, owner in module.SWEEPS.items() for group in owner.PLAN(options.tier).values()
-            for c in group.values()}
 
 
 def _cpu_s(path) -> float:
@@ -145,32 +149,13 @@ class Added:
     meshes: tuple[float, ...]
 
 
-def _plan_cases(name: str, tier: str) -> list[tuple[float, dict]]:
-    """``(estimated CPU seconds, case)`` of every case of study ``name`` at ``tier``, once each; a study of
-    other studies' cases (``SWEEPS``) counts only those its owners' plans do not hold at that tier."""
-    module = importlib.import_module(f"studies.{name}")
-    if hasattr(module, "SWEEPS"):
-        out = []
-        for study, plan in module.PLANS(tier).items():
-            owner = module.SWEEPS[study]
-            owned = {_key(c) for group in owner.PLAN(tier).values() for c in group.values()}
-            unique = {_key(c): c for group in plan.values() for c in group.values() if _key(c) not in owned}
-            out += [(owner.SECONDS_PER_COST * owner.COST(c), c) for c in unique.values()]
-        return out
-    plan, cost, rate = (getattr(module, a, None) for a in ("PLAN", "COST", "SECONDS_PER_COST"))
-    if plan is None or cost is None or rate is None:
-        return []
-    unique = {_key(c): c for group in plan(tier).values() for c in group.values()}
-    return [(rate * cost(c), c) for c in unique.values()]
-
-
 def added(names, lower: str = "full", higher: str = "deep") -> dict[str, Added]:
     """Per study of ``names``, the cases of tier ``higher`` that tier ``lower`` does not run (what the
     full tier leaves to the deep one to fit its time budget); studies that add none are left out."""
     out = {}
     for name in names:
-        below = {_key(c) for _, c in _plan_cases(name, lower)}
-        extra = [(s, c) for s, c in _plan_cases(name, higher) if _key(c) not in below]
+        below = {_key(p.case) for p in _priced(name, lower) or () if not p.owned}
+        extra = [(p.seconds, p.case) for p in _priced(name, higher) or () if not p.owned and _key(p.case) not in below]
         if extra:
             meshes = tuple(sorted({c["h"] for _, c in extra if "h" in c}, reverse=True))
             out[name] = Added(len(extra), sum(s for s, _ in extra), meshes)
