@@ -288,7 +288,7 @@ def test_a_finding_shows_its_table_or_its_evidence_as_a_list():
     from mpm_fem.app.paper import evidence
     from mpm_fem.measure.claims import Finding
 
-    assert evidence(Finding("partly", "a (b; c); d")) == ["- a (b; c)", "- d", ""]
+    assert evidence(Finding("partly", "a (b; c); d")) == ["- a (b; c)", "", "- d", ""]  # items apart
     table = evidence(Finding("partly", "e", "s", ({"ppc": "8", "order": "0.5"}, {"ppc": "16", "order": "0.9"})))
     assert table[:3] == ["| ppc | order |", "|---|---|", "| 8 | 0.5 |"]
 
