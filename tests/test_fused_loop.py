@@ -12,12 +12,13 @@ import mpm_fem.fused.codes as fused_codes
 import mpm_fem.fused.compiler as fused_compiler
 import mpm_fem.fused.loop as fused_loop
 import mpm_fem.fused.step as fused_module
+from baselines.exact.burgers import SOLUTIONS, make_solution
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import make_particles, seed_positions
 from mpm_fem.core.solve import Problem, run
-from mpm_fem.core.step import Stages, Walls
+from mpm_fem.core.step import Dirichlet, Stages, Walls
 from mpm_fem.problems import burgers
 from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
 
@@ -221,3 +222,35 @@ def test_a_loop_variant_carries_only_the_passes_its_run_takes(scheme, remedy, ru
             fused_codes.SCHEME_CODE[scheme], int("xpic" in remedy), int("volume" in remedy),
             int("reconstruct" in remedy))
         assert all(scope[name] == value for name, value in constants.items())
+
+
+@pytest.mark.parametrize("name", sorted(SOLUTIONS))
+def test_the_dirichlet_table_holds_the_floats_of_one_call_per_time(name):
+    """``Dirichlet.end_values_at`` (the loop's table) gives, at every time, the floats of
+    ``end_values`` at that time: the table changes no number of a run."""
+    solution = make_solution(name, 0.01)
+    grid = uniform_grid(*solution.domain, 0.01)
+    boundary = Dirichlet(solution.v)
+    times = np.add.accumulate(np.concatenate(([0.0], np.full(500, 0.5 * 0.01**2 / 0.02))))
+    table = boundary.end_values_at(grid, times)
+    assert table.shape == (times.size, 2)
+    assert np.array_equal(table, np.array([boundary.end_values(grid, t) for t in times]))
+
+
+def test_the_loop_reads_the_dirichlet_data_from_the_table_when_its_time_step_is_steady(monkeypatch):
+    """With the stable rule's steady time step the loop reads ``g`` from the table: fewer than one
+    call of ``g`` per ten steps (one per step without the table), the same particles as the numpy step."""
+    calls = []
+    original = Dirichlet.end_values
+
+    def counting(self, grid, t):
+        calls.append(t)
+        return original(self, grid, t)
+
+    monkeypatch.setattr(Dirichlet, "end_values", counting)
+    settings = dict(h=0.01, T=0.1, solution="rarefaction", eps=0.045)
+    fused = burgers.simulate(burgers.BurgersSettings(**settings), progress=False)
+    in_loop = len(calls)
+    reference = burgers.simulate(burgers.BurgersSettings(**settings, kernel="numpy"), progress=False)
+    assert _assert_close(reference, fused) <= TOLERANCE
+    assert fused.steps > 100 and in_loop < fused.steps / 10

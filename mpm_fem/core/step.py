@@ -191,6 +191,21 @@ class Dirichlet:
         """``g`` at the boundary nodes at ``t``, the evaluation the step uses (kept per ``t``)."""
         return self._values(grid, t)[1]
 
+    def end_values_at(self, grid, times: np.ndarray) -> np.ndarray:
+        """``g`` at the boundary nodes at each of ``times`` (K,), as (K, boundary nodes): one call of
+        ``g`` on the broadcast arrays ``(x_b[None, :], times[:, None])``, elementwise the same floats as
+        :meth:`end_values` at each time (``g`` is elementwise; a test checks the exact solutions); a
+        ``g`` that does not broadcast is called once per time."""
+        x_b = grid.nodes[grid.boundary_nodes]
+        times = np.asarray(times, dtype=float)
+        try:
+            values = np.asarray(self.g(x_b[None, :], times[:, None]), dtype=float)
+        except (ValueError, TypeError):
+            values = None
+        if values is None or values.shape != (times.size, x_b.size):
+            values = np.array([np.asarray(self.g(x_b, t), dtype=float) for t in times]).reshape(times.size, x_b.size)
+        return np.ascontiguousarray(values)
+
     def velocity(self, grid, v, t):
         v = v.copy()
         b, g = self._values(grid, t)

@@ -4,11 +4,14 @@ Between walls or Dirichlet ends with the lumped mass, a run takes its steps here
 step of :func:`mpm_fem.core.solve.run`, pass 1, the grid stage (``v_i = P_i / m_i``, ``a_i = F_i /
 m_i``, the end conditions), the remedies' passes and pass 2, in the order and with the operations
 of the per-step path :meth:`mpm_fem.fused.step.FusedStep.step`, so the same numbers bit for bit.
-The Dirichlet data and an exact acceleration come from the problem's own Python objects, called in
-object mode once per step (the same floats). The loop's arguments travel in a few named structures
-(:class:`Geometry`, :class:`Conditions`, :class:`Clock`, :class:`Scratch`, :class:`Remedies`). The
-scheme, the remedies that run and the passes it calls are compile-time globals of each variant
-(:mod:`mpm_fem.fused.compiler`): the branches not taken are pruned and their passes never compile.
+The Dirichlet data come from a table the caller evaluates ahead, at the times the loop will reach
+(:meth:`mpm_fem.core.step.Dirichlet.end_values_at`: the same floats as one call per time), and from the
+boundary object in object mode at a time the table misses; an exact acceleration comes from the
+problem's own Python object, in object mode once per step (the same floats). The loop's arguments
+travel in a few named structures (:class:`Geometry`, :class:`Conditions`, :class:`Clock`,
+:class:`Scratch`, :class:`Remedies`). The scheme, the remedies that run and the passes it calls are
+compile-time globals of each variant (:mod:`mpm_fem.fused.compiler`): the branches not taken are
+pruned and their passes never compile.
 """
 
 from typing import NamedTuple
@@ -64,6 +67,8 @@ class Conditions(NamedTuple):
     dirichlet: bool  # the ends take the boundary's data g(t)
     window: np.ndarray  # the reservoir's (a, b, spacing); empty: no particle boundary
     exact: bool  # the problem's exact nodal acceleration in place of F_i / m_i, and no viscous force
+    times: np.ndarray  # (K,) increasing: the times of the Dirichlet table (empty: no table)
+    table: np.ndarray  # (K, ends): g at the end nodes at those times
 
 
 class Clock(NamedTuple):
@@ -143,6 +148,13 @@ def _exact_acceleration(t):
     return np.ascontiguousarray(exact_acceleration(grid.nodes, t), dtype=float)
 
 
+@njit(cache=True)
+def _tabled(times, t):
+    """The row of the Dirichlet table at time ``t`` exactly (``times`` increasing), or -1."""
+    i = np.searchsorted(times, t)
+    return i if i < times.size and times[i] == t else -1
+
+
 @njit(cache=True, inline="always")
 def _set_ends(ends, values, out):
     """``out[ends] = values`` (:meth:`~mpm_fem.core.step.Dirichlet.velocity`)."""
@@ -186,10 +198,11 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     takes that step with :meth:`~mpm_fem.fused.step.FusedStep.step`, which raises as the numpy step does.
     With ``dirichlet`` the ends take :class:`~mpm_fem.core.step.Dirichlet`'s data instead of the walls'
     zeros (as its ``velocity`` and ``acceleration``: ``v_b = g(t)``, ``a_b = (g(t + dt) - v_b) / dt``,
-    MUSL's re-projection ``g(t + dt)``), ``g`` evaluated in object mode once per step
-    (:func:`_end_values`). A non-empty ``window`` stops the loop after the first step whose particles
-    the reservoir would change (:func:`_reservoir_quiet`): the caller applies it. With ``exact`` the
-    nodal acceleration is the problem's exact one (:func:`_exact_acceleration`, in object mode).
+    MUSL's re-projection ``g(t + dt)``), ``g`` read from the table ``(times, table)`` where it holds the
+    time exactly, else evaluated in object mode (:func:`_end_values`). A non-empty ``window`` stops the
+    loop after the first step whose particles the reservoir would change (:func:`_reservoir_quiet`):
+    the caller applies it. With ``exact`` the nodal acceleration is the problem's exact one
+    (:func:`_exact_acceleration`, in object mode).
     The remedies: ``xpic = m > 0``, XPIC(m) as :meth:`~mpm_fem.fused.step.FusedStep._xpic_target` with the lumped mass
     (``m - 1`` scatter passes, each divided by ``m_i``, the change zero at the end nodes);
     ``volume_width > 0``, the grid volume reset (domain rows that wide, the reset state in
@@ -198,7 +211,7 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     constants of the variant; the passes it calls (``PROJECT``, ``MOVE``, ...) are its globals too.
     Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     nodes, h, inv_spacing = geometry
-    ends, dirichlet, window, exact = conditions
+    ends, dirichlet, window, exact, times, table = conditions
     t, T, speed, fixed_dt, cfl, h_min, refine, viscous_limit, steps, max_steps, budget = clock
     cell, rows, S, G, grid, flags, upd, values, speeds, reset, sums = scratch
     xpic, volume_width, integrals, points, G_q, weights, offsets = remedies
@@ -237,12 +250,20 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
         _lumped_walls(P_i, m_i, ends, v_i)
         if dirichlet:
             if not known:
-                with objmode(g_t="float64[::1]"):
-                    g_t = _end_values(t)
+                row = _tabled(times, t)
+                if row >= 0:
+                    g_t = table[row]
+                else:
+                    with objmode(g_t="float64[::1]"):
+                        g_t = _end_values(t)
                 known = True
             t_next = t + dt
-            with objmode(g_next="float64[::1]"):
-                g_next = _end_values(t_next)
+            row = _tabled(times, t_next)
+            if row >= 0:
+                g_next = table[row]
+            else:
+                with objmode(g_next="float64[::1]"):
+                    g_next = _end_values(t_next)
             _set_ends(ends, g_t, v_i)
         if VOLUME_ON:  # the volume reset, then the force of the reset state
             V_i = _nodal_rows(XPIC_ON, 0)  # its V_i and ratio follow XPIC's arrays

@@ -60,6 +60,7 @@ from mpm_fem.fused.sums import _divide_by_lumped
 KERNELS = ("fused", "numpy")
 _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
 _PAD = 40  # doubles between advance's particle arrays: 5 cache lines, so that they do not share cache sets
+_TABLE_ROWS = 4096  # at most this many times of the Dirichlet table ahead (FusedStep._end_table)
 
 
 def supported(model, stages: Stages) -> str | None:
@@ -139,6 +140,7 @@ class FusedStep:
         self.slides = self.kind == BURGERS and getattr(model, "force", "weak") == "slides"
         self._width(WIDTH_OF[self.basis])
         self.speed, self.finite = np.nan, True
+        self._steady_dt, self._table = None, (np.empty(0), np.empty((0, 0)))  # advance's Dirichlet table
         self.reuse, self._pools, self._turn = reuse, ({}, {}), 0
         self._state = self._out = self._scratch = None  # advance's two sets of particle arrays, its last
         self._cur = 0  # particles, and its scratch arrays
@@ -245,8 +247,10 @@ class FusedStep:
         fixed = problem.dt if problem.dt is not None else 0.0
         viscous = bool(getattr(self.model, "viscous_limit", False))
         window = np.empty(0) if problem.particle_boundary is None else np.array(self._window(problem), dtype=float)
-        conditions = Conditions(ends=self._ends, dirichlet=type(self.boundary) is Dirichlet, window=window,
-                                exact=self.stages.acceleration == "exact")
+        dirichlet = type(self.boundary) is Dirichlet
+        times, table = self._end_table(float(t), float(problem.T)) if dirichlet else (np.empty(0), np.empty((0, 0)))
+        conditions = Conditions(ends=self._ends, dirichlet=dirichlet, window=window,
+                                exact=self.stages.acceleration == "exact", times=times, table=table)
         clock = Clock(t=float(t), T=float(problem.T), speed=float(self.speed), fixed_dt=float(fixed),
                       cfl=float(problem.cfl), h_min=self._h_min, refine=float(self.stages.refine),
                       viscous_limit=viscous, steps=steps, max_steps=max_steps, budget=budget)
@@ -259,10 +263,27 @@ class FusedStep:
         finally:
             _LOOP_CALLS.pop()
         if done:
+            self._steady_dt = float(dt_max) if dt_min == dt_max else None
             self._cur, self.speed, self.finite = cur, float(speed), True
             self._out = Particles(**{name: self._state[cur, j, :n] for j, name in enumerate(FIELDS)})
             particles = self._out
         return particles, t, done, dt_min, dt_max
+
+    def _end_table(self, t: float, T: float) -> tuple[np.ndarray, np.ndarray]:
+        """The Dirichlet table :meth:`advance` hands the loop: the times ``t, t + dt, t + 2 dt, ...`` it
+        will reach if its time step stays the last call's ``dt`` (accumulated one addition at a time,
+        as the loop's ``t += dt``: ``np.add.accumulate`` is sequential), up to ``T`` and at most
+        :data:`_TABLE_ROWS` rows, and ``g`` there (:meth:`~mpm_fem.core.step.Dirichlet.end_values_at`);
+        kept while the next call starts on one of its times. Without a steady ``dt`` yet, ``t`` alone."""
+        times, table = self._table
+        row = int(np.searchsorted(times, t))
+        if row < times.size and times[row] == t and times.size - row > 1:
+            return times[row:], table[row:]
+        dt = self._steady_dt
+        count = 0 if dt is None or not dt > 0 else int(min(max((T - t) / dt, 0.0), _TABLE_ROWS))
+        times = np.add.accumulate(np.concatenate(([t], np.full(count, dt if count else 0.0))))
+        self._table = (times, self.boundary.end_values_at(self.grid, times))
+        return self._table
 
     def _grid_volume(self, geometry, x, rows, S, V, m, rho, e, p, chunks):
         """The grid volume reset (:func:`~mpm_fem.fused.remedies._volume_reset`): ``(V, rho, p)`` of the
