@@ -18,7 +18,7 @@ from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import make_particles, seed_positions
 from mpm_fem.core.solve import Problem, run
-from mpm_fem.core.step import Dirichlet, Stages, Walls
+from mpm_fem.core.step import Dirichlet, Stages, Walls, at_times
 from mpm_fem.problems import burgers
 from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
 
@@ -254,3 +254,21 @@ def test_the_loop_reads_the_dirichlet_data_from_the_table_when_its_time_step_is_
     reference = burgers.simulate(burgers.BurgersSettings(**settings, kernel="numpy"), progress=False)
     assert _assert_close(reference, fused) <= TOLERANCE
     assert fused.steps > 100 and in_loop < fused.steps / 10
+
+
+@pytest.mark.parametrize("name", sorted(SOLUTIONS))
+def test_a_table_of_exact_accelerations_holds_the_floats_of_one_call_per_time(name):
+    """``at_times`` of the exact acceleration ``eps v_xx`` (the loop's table with the exact acceleration)
+    gives the floats of one call per time; a function that does not broadcast is called per time."""
+    solution = make_solution(name, 0.02)
+    x = np.linspace(*solution.domain, 201)
+    times = np.add.accumulate(np.concatenate(([0.0], np.full(300, 3e-4))))
+
+    def acceleration(x, t):
+        return 0.02 * solution.v_xx(x, t)
+
+    table = at_times(acceleration, x, times)
+    assert table.shape == (times.size, x.size) and table.flags.c_contiguous
+    assert np.array_equal(table, np.array([acceleration(x, t) for t in times]))
+    scalar_time = at_times(lambda x, t: acceleration(x, float(t)), x, times[:5])
+    assert np.array_equal(scalar_time, table[:5])

@@ -170,6 +170,21 @@ class Walls:
         return a
 
 
+def at_times(f: Callable[[np.ndarray, float], np.ndarray], x: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """``f(x, t)`` at each of ``times`` (K,), as (K, x.size), C-contiguous: one call of ``f`` on the
+    broadcast arrays ``(x[None, :], times[:, None])``, elementwise the floats of one call per time
+    when ``f`` is elementwise (the exact solutions are: a test checks); an ``f`` that does not
+    broadcast is called once per time."""
+    x, times = np.asarray(x, dtype=float), np.asarray(times, dtype=float)
+    try:
+        values = np.asarray(f(x[None, :], times[:, None]), dtype=float)
+    except (ValueError, TypeError, IndexError):
+        values = None
+    if values is None or values.shape != (times.size, x.size):
+        values = np.array([np.asarray(f(x, t), dtype=float) for t in times]).reshape(times.size, x.size)
+    return np.ascontiguousarray(values)
+
+
 @dataclass(frozen=True)
 class Dirichlet:
     """Prescribed velocity ``g(x, t)`` at both ends; ``a_i`` makes ``v_i^{n+1} = g(x_i, t + dt)``.
@@ -192,19 +207,9 @@ class Dirichlet:
         return self._values(grid, t)[1]
 
     def end_values_at(self, grid, times: np.ndarray) -> np.ndarray:
-        """``g`` at the boundary nodes at each of ``times`` (K,), as (K, boundary nodes): one call of
-        ``g`` on the broadcast arrays ``(x_b[None, :], times[:, None])``, elementwise the same floats as
-        :meth:`end_values` at each time (``g`` is elementwise; a test checks the exact solutions); a
-        ``g`` that does not broadcast is called once per time."""
-        x_b = grid.nodes[grid.boundary_nodes]
-        times = np.asarray(times, dtype=float)
-        try:
-            values = np.asarray(self.g(x_b[None, :], times[:, None]), dtype=float)
-        except (ValueError, TypeError):
-            values = None
-        if values is None or values.shape != (times.size, x_b.size):
-            values = np.array([np.asarray(self.g(x_b, t), dtype=float) for t in times]).reshape(times.size, x_b.size)
-        return np.ascontiguousarray(values)
+        """``g`` at the boundary nodes at each of ``times`` (K,), as (K, boundary nodes)
+        (:func:`at_times`: the floats of :meth:`end_values` at each time)."""
+        return at_times(self.g, grid.nodes[grid.boundary_nodes], times)
 
     def velocity(self, grid, v, t):
         v = v.copy()

@@ -6,8 +6,8 @@ m_i``, the end conditions), the remedies' passes and pass 2, in the order and wi
 of the per-step path :meth:`mpm_fem.fused.step.FusedStep.step`, so the same numbers bit for bit.
 The Dirichlet data come from a table the caller evaluates ahead, at the times the loop will reach
 (:meth:`mpm_fem.core.step.Dirichlet.end_values_at`: the same floats as one call per time), and from the
-boundary object in object mode at a time the table misses; an exact acceleration comes from the
-problem's own Python object, in object mode once per step (the same floats). The loop's arguments
+boundary object in object mode at a time the table misses; an exact acceleration likewise, from a
+table of the problem's own function evaluated ahead, or in object mode (the same floats). The loop's arguments
 travel in a few named structures (:class:`Geometry`, :class:`Conditions`, :class:`Clock`,
 :class:`Scratch`, :class:`Remedies`). The scheme, the remedies that run and the passes it calls are
 compile-time globals of each variant (:mod:`mpm_fem.fused.compiler`): the branches not taken are
@@ -67,8 +67,9 @@ class Conditions(NamedTuple):
     dirichlet: bool  # the ends take the boundary's data g(t)
     window: np.ndarray  # the reservoir's (a, b, spacing); empty: no particle boundary
     exact: bool  # the problem's exact nodal acceleration in place of F_i / m_i, and no viscous force
-    times: np.ndarray  # (K,) increasing: the times of the Dirichlet table (empty: no table)
-    table: np.ndarray  # (K, ends): g at the end nodes at those times
+    times: np.ndarray  # (K,) increasing: the times of the tables (empty: no table)
+    table: np.ndarray  # (K, ends): the Dirichlet data g at the end nodes at those times
+    accelerations: np.ndarray  # (K, nodes): the exact nodal acceleration at those times ((0, 0): none)
 
 
 class Clock(NamedTuple):
@@ -201,8 +202,8 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     MUSL's re-projection ``g(t + dt)``), ``g`` read from the table ``(times, table)`` where it holds the
     time exactly, else evaluated in object mode (:func:`_end_values`). A non-empty ``window`` stops the
     loop after the first step whose particles the reservoir would change (:func:`_reservoir_quiet`):
-    the caller applies it. With ``exact`` the nodal acceleration is the problem's exact one
-    (:func:`_exact_acceleration`, in object mode).
+    the caller applies it. With ``exact`` the nodal acceleration is the problem's exact one, from the
+    table ``accelerations`` at the times it holds, else in object mode (:func:`_exact_acceleration`).
     The remedies: ``xpic = m > 0``, XPIC(m) as :meth:`~mpm_fem.fused.step.FusedStep._xpic_target` with the lumped mass
     (``m - 1`` scatter passes, each divided by ``m_i``, the change zero at the end nodes);
     ``volume_width > 0``, the grid volume reset (domain rows that wide, the reset state in
@@ -211,7 +212,7 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     constants of the variant; the passes it calls (``PROJECT``, ``MOVE``, ...) are its globals too.
     Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     nodes, h, inv_spacing = geometry
-    ends, dirichlet, window, exact, times, table = conditions
+    ends, dirichlet, window, exact, times, table, accelerations = conditions
     t, T, speed, fixed_dt, cfl, h_min, refine, viscous_limit, steps, max_steps, budget = clock
     cell, rows, S, G, grid, flags, upd, values, speeds, reset, sums = scratch
     xpic, volume_width, integrals, points, G_q, weights, offsets = remedies
@@ -291,9 +292,13 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
             TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if SCHEME == USF else p, v_i, eps, points, G_q,
                    weights, offsets, chunks, sums, F_i)
         if exact:
-            with objmode(a_exact="float64[::1]"):
-                a_exact = _exact_acceleration(t)
-            a_i[:] = a_exact
+            row = _tabled(times, t) if accelerations.shape[0] else -1
+            if row >= 0:
+                a_i[:] = accelerations[row]
+            else:
+                with objmode(a_exact="float64[::1]"):
+                    a_exact = _exact_acceleration(t)
+                a_i[:] = a_exact
             for i in ends:
                 a_i[i] = 0.0
         else:

@@ -26,7 +26,7 @@ from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import Particles, PositivityError
 from mpm_fem.core.reconstruction import OFFSETS, force_quadrature
 from mpm_fem.core.shape import Shape, basis_integrals, make_shape
-from mpm_fem.core.step import SCHEMES, Dirichlet, GridState, Stages, Walls
+from mpm_fem.core.step import SCHEMES, Dirichlet, GridState, Stages, Walls, at_times
 from mpm_fem.core.transfer import solve_consistent
 from mpm_fem.core.xpic import boundary_change_rule
 from mpm_fem.exact_stages import ExactFields, ExactGridStage, GridData
@@ -60,7 +60,8 @@ from mpm_fem.fused.sums import _divide_by_lumped
 KERNELS = ("fused", "numpy")
 _STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
 _PAD = 40  # doubles between advance's particle arrays: 5 cache lines, so that they do not share cache sets
-_TABLE_ROWS = 4096  # at most this many times of the Dirichlet table ahead (FusedStep._end_table)
+_TABLE_ROWS = 4096  # at most this many times of the tables ahead (FusedStep._tables)
+_TABLE_VALUES = 1 << 18  # at most this many exact nodal accelerations in a table (2 MiB)
 
 
 def supported(model, stages: Stages) -> str | None:
@@ -140,7 +141,7 @@ class FusedStep:
         self.slides = self.kind == BURGERS and getattr(model, "force", "weak") == "slides"
         self._width(WIDTH_OF[self.basis])
         self.speed, self.finite = np.nan, True
-        self._steady_dt, self._table = None, (np.empty(0), np.empty((0, 0)))  # advance's Dirichlet table
+        self._steady_dt, self._table = None, (np.empty(0), np.empty((0, 0)), np.empty((0, 0)))  # advance's tables
         self.reuse, self._pools, self._turn = reuse, ({}, {}), 0
         self._state = self._out = self._scratch = None  # advance's two sets of particle arrays, its last
         self._cur = 0  # particles, and its scratch arrays
@@ -248,9 +249,11 @@ class FusedStep:
         viscous = bool(getattr(self.model, "viscous_limit", False))
         window = np.empty(0) if problem.particle_boundary is None else np.array(self._window(problem), dtype=float)
         dirichlet = type(self.boundary) is Dirichlet
-        times, table = self._end_table(float(t), float(problem.T)) if dirichlet else (np.empty(0), np.empty((0, 0)))
-        conditions = Conditions(ends=self._ends, dirichlet=dirichlet, window=window,
-                                exact=self.stages.acceleration == "exact", times=times, table=table)
+        exact = self.stages.acceleration == "exact"
+        times, table, accelerations = (self._tables(float(t), float(problem.T), exact) if dirichlet or exact
+                                       else (np.empty(0), np.empty((0, 0)), np.empty((0, 0))))
+        conditions = Conditions(ends=self._ends, dirichlet=dirichlet, window=window, exact=exact, times=times,
+                                table=table, accelerations=accelerations)
         clock = Clock(t=float(t), T=float(problem.T), speed=float(self.speed), fixed_dt=float(fixed),
                       cfl=float(problem.cfl), h_min=self._h_min, refine=float(self.stages.refine),
                       viscous_limit=viscous, steps=steps, max_steps=max_steps, budget=budget)
@@ -269,20 +272,26 @@ class FusedStep:
             particles = self._out
         return particles, t, done, dt_min, dt_max
 
-    def _end_table(self, t: float, T: float) -> tuple[np.ndarray, np.ndarray]:
-        """The Dirichlet table :meth:`advance` hands the loop: the times ``t, t + dt, t + 2 dt, ...`` it
-        will reach if its time step stays the last call's ``dt`` (accumulated one addition at a time,
-        as the loop's ``t += dt``: ``np.add.accumulate`` is sequential), up to ``T`` and at most
-        :data:`_TABLE_ROWS` rows, and ``g`` there (:meth:`~mpm_fem.core.step.Dirichlet.end_values_at`);
-        kept while the next call starts on one of its times. Without a steady ``dt`` yet, ``t`` alone."""
-        times, table = self._table
+    def _tables(self, t: float, T: float, exact: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The tables :meth:`advance` hands the loop: the times ``t, t + dt, t + 2 dt, ...`` it will
+        reach if its time step stays the last call's ``dt`` (accumulated one addition at a time, as the
+        loop's ``t += dt``: ``np.add.accumulate`` is sequential), up to ``T``, at most
+        :data:`_TABLE_ROWS` rows and :data:`_TABLE_VALUES` exact accelerations; there the Dirichlet data
+        (:meth:`~mpm_fem.core.step.Dirichlet.end_values_at`; none between walls) and, with ``exact``,
+        the exact nodal acceleration, each one vectorised call of the problem's function (elementwise:
+        the floats of one call per time; a test checks). Kept while the next call starts on one of
+        its times. Without a steady ``dt`` yet, ``t`` alone."""
+        times, table, accelerations = self._table
         row = int(np.searchsorted(times, t))
         if row < times.size and times[row] == t and times.size - row > 1:
-            return times[row:], table[row:]
-        dt = self._steady_dt
-        count = 0 if dt is None or not dt > 0 else int(min(max((T - t) / dt, 0.0), _TABLE_ROWS))
+            return times[row:], table[row:], accelerations[row:]
+        dt, rows = self._steady_dt, _TABLE_ROWS if not exact else max(1, _TABLE_VALUES // self.grid.n_nodes)
+        count = 0 if dt is None or not dt > 0 else int(min(max((T - t) / dt, 0.0), rows))
         times = np.add.accumulate(np.concatenate(([t], np.full(count, dt if count else 0.0))))
-        self._table = (times, self.boundary.end_values_at(self.grid, times))
+        table = (self.boundary.end_values_at(self.grid, times) if type(self.boundary) is Dirichlet
+                 else np.empty((0, 0)))
+        accelerations = at_times(self.exact_acceleration, self.grid.nodes, times) if exact else np.empty((0, 0))
+        self._table = (times, table, accelerations)
         return self._table
 
     def _grid_volume(self, geometry, x, rows, S, V, m, rho, e, p, chunks):
