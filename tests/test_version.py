@@ -143,3 +143,22 @@ def test_the_sweeps_key_by_the_case_version(tmp_path):
     version.case_version.cache_clear()
     assert sweep.fn_version(sod.run_case) == version.case_source_version(ROOT / "studies/sod.py", "run_case")
     assert sweep.case_key(sod.run_case, case) == key
+
+
+def test_a_remembered_version_is_the_computed_one_and_an_edit_computes_it_anew(tree, tmp_path, monkeypatch):
+    """The versions are remembered on disk under the files' bytes: a second process's lookup gives the
+    computed value, an edit (one byte of code) gives the new file's version, not the remembered one,
+    and an unreadable memo is computed around."""
+    memo = tmp_path / "memo" / "versions.json"
+    monkeypatch.setattr(version, "VERSION_CACHE", memo)
+    computed = version._source_version(tree.resolve())
+    assert source_version(tree) == computed and memo.exists()
+    monkeypatch.setattr(version, "_source_version", lambda root: pytest.fail("not read from the memo"))
+    assert source_version(tree) == computed
+    monkeypatch.undo()
+    monkeypatch.setattr(version, "VERSION_CACHE", memo)
+    model = tree / "mpm_fem" / "core" / "norms.py"
+    model.write_text(model.read_text() + "\nEXTRA = 1\n")
+    assert source_version(tree) == version._source_version(tree.resolve()) != computed
+    memo.write_text("not json")
+    assert source_version(tree) == version._source_version(tree.resolve())

@@ -20,13 +20,20 @@ study's plan (which meshes, seeds and tiers) chooses cases but computes none, so
 leaves every finished case valid, while an edit of the model, of the case function or of a constant
 it reads recomputes the cases.
 The version is 12 hexadecimal digits of a SHA-256; it depends on the Python version only through
-:func:`ast.dump`. No project imports.
+:func:`ast.dump`. Parsing every file takes about 3 CPU-s, once per process: each version computed is
+remembered on disk (:func:`_remembered`, in the user's cache folder) under a SHA-256 of the bytes of
+every versioned file, so a process whose files are unchanged reads it in milliseconds (the same
+value: any changed byte computes it anew). No project imports.
 """
 
 from __future__ import annotations
 
 import ast
 import hashlib
+import json
+import os
+import sys
+import tempfile
 from functools import lru_cache
 from pathlib import Path
 
@@ -74,9 +81,53 @@ def _source_text(source: bytes) -> bytes:
         return source
 
 
+#: Where computed versions are remembered (:func:`_remembered`); ``MPM_FEM_VERSION_CACHE`` overrides it.
+VERSION_CACHE = Path(os.environ.get("MPM_FEM_VERSION_CACHE")
+                     or Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "mpm-fem" / "versions.json")
+_REMEMBERED = 256  # entries kept in VERSION_CACHE, the newest
+
+
+def _bytes_digest(root: Path) -> str:
+    """SHA-256 of the path and bytes of every versioned file under ``root`` (and of the Python version,
+    which :func:`ast.dump` depends on): equal digests, equal versions."""
+    digest = hashlib.sha256(sys.version.encode() + b"\0")
+    for path in versioned_files(root):
+        digest.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+def _remembered(key: str, root: Path, compute) -> str:
+    """``compute()``, remembered in :data:`VERSION_CACHE` under ``key`` and the bytes of the versioned
+    files (:func:`_bytes_digest`). A cache that cannot be read or written is computed around."""
+    full = f"{key}\0{_bytes_digest(root)}"
+    try:
+        memo = json.loads(VERSION_CACHE.read_text())
+    except (OSError, ValueError):
+        memo = {}
+    if not isinstance(memo, dict):
+        memo = {}
+    if isinstance(memo.get(full), str):
+        return memo[full]
+    value = compute()
+    memo = {k: v for k, v in list(memo.items())[-(_REMEMBERED - 1):] if k != full} | {full: value}
+    try:
+        VERSION_CACHE.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile("w", dir=VERSION_CACHE.parent, delete=False, suffix=".tmp") as out:
+            json.dump(memo, out)
+        os.replace(out.name, VERSION_CACHE)
+    except OSError:
+        pass
+    return value
+
+
 def source_version(root: Path = ROOT) -> str:
-    """12 hexadecimal digits of the SHA-256 of every versioned file's path and :func:`file_text`."""
-    root = Path(root)
+    """12 hexadecimal digits of the SHA-256 of every versioned file's path and :func:`file_text`
+    (remembered: :func:`_remembered`)."""
+    root = Path(root).resolve()
+    return _remembered(f"source\0{root}", root, lambda: _source_version(root))
+
+
+def _source_version(root: Path) -> str:
     digest = hashlib.sha256()
     for path in versioned_files(root):
         digest.update(path.relative_to(root).as_posix().encode() + b"\0")
@@ -213,6 +264,10 @@ def case_source_version(path: Path, qualname: str, root: Path = ROOT) -> str:
     what the definition ``qualname`` (its first dotted part) of the file ``path`` depends on outside
     the model (:func:`_closure_texts`)."""
     root, path = Path(root).resolve(), Path(path).resolve()
+    return _remembered(f"case\0{root}\0{path}\0{qualname}", root, lambda: _case_source_version(path, qualname, root))
+
+
+def _case_source_version(path: Path, qualname: str, root: Path) -> str:
     digest = hashlib.sha256(_model_version(root))
     for text in _closure_texts(root, path, qualname.split(".")[0], set()):
         digest.update(text + b"\0")
