@@ -12,6 +12,7 @@ its range over the seeds is (:mod:`mpm_fem.measure.spread`).
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import mpm_fem.measure.claims.shape as shape
 from baselines.exact.riemann import wave_positions
@@ -64,9 +65,16 @@ SIDE_BY_SIDE = {"MPM nodes": "mpm_nodes_L1", "FEM consistent": "fem_consistent_L
                 "FV": "fv_L1"}
 
 
-def _settings(rows: list[dict]) -> list[tuple[int, float]]:
-    """The settings (particles per cell, CFL) of ``rows``, in their order; FEM rows (no ``ppc``) left out."""
-    found = dict.fromkeys((int(num(r, "ppc")), num(r, "cfl")) for r in rows if math.isfinite(num(r, "ppc")))
+class Setting(NamedTuple):
+    """A run setting of the Sod tables: particles per cell and CFL number (the key of a per-setting verdict)."""
+
+    ppc: int
+    cfl: float
+
+
+def _settings(rows: list[dict]) -> list[Setting]:
+    """The settings of ``rows``, in their order; FEM rows (no ``ppc``) left out."""
+    found = dict.fromkeys(Setting(int(num(r, "ppc")), num(r, "cfl")) for r in rows if math.isfinite(num(r, "ppc")))
     return list(found)
 
 
@@ -90,8 +98,8 @@ def headline(verdicts: dict[tuple, str]) -> str:
 
 def _per_setting(criterion, rows: list[dict], *more) -> tuple[dict, dict]:
     verdicts, lines = {}, {}
-    for n, cfl in _settings(rows):
-        verdicts[(n, cfl)], lines[(n, cfl)] = criterion(select(rows, ppc=n, cfl=cfl), n, cfl, *more)
+    for k in _settings(rows):
+        verdicts[k], lines[k] = criterion(select(rows, ppc=k.ppc, cfl=k.cfl), k.ppc, k.cfl, *more)
     return verdicts, lines
 
 
@@ -99,7 +107,7 @@ def _settings_text(verdicts: dict, lines: dict) -> str:
     """One clause per setting, the prescribed ones first."""
     if not verdicts:
         return "no row with a setting (ppc, cfl)"
-    order = sorted(verdicts, key=lambda k: (not _prescribed(k[0]), -k[0], k[1]))
+    order = sorted(verdicts, key=lambda k: (not _prescribed(k.ppc), -k.ppc, k.cfl))
     return "; ".join(f"{_label(*k)}: {verdicts[k]}, {lines[k]}" for k in order)
 
 
@@ -145,16 +153,16 @@ def _matching(t: Tables) -> tuple[dict, str]:
     the convergence table with the smallest mean |log(measured / source)| (said so)."""
     found = {}
     for r in source_matching(t, "sod"):
-        found.setdefault((int(num(r, "ppc")), num(r, "cfl")), f"{r['quantity']} {r['norm']}, rank {r['rank']}")
+        found.setdefault(Setting(int(num(r, "ppc")), num(r, "cfl")), f"{r['quantity']} {r['norm']}, rank {r['rank']}")
     if found:
         return found, "the identification table"
     rows, best = t.get(CONVERGENCE, []), None
-    for n, cfl in _settings(rows):
+    for k in _settings(rows):
         for q in ("nodes", "particles"):
             for norm in ("L1", "L2"):
-                m = shape.misfit(select(rows, ppc=n, cfl=cfl), f"ratio_{q}_{norm}")
+                m = shape.misfit(select(rows, ppc=k.ppc, cfl=k.cfl), f"ratio_{q}_{norm}")
                 if math.isfinite(m) and (best is None or m < best[0]):
-                    best = (m, (n, cfl), f"{q} {norm}, closest in {CONVERGENCE}")
+                    best = (m, k, f"{q} {norm}, closest in {CONVERGENCE}")
     if best is None:
         return {}, "no identification table and no ratio to the source"
     return {best[1]: best[2]}, (f"no identification table: the closest setting of the study's "
@@ -186,16 +194,16 @@ def _reproduction(t: Tables, matching: dict) -> str:
 def _c11_sentence(rows: list[dict], verdicts: dict, reproduction: str) -> str:
     """The plain sentence: what the particle density does at the source's particles per cell, with its
     mean orders from where it departs, and where the source's table is reproduced."""
-    prescribed = [k for k in verdicts if _prescribed(k[0]) and verdicts[k] != "not measured"]
+    prescribed = [k for k in verdicts if _prescribed(k.ppc) and verdicts[k] != "not measured"]
     shapes, tails = {}, []
     for k in prescribed:
-        found = _judged_orders(select(rows, ppc=k[0], cfl=k[1]), C11_JUDGED["particle density"])
+        found = _judged_orders(select(rows, ppc=k.ppc, cfl=k.cfl), C11_JUDGED["particle density"])
         shapes[k] = shape.shape([o for _, _, o in found])
         start = shape.growth_start(found)
         tails += [o for h1, _, o in found if shapes[k] != shape.GROWS or h1 <= start]
     if not prescribed:
         return reproduction
-    ppcs = "-".join(map(str, sorted({k[0] for k in prescribed})))
+    ppcs = "-".join(map(str, sorted({k.ppc for k in prescribed})))
     kinds = set(shapes.values())
     what = {shape.GROWS: "grows under refinement", shape.LEVELS: "converges, then levels off",
             shape.STALLS: "stalls from the coarsest mesh", shape.CONVERGES: "keeps converging"}
@@ -226,8 +234,8 @@ def _c11(t: Tables) -> Finding:
     mechanism of the growth is the drift study's finding, quoted from its table (not judged here)."""
     rows = t[SEEDS]
     verdicts, lines, table = {}, {}, []
-    for n, cfl in _settings(rows):
-        verdicts[(n, cfl)], lines[(n, cfl)], row = _c11_setting(select(rows, ppc=n, cfl=cfl), n, cfl)
+    for k in _settings(rows):
+        verdicts[k], lines[k], row = _c11_setting(select(rows, ppc=k.ppc, cfl=k.cfl), k.ppc, k.cfl)
         table.append(row)
     matching, whence = _matching(t)
     for row, k in zip(table, verdicts, strict=True):
@@ -235,7 +243,7 @@ def _c11(t: Tables) -> Finding:
     table += [{"setting": _label(*k), "verdict": "not run in sod/seeds", "source-matching": v}
               for k, v in matching.items() if k not in verdicts]
     reproduction = _reproduction(t, matching)
-    density = [f"{v} ({k[0]} ppc at CFL {k[1]:g})" for k, v in verdicts.items() if _prescribed(k[0])]
+    density = [f"{v} ({k.ppc} ppc at CFL {k.cfl:g})" for k, v in verdicts.items() if _prescribed(k.ppc)]
     evidence = (f"particle density at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell: "
                 + ", ".join(density) + "; " + _settings_text(verdicts, lines)
                 + f"; source-matching settings from {whence}: "
@@ -285,22 +293,21 @@ def _c12(t: Tables) -> Finding:
         return Finding("not measured", f"no region half-width recorded with {SOD_REGIONS.name}")
     rows = select(t[SOD_REGIONS.name], method="MPM nodes")
     verdicts, lines, table = {}, {}, []
-    for n, cfl in _settings(rows):
-        mine = sorted(select(rows, ppc=n, cfl=cfl), key=lambda r: -num(r, "h"))
+    for k in _settings(rows):
+        mine = sorted(select(rows, ppc=k.ppc, cfl=k.cfl), key=lambda r: -num(r, "h"))
         factors = [_density(r, WAVE_REGIONS, lengths) / _density(r, _SMOOTH, lengths) for r in mine]
         hits = sum(f >= WAVE_DENSITY for f in factors)
-        verdicts[(n, cfl)] = count_verdict(hits, len(mine), DIFFERS)
-        share = [sum(num(r, f"share_{k}") for k in WAVE_REGIONS) for r in mine]
-        ranked = sorted(lengths, key=lambda k: -_density(mine[-1], (k,), lengths))
-        lines[(n, cfl)] = (f"the waves' error per unit length {span(factors, '.1f')}x the smooth region's, at least "
-                           f"{WAVE_DENSITY:g} on {hits} of {len(mine)} meshes; share of the nodal L1 "
-                           f"{share[0]:.0%} at h = {mine[0]['h']} -> {share[-1]:.0%} at h = {mine[-1]['h']}; ranked "
-                           f"by error per unit length at h = {mine[-1]['h']}: "
-                           + ", ".join(REGION_NAMES[k] for k in ranked))
-        table.append({"setting": _label(n, cfl), "waves / smooth per unit length": span(factors, ".1f"),
+        verdicts[k] = count_verdict(hits, len(mine), DIFFERS)
+        share = [sum(num(r, f"share_{region}") for region in WAVE_REGIONS) for r in mine]
+        ranked = sorted(lengths, key=lambda region: -_density(mine[-1], (region,), lengths))
+        lines[k] = (f"the waves' error per unit length {span(factors, '.1f')}x the smooth region's, at least "
+                    f"{WAVE_DENSITY:g} on {hits} of {len(mine)} meshes; share of the nodal L1 "
+                    f"{share[0]:.0%} at h = {mine[0]['h']} -> {share[-1]:.0%} at h = {mine[-1]['h']}; ranked "
+                    f"by error per unit length at h = {mine[-1]['h']}: " + ", ".join(REGION_NAMES[r] for r in ranked))
+        table.append({"setting": _label(*k), "waves / smooth per unit length": span(factors, ".1f"),
                       "waves' share": f"{share[0]:.0%} -> {share[-1]:.0%}", "meshes": f"{hits} of {len(mine)}",
-                      "verdict": verdicts[(n, cfl)]})
-    head = [r for r, k in zip(table, verdicts, strict=True) if _prescribed(k[0])]
+                      "verdict": verdicts[k]})
+    head = [r for r, k in zip(table, verdicts, strict=True) if _prescribed(k.ppc)]
     sentence = ("the error per unit length at the waves is " + ", ".join(
         f"{r['waves / smooth per unit length']} ({r['setting']})" for r in head) + " times the smooth region's")
     return Finding(headline(verdicts), "the waves' error per unit length over the smooth region's at "
@@ -465,17 +472,17 @@ def _e3(t: Tables) -> Finding:
     fem = "FEM: " + setting(t, CONVERGENCE, "fem.viscosity", "viscosity variant not recorded")
     last = min(t[CONVERGENCE], key=lambda r: num(r, "h"))
     rows = t[SEEDS]
-    growth = {k: _growth(select(rows, ppc=k[0], cfl=k[1]), t[CONVERGENCE], E3_WHERE["particles"])[0]
-              for k in verdicts if _prescribed(k[0])}
+    growth = {k: _growth(select(rows, ppc=k.ppc, cfl=k.cfl), t[CONVERGENCE], E3_WHERE["particles"])[0]
+              for k in verdicts if _prescribed(k.ppc)}
     table = []
     for k in verdicts:
         row = {"setting": _label(*k)}
         for where, key in E3_WHERE.items():
-            g, coarse, fine = _growth(select(rows, ppc=k[0], cfl=k[1]), t[CONVERGENCE], key)
+            g, coarse, fine = _growth(select(rows, ppc=k.ppc, cfl=k.cfl), t[CONVERGENCE], key)
             row[f"MPM/FEM at the {where}, finest over coarsest"] = g.text()
         row["verdict"] = verdicts[k]
         table.append(row)
-    meshes = [h for k in growth for h in _growth(select(rows, ppc=k[0], cfl=k[1]), t[CONVERGENCE],
+    meshes = [h for k in growth for h in _growth(select(rows, ppc=k.ppc, cfl=k.cfl), t[CONVERGENCE],
                                                   E3_WHERE["particles"])[1:] if math.isfinite(h)]
     where = f" from h = {max(meshes):g} to {min(meshes):g}" if meshes else ""
     sentence = (f"on the same meshes{where} MPM's particle density error over the fixed-mesh FEM's changes by a "
@@ -485,7 +492,7 @@ def _e3(t: Tables) -> Finding:
                 f"{E3_FACTOR:g})")
     return Finding(headline(verdicts), (
         f"MPM/FEM particle error, finest over coarsest mesh at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell: "
-        + ", ".join(f"x{g.text()} ({k[0]} ppc at CFL {k[1]:g})" for k, g in growth.items()) + "; "
+        + ", ".join(f"x{g.text()} ({k.ppc} ppc at CFL {k.cfl:g})" for k, g in growth.items()) + "; "
         + _settings_text(verdicts, lines)
         + f"; density L1 at h = {last['h']} ({_label(int(num(last, 'ppc')), num(last, 'cfl'))}, regular): "
         + ", ".join(f"{m} {num(last, c):.3g}" for m, c in SIDE_BY_SIDE.items()) + f"; FV: {fv}; {fem}"),
