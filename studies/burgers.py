@@ -11,6 +11,7 @@ Tables (their rows: :mod:`mpm_fem.measure.burgers_tables`): ``errors``, ``orders
 from __future__ import annotations
 
 import sys
+from typing import NamedTuple
 
 import numpy as np
 
@@ -90,6 +91,33 @@ QUICK = dict(solutions=(DEFAULT,), eps=EPS[:1], H=H[:2], skip=_MORE[1:], PPC=(2,
              C13=(("rarefaction", "cole_hopf"), ("mpm_calculated", "mpm_exact_dt_h")))
 
 
+class TableKey(NamedTuple):
+    """A case of the ``table`` plan: exact solution, method (:data:`METHODS`), viscosity, mesh."""
+
+    solution: str
+    method: str
+    eps: float
+    h: float
+
+
+class PpcKey(NamedTuple):
+    """A case of the ``ppc`` plan (C3): method, mesh, particles per cell."""
+
+    method: str
+    h: float
+    ppc: int
+
+
+class SeedKey(NamedTuple):
+    """A case of the ``seeds`` plan: method, viscosity, mesh, layout, seed (0 for the regular layout)."""
+
+    method: str
+    eps: float
+    h: float
+    layout: str
+    seed: int
+
+
 def run_case(case: dict) -> dict:
     """One run. ``case["solver"]``: ``"mpm"`` (fields of ``BurgersSettings``) or ``"fem"``
     (``solution``, ``eps``, ``h``, ``mass``, ``cfl``, ``cfl_visc``). Velocity errors at T over
@@ -145,18 +173,18 @@ def _plan(tier: str) -> dict:
     kept = lambda m, h: m not in skip and not (quick and h not in q["H"])  # noqa: E731
     c13_solutions, c13_methods = q.get("C13", ((), ()))
     return {
-        "table": {**{(s, m, e, h): method_case(m, s, e, h) for s in q.get("solutions", SOLUTIONS)
+        "table": {**{TableKey(s, m, e, h): method_case(m, s, e, h) for s in q.get("solutions", SOLUTIONS)
                      for m, hs in meshes["default" if s == DEFAULT else "other"].items() for e in eps_list
                      for h in (meshes.get("headline", {}).get(m, hs) if (s, e) == (DEFAULT, EPS[0]) else hs)
                      if kept(m, h)},
-                  **{(s, m, e, h): method_case(m, s, e, h) for s in c13_solutions for m in c13_methods
+                  **{TableKey(s, m, e, h): method_case(m, s, e, h) for s in c13_solutions for m in c13_methods
                      for e in EPS for h in q.get("H", ())}},
         "profile": {(m, e): {**method_case(m, DEFAULT, e, PROFILE_H), "profile": True}
                     for e in (EPS[0], EPS[-1]) if e in eps_list for m in METHODS if m not in skip},
         "timestep": {(m, e, k): method_case(m, DEFAULT, e, time_h, **({"refine": k} if k > 1 else {}))
                      for e in q.get("time_eps", (EPS[0], EPS[-1]))
                      for m in q.get("time_methods", _MPM + ("mpm_exact_dt_h",)) for k in REFINE},
-        "ppc": {(m, h, n): method_case(m, DEFAULT, EPS[0], h, ppc=n) for m in _MPM for h in q.get("PPC_H", PPC_H)
+        "ppc": {PpcKey(m, h, n): method_case(m, DEFAULT, EPS[0], h, ppc=n) for m in _MPM for h in q.get("PPC_H", PPC_H)
                 for n in q.get("PPC", PPC)},
         "lumping": {**{(m, mass, h): method_case(m, DEFAULT, EPS[0], h, mass=mass, cfl=LUMPING_CFL)
                        for h in q.get("lumping_H", H[:3]) for m in _MPM for mass in ("lumped", "consistent")},
@@ -164,7 +192,7 @@ def _plan(tier: str) -> dict:
                        for h in q.get("lumping_H", H[:3]) for m in fem}},
         "diagnosis": {(label, h): method_case("mpm_calculated", DEFAULT, EPS[0], h, **changes)
                       for h in q.get("diagnosis_H", H[:3]) for label, changes in DIAGNOSIS.items()},
-        "seeds": {(m, EPS[0], h, layout, seed): method_case(m, DEFAULT, EPS[0], h, layout=layout, seed=seed)
+        "seeds": {SeedKey(m, EPS[0], h, layout, seed): method_case(m, DEFAULT, EPS[0], h, layout=layout, seed=seed)
                   for m, hs in meshes["seeds"].items() if m in q.get("seeded", SEEDED)
                   for h in q.get("seeds_H", hs) if h in hs and kept(m, h)
                   for layout, seed in (("regular", 0), *(("jittered", k) for k in q.get("seeds", SEEDS)))},
@@ -199,15 +227,15 @@ def run(options: StudyOptions) -> None:
             BURGERS_PPC: tables.ppc_rows(got["ppc"], EPS[0], WHERE, NORM),
             BURGERS_LUMPING: tables.lumping_rows(got["lumping"], EPS[0], WHERE),
             BURGERS_DIAGNOSIS: tables.diagnosis_rows(got["diagnosis"], DIAGNOSIS, EPS[0], WHERE)}
-    seeded = {"layouts": tables.LAYOUTS, "seeds": sorted({k[4] for k in got["seeds"]}), "eps": EPS[0],
-              "solution": DEFAULT, "meshes": tables.meshes_of({(k[0], k[2]) for k in got["seeds"]})}
-    extra = {"errors": {"meshes": tables.meshes_of({(f"{k[0]}/{k[1]}", k[3]) for k in got["table"]})},
+    seeded = {"layouts": tables.LAYOUTS, "seeds": sorted({k.seed for k in got["seeds"]}), "eps": EPS[0],
+              "solution": DEFAULT, "meshes": tables.meshes_of({(k.method, k.h) for k in got["seeds"]})}
+    extra = {"errors": {"meshes": tables.meshes_of({(f"{k.solution}/{k.method}", k.h) for k in got["table"]})},
              BURGERS_ORDERS.stem: {"seeds": seeded, "interval": tables.INTERVAL}, BURGERS_SEEDS.stem: seeded,
              "timestep": {"h": time_h, "refine": list(REFINE),
                           "meaning": "time_error = |E(dt) - E(dt/16)|; time_below_space: time error < E(dt/16) "
                                      "(the space error)"},
              BURGERS_PPC.stem: {"eps": EPS[0], "solution": DEFAULT,
-                                "meshes": tables.meshes_of({(k[0], k[1]) for k in got["ppc"]})},
+                                "meshes": tables.meshes_of({(k.method, k.h) for k in got["ppc"]})},
              BURGERS_LUMPING.stem: {"mpm_cfl": LUMPING_CFL, "eps": EPS[0], "solution": DEFAULT},
              BURGERS_DIAGNOSIS.stem: {"diagnosis": dict(DIAGNOSIS), "base": "mpm_calculated", "eps": EPS[0],
                                       "solution": DEFAULT}}
