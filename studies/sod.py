@@ -11,6 +11,7 @@ and mesh, the spread over seeds; C11, E3), ``regions`` (C12), ``extrema`` (C14),
 from __future__ import annotations
 
 import sys
+from typing import NamedTuple
 
 import numpy as np
 
@@ -116,6 +117,23 @@ def fem_case(h: float, mass: str) -> dict:
             "profiles": h in PROFILE_H}
 
 
+class SettingKey(NamedTuple):
+    """A case of the ``settings`` plan: particles per cell, CFL, mesh (the regular layout)."""
+
+    ppc: int
+    cfl: float
+    h: float
+
+
+class SeedKey(NamedTuple):
+    """A case of the ``seeds`` plan: particles per cell, CFL, mesh, seed of the jittered layout."""
+
+    ppc: int
+    cfl: float
+    h: float
+    seed: int
+
+
 def _cost(case: dict) -> float:
     """Particles x steps, to start the longest runs first."""
     if case["solver"] in ("fem", "fv"):
@@ -138,8 +156,8 @@ def _plan(tier: str) -> dict:
     refs = sorted(set(hs).union(*(m for m, _ in runs.values())), reverse=True)
     return {
         "mpm": {h: mpm_case(h) for h in hs},
-        "settings": {(n, cfl, h): _setting_case(h, n, cfl) for (n, cfl), (ms, _) in runs.items() for h in ms},
-        "seeds": {(n, cfl, h, seed): _setting_case(h, n, cfl, layout="jittered", seed=seed)
+        "settings": {SettingKey(n, cfl, h): _setting_case(h, n, cfl) for (n, cfl), (ms, _) in runs.items() for h in ms},
+        "seeds": {SeedKey(n, cfl, h, seed): _setting_case(h, n, cfl, layout="jittered", seed=seed)
                   for (n, cfl), (_, jittered) in runs.items() for h in jittered for seed in SEEDS},
         "mpm_consistent": {h: mpm_case(h, mass="consistent") for h in consistent_h},
         "fem_consistent": {h: fem_case(h, "consistent") for h in refs},
@@ -166,10 +184,10 @@ def run(options: StudyOptions) -> None:
               SOD_EXTREMA: sod_tables.extrema_rows(got["settings"]), SOD_PPC: _ppc(got), SOD_MASS: _mass(got),
               "plateau": _plateau(got) if got["plateau"] else []}
     waves = riemann.wave_positions(T, sod.SodSettings.left, sod.SodSettings.right)
-    runs = {"runs": {"ppc_cfl": [list(x) for x in dict.fromkeys(k[:2] for k in got["settings"])],
+    runs = {"runs": {"ppc_cfl": [list(x) for x in dict.fromkeys((k.ppc, k.cfl) for k in got["settings"])],
                      "other settings": "as in mpm",
-                     "layouts": {"regular": [0], "jittered": sorted({k[3] for k in got["seeds"]})},
-                     "jittered_meshes": sorted({k[2] for k in got["seeds"]}, reverse=True)}}
+                     "layouts": {"regular": [0], "jittered": sorted({k.seed for k in got["seeds"]})},
+                     "jittered_meshes": sorted({k.h for k in got["seeds"]}, reverse=True)}}
     extra = {SOD_CONVERGENCE.stem: runs, SOD_SEEDS.stem: runs,
              SOD_REGIONS.stem: {**runs, "regions": describe(REGION_HALF_WIDTH, waves, T)},
              SOD_EXTREMA.stem: {**runs, "rtol": 1e-9, "moving": f"|v_p| > {MOVING_FRACTION:g} x the smaller sound "
