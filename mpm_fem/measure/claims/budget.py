@@ -143,10 +143,10 @@ def _e1(problem: str) -> Criterion:
         r = e1_result(select(t[SUBSETS], problem=problem))
         if r is None:
             return "not measured", f"no complete set of the {2 ** len(STEP_ORDER)} combinations of {STEP_ORDER}"
-        table = tuple({"basis": k[0], "norm": k[1], "run": k[2] or "regular", "h": f"{series[-1][0]:g}",
+        table = tuple({"basis": basis, "norm": norm, "run": run or "regular", "h": f"{series[-1][0]:g}",
                        "interactions / gap": f"{series[-1][1]['interactions']:.2g}",
                        "separate": str(series[-1][1]["separate"]), "dominant": series[-1][1]["dominant"] or "none"}
-                      for k, series in r["found"].items())
+                      for (basis, norm, run), series in r["found"].items())
         return Finding(r["verdict"], _e1_text(r["found"]) + _roundoff_text(t, problem), e1_sentence(problem, r),
                        table)
     return criterion

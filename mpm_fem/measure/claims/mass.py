@@ -73,9 +73,9 @@ def mass_finding(t: Tables, problem: str, second: tuple[str, str], sentence_name
     n, hits = len(cases), sum(source.values())
     verdict = (CONFIRMED if hits == n and all(separable.values()) else PARTLY if hits else
                DIFFERS if lowers else REFUTED)
-    table = tuple({"norm": k[0], "h": f"{k[1]:g}", "ppc": k[2] or "study's", "mass alone / all-MPM":
+    table = tuple({"norm": norm, "h": f"{h:g}", "ppc": ppc or "study's", "mass alone / all-MPM":
                    _text(c["alone"], ".2f"), "its interactions / its effect": _text(c["tangled"], ".2g"),
-                   "Shapley / gap": _text(c["shapley"], ".2f")} for k, c in cases.items())
+                   "Shapley / gap": _text(c["shapley"], ".2f")} for (norm, h, ppc), c in cases.items())
     alone = [c["alone"] for c in cases.values()]
     tangled = [c["tangled"] for c in cases.values()]
     lo, hi = min(a.lo for a in alone), max(a.hi for a in alone)
