@@ -272,3 +272,36 @@ def test_a_table_of_exact_accelerations_holds_the_floats_of_one_call_per_time(na
     assert np.array_equal(table, np.array([acceleration(x, t) for t in times]))
     scalar_time = at_times(lambda x, t: acceleration(x, float(t)), x, times[:5])
     assert np.array_equal(scalar_time, table[:5])
+
+
+@pytest.mark.parametrize("dt_rule", ["stable", "advective"])
+def test_the_tables_never_evaluate_much_more_than_the_steps_need(dt_rule, monkeypatch):
+    """The tables look ahead only as far as the run went since the last one was built: at most about
+    three evaluations of ``g`` and of the exact acceleration per step, whatever the reservoir does
+    (a table built far ahead at every call, when the reservoir acts every step, evaluated hundreds
+    per step: 12,193 exact accelerations for 158 steps, the regression this guards against)."""
+    counted = {"g": 0, "a": 0}
+    end_values, end_values_at, at_times_fused = Dirichlet.end_values, Dirichlet.end_values_at, fused_module.at_times
+
+    def one(self, grid, t):
+        counted["g"] += 1
+        return end_values(self, grid, t)
+
+    def many(self, grid, times):
+        counted["g"] += len(times)
+        return end_values_at(self, grid, times)
+
+    def accelerations(f, x, times):
+        counted["a"] += len(times)
+        return at_times_fused(f, x, times)
+
+    monkeypatch.setattr(Dirichlet, "end_values", one)
+    monkeypatch.setattr(Dirichlet, "end_values_at", many)
+    monkeypatch.setattr(fused_module, "at_times", accelerations)
+    for solution, eps in (("rarefaction", 0.045), ("three_exp", 0.02)):  # the second's reservoir acts every step
+        counted.update(g=0, a=0)
+        settings = dict(h=0.0025, T=0.05, ppc=16, solution=solution, eps=eps, acceleration="exact",
+                        dt_rule=dt_rule, cfl=0.125)
+        fused = burgers.simulate(burgers.BurgersSettings(**settings), progress=False)
+        assert fused.steps > 50
+        assert counted["g"] <= 3 * fused.steps + 2 and counted["a"] <= 3 * fused.steps + 2, (solution, counted)

@@ -141,7 +141,9 @@ class FusedStep:
         self.slides = self.kind == BURGERS and getattr(model, "force", "weak") == "slides"
         self._width(WIDTH_OF[self.basis])
         self.speed, self.finite = np.nan, True
-        self._steady_dt, self._table = None, (np.empty(0), np.empty((0, 0)), np.empty((0, 0)))  # advance's tables
+        # advance's tables: the last call's steady dt, the tables, the dt and the rows ahead they were built with
+        self._steady_dt, self._table = None, (np.empty(0), np.empty((0, 0)), np.empty((0, 0)))
+        self._table_dt, self._ahead, self._built_at = None, 0, 0
         self.reuse, self._pools, self._turn = reuse, ({}, {}), 0
         self._state = self._out = self._scratch = None  # advance's two sets of particle arrays, its last
         self._cur = 0  # particles, and its scratch arrays
@@ -250,7 +252,7 @@ class FusedStep:
         window = np.empty(0) if problem.particle_boundary is None else np.array(self._window(problem), dtype=float)
         dirichlet = type(self.boundary) is Dirichlet
         exact = self.stages.acceleration == "exact"
-        times, table, accelerations = (self._tables(float(t), float(problem.T), exact) if dirichlet or exact
+        times, table, accelerations = (self._tables(float(t), float(problem.T), exact, steps) if dirichlet or exact
                                        else (np.empty(0), np.empty((0, 0)), np.empty((0, 0))))
         conditions = Conditions(ends=self._ends, dirichlet=dirichlet, window=window, exact=exact, times=times,
                                 table=table, accelerations=accelerations)
@@ -266,27 +268,38 @@ class FusedStep:
         finally:
             _LOOP_CALLS.pop()
         if done:
-            self._steady_dt = float(dt_max) if dt_min == dt_max else None
+            self._steady_dt = float(dt_max) if dt_min == dt_max and done > 1 else None
             self._cur, self.speed, self.finite = cur, float(speed), True
             self._out = Particles(**{name: self._state[cur, j, :n] for j, name in enumerate(FIELDS)})
             particles = self._out
         return particles, t, done, dt_min, dt_max
 
-    def _tables(self, t: float, T: float, exact: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _tables(self, t: float, T: float, exact: bool, steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The tables :meth:`advance` hands the loop: the times ``t, t + dt, t + 2 dt, ...`` it will
         reach if its time step stays the last call's ``dt`` (accumulated one addition at a time, as the
-        loop's ``t += dt``: ``np.add.accumulate`` is sequential), up to ``T``, at most
-        :data:`_TABLE_ROWS` rows and :data:`_TABLE_VALUES` exact accelerations; there the Dirichlet data
+        loop's ``t += dt``: ``np.add.accumulate`` is sequential), up to ``T``; there the Dirichlet data
         (:meth:`~mpm_fem.core.step.Dirichlet.end_values_at`; none between walls) and, with ``exact``,
         the exact nodal acceleration, each one vectorised call of the problem's function (elementwise:
         the floats of one call per time; a test checks). Kept while the next call starts on one of
-        its times. Without a steady ``dt`` yet, ``t`` alone."""
+        its times. How far ahead: ``t`` alone unless the last call took more than one step, all with one
+        ``dt``; twice the rows of the last table (from one, at most :data:`_TABLE_ROWS` rows and
+        :data:`_TABLE_VALUES` exact accelerations) when that ``dt`` is the one the last table was built
+        with, else one row ahead; and never more than twice the steps the run took (``steps``, counted
+        from the run's start) since the last table was built, plus one. So a changing time step costs
+        one evaluation at ``t`` per call, as without a table, a steady one reaches the longest table
+        in a few calls, and the rows built never exceed about three per step taken."""
         times, table, accelerations = self._table
         row = int(np.searchsorted(times, t))
         if row < times.size and times[row] == t and times.size - row > 1:
             return times[row:], table[row:], accelerations[row:]
         dt, rows = self._steady_dt, _TABLE_ROWS if not exact else max(1, _TABLE_VALUES // self.grid.n_nodes)
-        count = 0 if dt is None or not dt > 0 else int(min(max((T - t) / dt, 0.0), rows))
+        if dt is None or not dt > 0:
+            ahead = 0
+        else:
+            ahead = min(max(1, 2 * self._ahead), rows) if dt == self._table_dt else 1
+            ahead = min(ahead, 2 * max(steps - self._built_at, 0) + 1)
+        self._table_dt, self._ahead, self._built_at = dt, ahead, steps
+        count = int(min(max((T - t) / dt, 0.0), ahead)) if ahead else 0
         times = np.add.accumulate(np.concatenate(([t], np.full(count, dt if count else 0.0))))
         table = (self.boundary.end_values_at(self.grid, times) if type(self.boundary) is Dirichlet
                  else np.empty((0, 0)))
