@@ -42,6 +42,10 @@ Time: SSP-RK3 (Shu-Osher) with ``dt = cfl h / max_i (|u_i| + c_i)`` recomputed e
 last step shortened to land on ``T``. Default ``cfl = 0.3``: with the consistent mass the first
 step across the diaphragm loses positivity for ``cfl >= 0.5`` (0.45 runs), the lumped mass runs
 up to ``cfl = 1``. Positivity of density and pressure is checked after every stage.
+
+The time loop runs compiled (:mod:`baselines.fem_euler_kernel`, ``kernel="fused"``, the default):
+bit for bit with the numpy loop below (``kernel="numpy"``, the readable reference) for the lumped
+mass, to round-off for the consistent one (a Thomas solve where numpy uses SuperLU).
 """
 
 from __future__ import annotations
@@ -52,6 +56,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from baselines import fem_euler_kernel
+from baselines.fem_burgers_kernel import tridiagonal_factors
 from baselines.galerkin import (
     MASS_KINDS,  # noqa: F401 (the choices of ``mass``, for callers)
     P1Cells,
@@ -65,6 +71,8 @@ from mpm_fem.core.grid import Grid
 SOD_LEFT = (1.0, 0.0, 1.0)
 SOD_RIGHT = (0.125, 0.0, 0.1)
 SOD_DIAPHRAGM = 0.5
+KERNELS = ("fused", "numpy")  # the compiled loop, the numpy reference (:func:`solve`)
+PROGRESS_EVERY = 100  # steps per compiled call, and between progress lines
 
 
 class PositivityError(ArithmeticError):
@@ -116,10 +124,12 @@ class EulerFEMResult:
 
 @dataclass(frozen=True, eq=False)
 class _Operators(P1Cells):
-    """The P1 cells and the solves with the consistent mass."""
+    """The P1 cells and the consistent mass: its matrices and their (SuperLU) solves."""
 
-    solve_free: object = None  # consistent M, for rho and E
-    solve_wall: object = None  # consistent M with wall rows replaced by identity, for rho u
+    M_free: object = None  # consistent M, for rho and E
+    M_wall: object = None  # consistent M with wall rows replaced by identity, for rho u
+    solve_free: object = None
+    solve_wall: object = None
 
 
 def _operators(grid: Grid, mass: str) -> _Operators:
@@ -129,7 +139,7 @@ def _operators(grid: Grid, mass: str) -> _Operators:
         keep = np.ones(grid.n_nodes)
         keep[grid.boundary_nodes] = 0.0
         wall = (sp.diags(keep) @ M + sp.diags(1.0 - keep)).tocsc()
-        ops.update(solve_free=splu(M).solve, solve_wall=splu(wall).solve)
+        ops.update(M_free=M, M_wall=wall, solve_free=splu(M).solve, solve_wall=splu(wall).solve)
     return _Operators(**ops)
 
 
@@ -211,37 +221,34 @@ def solve(
     gamma: float = 1.4,
     viscosity: Viscosity = Viscosity(),
     progress: bool = False,
+    kernel: str = "fused",
 ) -> EulerFEMResult:
     """Sod's shock tube on a uniform mesh of size ``h`` up to time ``T`` (module docstring).
 
+    ``kernel="fused"`` takes the steps in blocks of ``PROGRESS_EVERY`` with the compiled loop of
+    :mod:`baselines.fem_euler_kernel` (bit for bit with the numpy step for the lumped mass, to
+    round-off for the consistent one: a Thomas solve in place of SuperLU); ``"numpy"`` is the
+    readable reference, :func:`_rk3_step`.
+
     Raises ValueError for bad input (``h`` not dividing [0, 1], ``cfl`` outside (0, 1], unknown
-    ``mass``) and :class:`PositivityError` naming the step and node if density or pressure
-    stops being positive.
+    ``mass`` or ``kernel``) and :class:`PositivityError` naming the step and node if density or
+    pressure stops being positive (the same message from either kernel).
     """
     check_settings(mass, T, cfl=cfl)
     if not (np.isfinite(gamma) and gamma > 1):
         raise ValueError(f"gamma must be > 1, got gamma={gamma}")
+    if kernel not in KERNELS:
+        raise ValueError(f"unknown kernel {kernel!r}; choose one of {', '.join(KERNELS)}")
     grid = mesh(0.0, 1.0, h)
     ops = _operators(grid, mass)
     U = sod_initial_state(grid.nodes, gamma)
-    h_min = float(grid.h.min())
-
-    def L(V):
-        return time_derivative(V, ops, gamma, viscosity)
+    run = _Run(ops, T, cfl, float(grid.h.min()), gamma, viscosity)
+    take = _compiled_steps(run) if kernel == "fused" else _numpy_steps(run)
 
     t, steps = 0.0, 0
     while t < T * (1 - 1e-14):
-        rho, u, p = primitives(U, gamma)
-        dt = min(cfl * h_min / float(np.max(np.abs(u) + np.sqrt(gamma * p / rho))), T - t)
-        U1 = U + dt * L(U)
-        _check_positive(U1, gamma, steps + 1, 1)
-        U2 = 0.75 * U + 0.25 * (U1 + dt * L(U1))
-        _check_positive(U2, gamma, steps + 1, 2)
-        U = U / 3.0 + 2.0 / 3.0 * (U2 + dt * L(U2))
-        _check_positive(U, gamma, steps + 1, 3)
-        t += dt
-        steps += 1
-        if progress and steps % 100 == 0:
+        U, t, steps = take(U, t, steps, PROGRESS_EVERY)
+        if progress and steps % PROGRESS_EVERY == 0:
             print(f"fem_euler h={h} {mass}: step {steps}, t={t:.4f}/{T}", flush=True)
 
     rho, u, p = primitives(U, gamma)
@@ -271,3 +278,81 @@ def solve(
         steps=steps,
         settings=settings,
     )
+
+
+@dataclass(frozen=True)
+class _Run:
+    """What every step of a run needs: the operators, the final time, the step rule's ``cfl`` and
+    ``h_min``, ``gamma`` and the viscosity."""
+
+    ops: _Operators
+    T: float
+    cfl: float
+    h_min: float
+    gamma: float
+    viscosity: Viscosity
+
+
+def _rk3_step(U: np.ndarray, t: float, step: int, run: _Run) -> tuple[np.ndarray, float]:
+    """Step number ``step`` (from 1) of SSP-RK3 in numpy from ``(U, t)``: ``dt = min(cfl h_min /
+    max(|u| + c), T - t)``, ``U1 = U + dt L(U)``, ``U2 = 3/4 U + 1/4 (U1 + dt L(U1))``,
+    ``U <- U/3 + 2/3 (U2 + dt L(U2))``; returns ``(U, t + dt)``. :class:`PositivityError` after
+    the first stage whose density or pressure is not positive."""
+    gamma = run.gamma
+
+    def L(V):
+        return time_derivative(V, run.ops, gamma, run.viscosity)
+
+    rho, u, p = primitives(U, gamma)
+    dt = min(run.cfl * run.h_min / float(np.max(np.abs(u) + np.sqrt(gamma * p / rho))), run.T - t)
+    U1 = U + dt * L(U)
+    _check_positive(U1, gamma, step, 1)
+    U2 = 0.75 * U + 0.25 * (U1 + dt * L(U1))
+    _check_positive(U2, gamma, step, 2)
+    U = U / 3.0 + 2.0 / 3.0 * (U2 + dt * L(U2))
+    _check_positive(U, gamma, step, 3)
+    return U, t + dt
+
+
+def _numpy_steps(run: _Run):
+    """``take(U, t, first, count)``: steps ``first + 1 ... first + count`` of :func:`_rk3_step`,
+    fewer if ``t`` reaches ``T``; returns ``(U, t, steps taken in all)``."""
+
+    def take(U, t, first, count):
+        steps = first
+        while steps < first + count and t < run.T * (1 - 1e-14):
+            steps += 1
+            U, t = _rk3_step(U, t, steps, run)
+        return U, t, steps
+
+    return take
+
+
+def _compiled_steps(run: _Run):
+    """``take(U, t, first, count)`` of :func:`_numpy_steps` with the compiled loop
+    (:mod:`baselines.fem_euler_kernel`). At a loss of positivity the kernel hands back the state
+    before the step, and :func:`_rk3_step` retakes that step in numpy to raise its message (with
+    the consistent mass, if round-off spares the numpy step, the kernel's failed stage is named)."""
+    ops = run.ops
+    empty = np.zeros(0)
+    free = wall = (empty, empty, empty)
+    if ops.mass == "consistent":
+        free, wall = tridiagonal_factors(ops.M_free), tridiagonal_factors(ops.M_wall)
+    cells = fem_euler_kernel.Cells(np.ascontiguousarray(ops.a, dtype=np.int64),
+                                   np.ascontiguousarray(ops.b, dtype=np.int64), np.ascontiguousarray(ops.h),
+                                   np.ascontiguousarray(ops.lumped), ops.mass == "consistent", *free, *wall)
+    visc = run.viscosity
+    gas = fem_euler_kernel.Gas(float(run.gamma), float(visc.linear), float(visc.quadratic), bool(visc.compression_only))
+    work = fem_euler_kernel.work(ops.n_nodes)
+    failed = np.empty((3, ops.n_nodes))
+
+    def take(U, t, first, count):
+        U = np.array(U, dtype=float, order="C")
+        t, steps, stage = fem_euler_kernel.steps(U, t, first, count, run.T, run.cfl, run.h_min, cells, gas, work,
+                                                 failed)
+        if stage:
+            _rk3_step(U, t, steps, run)  # raises PositivityError, the numpy loop's message
+            _check_positive(failed, run.gamma, steps, stage)
+        return U, t, steps
+
+    return take
