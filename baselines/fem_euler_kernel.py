@@ -172,13 +172,26 @@ def _max_speed(U, gamma):
 
 
 @njit(cache=True)
+def _stage(stage, U, V, D, dt, out):
+    """SSP-RK3 (Shu-Osher) stage ``stage`` into ``out``, with the numpy loop's operations: ``U + dt D``,
+    ``3/4 U + 1/4 (V + dt D)``, ``U / 3 + 2/3 (V + dt D)`` (``V`` the previous stage, ``D = L(V)``)."""
+    for k in range(3):
+        for i in range(U.shape[1]):
+            if stage == 1:
+                out[k, i] = U[k, i] + dt * D[k, i]
+            elif stage == 2:
+                out[k, i] = 0.75 * U[k, i] + 0.25 * (V[k, i] + dt * D[k, i])
+            else:
+                out[k, i] = U[k, i] / 3.0 + 2.0 / 3.0 * (V[k, i] + dt * D[k, i])
+
+
+@njit(cache=True)
 def steps(U, t, first, count, T, cfl, h_min, cells, gas, work, failed):
     """Steps ``first + 1 ... first + count`` of SSP-RK3 on ``U`` (3, n, in place) from time ``t``,
     fewer if ``t`` reaches ``T``. Returns ``(t, steps taken in all, 0)``, or at the first loss of
     positivity ``(t before that step, that step, its RK stage 1-3)`` with ``U`` left as it was
     before the step and the stage's state in ``failed``."""
     U1, U2, D = work.U1, work.U2, work.D
-    n = U.shape[1]
     end = T * (1 - 1e-14)
     for step in range(first + 1, first + count + 1):
         if not t < end:
@@ -186,27 +199,12 @@ def steps(U, t, first, count, T, cfl, h_min, cells, gas, work, failed):
         dt = cfl * h_min / _max_speed(U, gas.gamma)
         if T - t < dt:
             dt = T - t
-        _derivative(U, cells, gas, work, D)
-        for k in range(3):
-            for i in range(n):
-                U1[k, i] = U[k, i] + dt * D[k, i]
-        if not _positive(U1, gas.gamma):
-            failed[:] = U1
-            return t, step, 1
-        _derivative(U1, cells, gas, work, D)
-        for k in range(3):
-            for i in range(n):
-                U2[k, i] = 0.75 * U[k, i] + 0.25 * (U1[k, i] + dt * D[k, i])
-        if not _positive(U2, gas.gamma):
-            failed[:] = U2
-            return t, step, 2
-        _derivative(U2, cells, gas, work, D)
-        for k in range(3):
-            for i in range(n):
-                U1[k, i] = U[k, i] / 3.0 + 2.0 / 3.0 * (U2[k, i] + dt * D[k, i])
-        if not _positive(U1, gas.gamma):
-            failed[:] = U1
-            return t, step, 3
+        for stage, source, out in ((1, U, U1), (2, U1, U2), (3, U2, U1)):
+            _derivative(source, cells, gas, work, D)
+            _stage(stage, U, source, D, dt, out)
+            if not _positive(out, gas.gamma):
+                failed[:] = out
+                return t, step, stage
         U[:] = U1
         t += dt
     return t, first + count, 0

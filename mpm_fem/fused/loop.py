@@ -156,6 +156,18 @@ def _tabled(times, t):
     return i if i < times.size and times[i] == t else -1
 
 
+@njit(cache=True)
+def _end_data(times, table, t):
+    """The Dirichlet data at ``t``: the table's row where it holds ``t`` exactly, else
+    :func:`_end_values` in object mode."""
+    row = _tabled(times, t)
+    if row >= 0:
+        return table[row]
+    with objmode(values="float64[::1]"):
+        values = _end_values(t)
+    return values
+
+
 @njit(cache=True, inline="always")
 def _set_ends(ends, values, out):
     """``out[ends] = values`` (:meth:`~mpm_fem.core.step.Dirichlet.velocity`)."""
@@ -251,20 +263,10 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
         _lumped_walls(P_i, m_i, ends, v_i)
         if dirichlet:
             if not known:
-                row = _tabled(times, t)
-                if row >= 0:
-                    g_t = table[row]
-                else:
-                    with objmode(g_t="float64[::1]"):
-                        g_t = _end_values(t)
+                g_t = _end_data(times, table, t)
                 known = True
             t_next = t + dt
-            row = _tabled(times, t_next)
-            if row >= 0:
-                g_next = table[row]
-            else:
-                with objmode(g_next="float64[::1]"):
-                    g_next = _end_values(t_next)
+            g_next = _end_data(times, table, t_next)
             _set_ends(ends, g_t, v_i)
         if VOLUME_ON:  # the volume reset, then the force of the reset state
             V_i = _nodal_rows(XPIC_ON, 0)  # its V_i and ratio follow XPIC's arrays
