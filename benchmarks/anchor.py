@@ -30,8 +30,12 @@ contiguous slices, which LLVM vectorises (it also computes the new cell and the 
 contributions to the next step's nodal sums, and the speed); and a scalar accumulation of those
 contributions into two running nodal sums. A node is finished (``v_i, a_i`` written for the next
 step) when the sweep passes it, so there is no grid pass, no zeroing and no scattered write; the
-nodal values alternate between two buffers. The state is six arrays (``x, v, rho, eps, s, m``;
-88 B read and written per particle-step); no helper that takes arrays is called in the loop.
+nodal values alternate between two buffers. The state is six fields (``x, v, rho, eps, s, m``;
+88 B read and written per particle-step), stored block by block (``BLOCK`` values of each field in
+turn), so that the slices of one block lie at fixed distances and LLVM vectorises the update
+without alias checks; the speed and the positivity minima are reduced with ``llvm.maxnum`` and
+``llvm.minnum`` (numba's ``max`` does not vectorise). No helper that takes arrays is called in the
+loop. Measured rates are in ``docs/performance.md`` ("The anchor").
 
 Usage: ``python benchmarks/anchor.py [--cells 200] [--ppc 4]`` runs Sod to ``T = 0.2`` and prints
 the density L1 error against the exact Riemann solution and the rate in particle-steps/s.
