@@ -12,10 +12,15 @@ lumped mass, 4 particles per cell) at n_p = 1e3 ... 1e7:
   * the machine's triad bandwidth (numpy ``a = b + s c`` on 2e7 doubles, counted as 24 B per
     element as STREAM does) and the fused step as a fraction of the bound ``bandwidth / (bytes
     moved per particle-step)``;
-  * the speed-up of ``threads=2`` over one thread (wall time).
+  * the speed-up of ``threads=2`` over one thread (wall time);
+  * the anchor (``benchmarks/anchor.py``, the bare P1 Sod loop written for speed, issue 47) at the
+    same particle counts, and each basis's fused loop as a fraction of it: the two loops' batches
+    alternate (anchor, loop, anchor, loop, ...) in the same run, the best batch of each is kept, and
+    the ratio, not a wall time, is the result.
 Times are the best of ``--repeat`` steps, as CPU time of this process (``time.process_time``):
 the machines are shared, and CPU time is what a loaded machine gives the step. Ratios in one run
-are the result. Usage: ``python benchmarks/step_cost.py [--max 1e7] [--repeat 3]``.
+are the result. Usage: ``python benchmarks/step_cost.py [--max 1e7] [--repeat 3] [--bases mpm,gimp]
+[--no-threads]``.
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ import platform
 import time
 
 import numpy as np
+from anchor import Anchor  # benchmarks/anchor.py, beside this script
 
 from mpm_fem.app.output import tee_markdown
 from mpm_fem.core.grid import uniform_grid
@@ -40,6 +46,7 @@ BASES = ("mpm", "gimp", "bspline", "bspline_gimp")
 # particle-steps/s of the fused loop at 1e6 particles, one thread (uniform-grid arithmetic in every basis)
 RATE_TARGETS = {"mpm": 3e7, "gimp": 2e7, "bspline": 2.5e7, "bspline_gimp": 1e7}
 PPC = 4
+ANCHOR_BYTES = 6 * 8 + 5 * 8  # the anchor reads x, v, rho, eps, s, m and writes all but m
 STATE_FIELDS = ("x", "volume", "mass", "velocity", "density", "energy", "pressure")
 
 
@@ -75,6 +82,31 @@ def best_time(fn, repeat: int, clock=time.process_time) -> float:
     return min(times)
 
 
+def interleaved(fns, repeat: int, clock=time.process_time) -> list[float]:
+    """The best time of each of ``fns``, called in turn ``repeat`` times (a, b, a, b, ...): a load
+    that comes and goes on a shared machine falls on both."""
+    best = [np.inf] * len(fns)
+    for _ in range(repeat):
+        for k, fn in enumerate(fns):
+            t0 = clock()
+            fn()
+            best[k] = min(best[k], clock() - t0)
+    return best
+
+
+def anchor_loop(n_particles: int, batch: int):
+    """A batch of ``batch`` steps of the anchor on Sod's data at ``n_particles`` (4 per cell, CFL
+    0.1, no final time), compiled and one step taken; each call continues from the last."""
+    anchor = Anchor(max(2, n_particles // PPC), PPC, T=1e9)
+    anchor.advance(1)
+
+    def loop():
+        done = anchor.advance(batch)
+        assert done == batch, f"the anchor stopped after {done} of {batch} steps"
+
+    return loop, anchor.n
+
+
 def setup(n_particles: int):
     n_cells = max(2, n_particles // PPC)
     h = 1.0 / n_cells
@@ -98,7 +130,8 @@ def measure(basis: str, n_particles: int, repeat: int, numpy_too: bool = True) -
         current[0], _, done, _, _ = fused.advance(current[0], 0.0, problem, 1, 10**9, batch)
         assert done == batch, f"the loop stopped after {done} of {batch} steps"
 
-    loop_s = best_time(loop, repeat) / batch
+    anchor, n_anchor = anchor_loop(n_particles, batch)
+    loop_s, anchor_s = (b / batch for b in interleaved([loop, anchor], repeat))
     numpy_s = best_time(lambda: explicit_step(grid, particles, gas, Walls(), 0.0, dt, stages),
                         repeat if n_particles <= 10**6 else 1) if numpy_too else np.nan
     n = particles.n
@@ -106,7 +139,8 @@ def measure(basis: str, n_particles: int, repeat: int, numpy_too: bool = True) -
     held += fused._state.nbytes + sum(a.nbytes for a in fused._scratch)  # loop's two sets and scratch
     return {"basis": basis, "n_p": n, "numpy_s": numpy_s, "fused_s": fused_s, "loop_s": loop_s,
             "numpy_rate": n / numpy_s, "fused_rate": n / fused_s, "loop_rate": n / loop_s,
-            "bytes_per_particle": held / n}
+            "bytes_per_particle": held / n, "anchor_rate": n_anchor / anchor_s,
+            "of_anchor": (n / loop_s) / (n_anchor / anchor_s)}
 
 
 def threads_ratio(basis: str, n_particles: int, repeat: int) -> float:
@@ -130,9 +164,15 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max", type=float, default=1e7, help="largest particle count (default 1e7)")
     parser.add_argument("--repeat", type=int, default=3, help="timed steps per size; the best is kept")
+    parser.add_argument("--bases", default=",".join(BASES), help="comma-separated bases (default: all four)")
+    parser.add_argument("--no-threads", action="store_true", help="skip the two-thread measurement")
     parser.add_argument("--markdown", metavar="FILE", default=None,
                         help="also write the tables into FILE's generated block (docs/performance.md)")
     args = parser.parse_args(argv)
+    args.bases = [b.strip() for b in args.bases.split(",") if b.strip()]
+    unknown = sorted(set(args.bases) - set(BASES))
+    if unknown or not args.bases:
+        parser.error(f"unknown bases {unknown}; choose from {', '.join(BASES)}")
     today = datetime.date.today().isoformat()
     header = f"Measured on {today} by `python benchmarks/step_cost.py` ({platform.node()}, {os.cpu_count()} cores)."
     with tee_markdown(args.markdown, "step_cost", header):
@@ -144,29 +184,32 @@ def _run(args) -> None:
     bandwidth = triad_bandwidth()
     print(f"triad bandwidth (numpy a = b + s c, 24 B/element): {bandwidth / 1e9:.1f} GB/s\n")
     print("| basis | particles | numpy particle-steps/s | fused step, particle-steps/s | fused loop, particle-steps/s "
-          "| step / numpy | loop / numpy | bytes per particle (state + buffers) |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+          "| step / numpy | loop / numpy | anchor, particle-steps/s | loop / anchor | bytes per particle "
+          "(state + buffers) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     summary = []
-    for basis in BASES:
+    for basis in args.bases:
         rows = [measure(basis, n, args.repeat) for n in sizes]
         for r in rows:
             print(f"| {basis} | {r['n_p']:.0e} | {r['numpy_rate']:.3g} | {r['fused_rate']:.3g} | "
                   f"{r['loop_rate']:.3g} | "
                   f"{r['fused_rate'] / r['numpy_rate']:.1f} | {r['loop_rate'] / r['numpy_rate']:.1f} | "
-                  f"{r['bytes_per_particle']:.0f} |")
+                  f"{r['anchor_rate']:.3g} | {r['of_anchor']:.2f} | {r['bytes_per_particle']:.0f} |")
         at = next((r for r in rows if r["n_p"] == 10**6), rows[-1])
         summary.append((basis, at, slope(rows, "loop_s"), slope(rows, "numpy_s")))
-    print("\n| basis | fused loop at 1e6, particle-steps/s | loop / numpy | slope loop | slope numpy | "
+    print("\n| basis | fused loop at 1e6, particle-steps/s | loop / anchor | loop / numpy | slope loop | slope numpy | "
           "bytes moved per particle-step | bandwidth bound, particle-steps/s | fraction of the bound | "
           "2 threads / 1 thread (step) |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     verdicts = []
+    anchors = []
     for basis, at, s_fused, s_numpy in summary:
         moved = bytes_moved(basis)
         bound = bandwidth / moved
-        ratio = threads_ratio(basis, at["n_p"], args.repeat)
+        ratio = np.nan if args.no_threads else threads_ratio(basis, at["n_p"], args.repeat)
         speedup = at["loop_rate"] / at["numpy_rate"]
-        print(f"| {basis} | {at['loop_rate']:.3g} | {speedup:.1f} | {s_fused:.2f} | "
+        anchors.append(at["anchor_rate"])
+        print(f"| {basis} | {at['loop_rate']:.3g} | {at['of_anchor']:.2f} | {speedup:.1f} | {s_fused:.2f} | "
               f"{s_numpy:.2f} | {moved} | {bound:.3g} | {at['loop_rate'] / bound:.2f} | {ratio:.2f} |")
         rate_target = RATE_TARGETS[basis]
         verdicts.append(f"{basis}: {at['loop_rate']:.3g} particle-steps/s at {at['n_p']:.0e} "
@@ -178,6 +221,12 @@ def _run(args) -> None:
         verdicts.append(f"{basis}: slope {s_fused:.2f} (target 1.0 +- 0.1: {met})")
         held = at["bytes_per_particle"]
         verdicts.append(f"{basis}: {held:.0f} B per particle (target <= 250: {'met' if held <= 250 else 'NOT met'})")
+    moved = ANCHOR_BYTES
+    print(f"| anchor (benchmarks/anchor.py, P1) | {np.median(anchors):.3g} | 1.00 | | | | {moved} | "
+          f"{bandwidth / moved:.3g} | {np.median(anchors) / (bandwidth / moved):.2f} | |")
+    print(f"\nThe anchor row: the median of its {len(anchors)} measurements at {summary[0][1]['n_p']:.0e} "
+          f"particles (one beside each basis; {min(anchors):.3g} ... {max(anchors):.3g} particle-steps/s); "
+          "each basis's fraction is taken against the anchor measured beside it.")
     print("\nTargets:\n" + "\n".join(f"- {v}" for v in verdicts))
 
 

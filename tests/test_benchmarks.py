@@ -4,6 +4,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -37,3 +39,21 @@ def test_a_generated_block_replaces_only_itself(tmp_path):
     with tee_markdown(page, "other", "Measured today."):
         print("| b |")
     assert "Measured today.\n\n| b |" in page.read_text() and "| 2 |" in page.read_text()
+
+
+def test_step_cost_reports_each_basis_as_a_fraction_of_the_anchor():
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "step_cost.py"), "--max", "1e3", "--repeat", "1",
+                           "--bases", "mpm", "--no-threads"], capture_output=True, text=True, timeout=600, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    cells = lambda line: [c.strip() for c in line.strip("|").split("|")]  # noqa: E731
+    rows = [cells(line) for line in proc.stdout.splitlines() if line.startswith("| mpm | 1e+03")]
+    assert len(rows) == 1  # loop rate, anchor rate, their ratio
+    loop, anchor, ratio = float(rows[0][4]), float(rows[0][7]), float(rows[0][8])
+    assert loop > 0 and anchor > 0 and ratio == pytest.approx(loop / anchor, rel=0.02, abs=0.01)
+    assert any(line.startswith("| anchor (benchmarks/anchor.py, P1) |") for line in proc.stdout.splitlines())
+
+
+def test_step_cost_rejects_an_unknown_basis():
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "step_cost.py"), "--bases", "fem"],
+                          capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert proc.returncode == 2 and "unknown bases" in proc.stderr
