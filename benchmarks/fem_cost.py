@@ -16,14 +16,12 @@ Usage: ``python benchmarks/fem_cost.py [--T 0.05] [--finest 0.000625]``.
 from __future__ import annotations
 
 import argparse
-import datetime
-import os
-import platform
 import time
+
+from measured import add_markdown_option, measured_block  # benchmarks/measured.py, beside this script
 
 from baselines import fem_burgers
 from baselines.exact.burgers import make_solution
-from mpm_fem.app.output import tee_markdown
 from mpm_fem.problems import burgers
 
 H = (0.005, 0.0025, 0.00125, 0.000625)
@@ -56,16 +54,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--T", type=float, default=0.05, help="final time of each timed run (default 0.05)")
     parser.add_argument("--finest", type=float, default=H[-1], help="the finest mesh (default 0.000625)")
-    parser.add_argument("--markdown", metavar="FILE", default=None,
-                        help="also write the tables into FILE's generated block (docs/performance.md)")
+    add_markdown_option(parser)
     args = parser.parse_args()
     if not 0 < args.T <= 0.5:
         parser.error(f"--T must lie in (0, 0.5], got {args.T}")
     if not [h for h in H if h >= args.finest]:
         parser.error(f"--finest must be at most {H[0]}, got {args.finest}")
-    today = datetime.date.today().isoformat()
-    header = f"Measured on {today} by `python benchmarks/fem_cost.py` ({platform.node()}, {os.cpu_count()} cores)."
-    with tee_markdown(args.markdown, "fem_cost", header):
+    with measured_block(args.markdown, "fem_cost"):
         _run(args)
 
 

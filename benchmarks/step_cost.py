@@ -26,15 +26,12 @@ are the result. Usage: ``python benchmarks/step_cost.py [--max 1e7] [--repeat 3]
 from __future__ import annotations
 
 import argparse
-import datetime
-import os
-import platform
 import time
 
 import numpy as np
 from anchor import Anchor  # benchmarks/anchor.py, beside this script
+from measured import add_markdown_option, measured_block  # benchmarks/measured.py
 
-from mpm_fem.app.output import tee_markdown
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.solve import Problem
@@ -166,16 +163,13 @@ def main(argv=None) -> None:
     parser.add_argument("--repeat", type=int, default=3, help="timed steps per size; the best is kept")
     parser.add_argument("--bases", default=",".join(BASES), help="comma-separated bases (default: all four)")
     parser.add_argument("--no-threads", action="store_true", help="skip the two-thread measurement")
-    parser.add_argument("--markdown", metavar="FILE", default=None,
-                        help="also write the tables into FILE's generated block (docs/performance.md)")
+    add_markdown_option(parser)
     args = parser.parse_args(argv)
     args.bases = [b.strip() for b in args.bases.split(",") if b.strip()]
     unknown = sorted(set(args.bases) - set(BASES))
     if unknown or not args.bases:
         parser.error(f"unknown bases {unknown}; choose from {', '.join(BASES)}")
-    today = datetime.date.today().isoformat()
-    header = f"Measured on {today} by `python benchmarks/step_cost.py` ({platform.node()}, {os.cpu_count()} cores)."
-    with tee_markdown(args.markdown, "step_cost", header):
+    with measured_block(args.markdown, "step_cost"):
         _run(args)
 
 
