@@ -183,31 +183,44 @@ COLORS = {"none": "k", "projection": "tab:blue", "mass": "tab:orange", "interpol
 
 
 def figure(folder, got: dict) -> None:
-    """``growth.png``: per problem and particles per cell, v(S) against h (log-log) for each subset, the
-    mean over the runs as a line and their range as a band, slope 1 drawn."""
-    values: dict[tuple, dict[float, list[float]]] = {}
-    for (p, n, _, _, h, _), r in got.items():
+    """``growth.png``: per problem and particles per cell, v(S) against h (log-log) for each subset: the
+    jittered layouts' mean as a solid line and their range as a band, the regular layout dotted; slope 1."""
+    from matplotlib.ticker import NullFormatter
+
+    values: dict[tuple, dict] = {}
+    for (p, n, lay, _, h, _), r in got.items():
         for made_exact, v in (r.get("errors") or {}).items():
-            values.setdefault((p, n), {}).setdefault(made_exact, {}).setdefault(h, []).append(v)
+            values.setdefault((p, n), {}).setdefault(made_exact, {}).setdefault(lay, {}).setdefault(h, []).append(v)
     panels = sorted(values, key=lambda k: (k[0] != "sod", k[1]))
     nrows, ncols = grid_shape(len(panels), (4.2, 3.6))
     fig, axes = plt.subplots(nrows, ncols, figsize=(4.2 * ncols, 3.6 * nrows), squeeze=False)
     for ax in axes.ravel()[len(panels):]:
         ax.set_visible(False)
     for ax, (p, n) in zip(axes.ravel(), panels, strict=False):
-        for made_exact, by_h in values[(p, n)].items():
-            hs = sorted(by_h)
-            lo, mean, hi = ([f(by_h[h]) for h in hs] for f in (min, np.mean, max))
-            name = "all MPM" if made_exact == "none" else f"{made_exact} exact"
-            ax.loglog(hs, mean, "o-", ms=3, lw=1.1, color=COLORS[made_exact], label=name)
-            ax.fill_between(hs, lo, hi, color=COLORS[made_exact], alpha=0.15, lw=0)
-        every = [v for by_h in values[(p, n)].values() for vs in by_h.values() for v in vs]
-        slope_guides(ax, sorted({h for by_h in values[(p, n)].values() for h in by_h}), min(every), (1,))
+        for made_exact, by_layout in values[(p, n)].items():
+            name, color = "all MPM" if made_exact == "none" else f"{made_exact} exact", COLORS[made_exact]
+            if "jittered" in by_layout:
+                by_h = by_layout["jittered"]
+                hs = sorted(by_h)
+                lo, mean, hi = ([f(by_h[h]) for h in hs] for f in (min, np.mean, max))
+                ax.loglog(hs, mean, "o-", ms=3, lw=1.1, color=color, label=name)
+                ax.fill_between(hs, lo, hi, color=color, alpha=0.1, lw=0)
+            if "regular" in by_layout:
+                hs = sorted(by_layout["regular"])
+                ax.loglog(hs, [by_layout["regular"][h][0] for h in hs], ":", lw=1.1, color=color,
+                          label=None if "jittered" in by_layout else name)
+        every = [v for by_layout in values[(p, n)].values() for by_h in by_layout.values() for vs in by_h.values()
+                 for v in vs]
+        hs = sorted({h for by_layout in values[(p, n)].values() for by_h in by_layout.values() for h in by_h})
+        slope_guides(ax, hs, min(every), (1,))
+        ax.set_xticks(hs, [f"{h:g}" for h in hs])
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set(xlabel="h", ylabel=f"particle {'density' if p == 'sod' else 'velocity'} error (L1)",
                title=f"{p}, {n} per cell")
     axes[0][0].legend(fontsize=7)
     save(fig, folder / "growth.png", caption="E6a: the particle L1 error against h with all stages MPM and with each "
-                                             "stage alone exact: mean over the layouts (line) and their range (band)")
+                                             "stage alone exact: the jittered layouts' mean (solid) and range "
+                                             "(band), the regular layout (dotted)")
 
 
 #: The cost model of :mod:`mpm_fem.app.estimate`: :func:`cost` is in CPU milliseconds (the budget's model).

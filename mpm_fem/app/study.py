@@ -156,8 +156,8 @@ def add_tier_options(parser: argparse.ArgumentParser, default: str = "quick") ->
     size = parser.add_mutually_exclusive_group()
     size.add_argument("--quick", dest="tier", action="store_const", const="quick",
                       help="the quick tier, the default: a subset of meshes that judges C11 and C13, into "
-                           "figures/quick (under a minute on 2 cores; reproduce leaves out the remedies, drift and "
-                           "budget studies there)")
+                           "figures/quick (under a minute on 2 cores; reproduce leaves out the remedies, drift, "
+                           "budget and mechanism studies there)")
     size.add_argument("--full", dest="tier", action="store_const", const="full",
                       help="every table of the committed record, figures/ (about an hour on 2 cores)")
     size.add_argument("--deep", dest="tier", action="store_const", const="deep",
