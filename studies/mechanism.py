@@ -43,8 +43,6 @@ from mpm_fem.measure.claims.mechanism import MECHANISM_GROWTH, MECHANISM_SUMMARY
 from mpm_fem.measure.decomposition import label
 from mpm_fem.problems import sod
 from studies.budget import (
-    BASES_STEP_MS,
-    BUDGET_STEP_MS,
     BURGERS,
     EXACT_FORM,
     SEEDS,
@@ -89,14 +87,21 @@ def plan(tier: str) -> dict:
                        for h in meshes for c in t["cases"]}}
 
 
+#: CPU milliseconds per step of one run, ``a + b n`` with ``n`` = particles per cell / h, per (problem, what
+#: the run is): ``mpm`` the all-MPM runs (the compiled step of each problem), ``exact`` a run with exact stages
+#: (their numpy grid stage). A least-squares fit, weighted by steps, to the full tier's 384 cases (2026-11-28,
+#: 8.6 CPU-min on the 2-core machine shared with other jobs); the budget's own model (``BUDGET_STEP_MS``)
+#: predates Burgers' compiled loop and overestimates its all-MPM runs sevenfold.
+STEP_MS = {("sod", "mpm"): (0.0031, 3.9e-5), ("sod", "exact"): (0.39, 9.1e-5),
+           ("burgers", "mpm"): (0.22, 3.4e-5), ("burgers", "exact"): (0.83, 1.7e-3)}
+
+
 def cost(case: dict) -> float:
-    """Estimated CPU milliseconds of a case from the budget's measured cost per step (:data:`BUDGET_STEP_MS`
-    for a run with an exact stage and for Burgers' numpy step, :data:`BASES_STEP_MS` for Sod's all-MPM
-    runs on the fused step): one step's worth per step at dt, ``1 + K`` for the cases run at dt and dt / K."""
+    """Estimated CPU milliseconds of a case (:data:`STEP_MS`): one step's worth per step at dt, ``1 + K`` for
+    the cases run at dt and dt / K."""
     problem, h = case["problem"], case["h"]
     n = setting_of(problem, case)["ppc"] / h
-    fused = problem == "sod" and case["made_exact"] == "time"
-    a, b = BASES_STEP_MS[BASIS] if fused else BUDGET_STEP_MS[(problem, BASIS)]
+    a, b = STEP_MS[(problem, "mpm" if case["made_exact"] == "time" else "exact")]
     runs = 1 + K if case["made_exact"] in ("time", "all") else 1
     return runs * _steps(problem, h) * (a + b * n)
 
@@ -223,7 +228,7 @@ def figure(folder, got: dict) -> None:
                                              "(band), the regular layout (dotted)")
 
 
-#: The cost model of :mod:`mpm_fem.app.estimate`: :func:`cost` is in CPU milliseconds (the budget's model).
+#: The cost model of :mod:`mpm_fem.app.estimate`: :func:`cost` is in CPU milliseconds (:data:`STEP_MS`).
 PLAN, COST, SECONDS_PER_COST = plan, cost, 1e-3
 
 if __name__ == "__main__":
