@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+import mechanism_fixture
 import pytest
 from claim_mutations import TABLES
 from sod_fixture import made_up_tables
@@ -178,8 +179,9 @@ def _undeclared_reads(claim, tables) -> list[str]:
 
 def test_every_table_and_column_a_claim_reads_is_declared():
     """On the committed tables, the Sod tables of made-up runs in place of theirs (``sod_fixture``: the
-    study's own builders, so that a table not yet committed, or committed before its columns changed, is read)."""
-    tables = {**TABLES, **made_up_tables()}
+    study's own builders, so that a table not yet committed, or committed before its columns changed, is read),
+    and the mechanism's tables of made-up runs (``mechanism_fixture``)."""
+    tables = {**TABLES, **made_up_tables(), **mechanism_fixture.tables(problems=("sod", "burgers"))}
     assert all(c.verdict(tables)[0] != "not measured" for c in CLAIMS)  # every criterion runs on its tables
     found = [line for c in CLAIMS for line in _undeclared_reads(c, tables)]
     assert not found, "\n".join(found)

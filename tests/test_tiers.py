@@ -10,7 +10,8 @@ import pytest
 from mpm_fem.app.cli import build_parser
 from mpm_fem.app.study import STUDIES, TIER_FOLDERS, StudyOptions, study_options
 
-PLANS = {"sod": "_plan", "burgers": "_plan", "budget": "plan", "remedies": "_plan", "time": "plan", "drift": "_plan"}
+PLANS = {"sod": "_plan", "burgers": "_plan", "budget": "plan", "remedies": "_plan", "time": "plan", "drift": "_plan",
+         "mechanism": "plan"}
 
 
 def _cases(plan: dict) -> set:
@@ -22,7 +23,7 @@ def test_the_deep_plan_holds_every_case_of_the_full_plan(name):
     make = getattr(importlib.import_module(f"studies.{name}"), PLANS[name])
     full, deep = _cases(make("full")), _cases(make("deep"))
     assert full <= deep, f"{len(full - deep)} full cases missing from the deep plan of {name}"
-    if name in ("sod", "burgers", "budget", "drift"):  # the finest meshes moved to the deep tier
+    if name in ("sod", "burgers", "budget", "drift", "mechanism"):  # the finest meshes moved to the deep tier
         assert len(deep) > len(full), name
 
 

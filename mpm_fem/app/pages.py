@@ -209,4 +209,17 @@ PAGES = (
                  "variant", "seed", "h", "particles_L1", "nodes_L1", "volume_drift", "order_particles_L1"),
                   {"layout": "jittered"}),
          )),
+    Page("mechanism", "Where the growth comes from, stage by stage (E6a)",
+         "Sod and Burgers at few particles per cell, on the regular layout and jittered ones, with every stage of the "
+         "step in MPM form and with each stage alone made exact (the error budget's exact forms): the particle L1 "
+         "error on each mesh and its order between successive meshes, per layout; then, per particle count and mesh "
+         "pair, the orders' range over the layouts and on how many of the layouts where all MPM grows each subset "
+         "converges.",
+         views=(
+             View("mechanism/summary", "Per particle count, subset and mesh pair: the orders over the layouts, the "
+                  "layouts where all MPM grows and those of them where the subset stops the growth or converges", (
+                      "problem", "ppc", "made_exact", "h_coarse", "h_fine", "runs", "order_min", "order_mean",
+                      "order_max", "order_regular", "mpm_growing", "stops_growth", "converging_where_mpm_grows",
+                      "turns_growth"), {}, "growth.png"),
+         )),
 )

@@ -290,9 +290,11 @@ def evidence(f: Finding) -> list[str]:
     return bullets(split_outside(f.evidence))
 
 
-def claim_section(c: Claim, f: Finding, figure_lines: list[str] = (), appendix: str = "") -> list[str]:
-    """A claim in the results: statement, verdict, its sentence, one figure, the evidence, the links."""
-    tables = ", ".join(f"[{t}.csv]({t}.csv)" for t in c.tables if "/" in t)
+def claim_section(c: Claim, f: Finding, figure_lines: list[str] = (), appendix: str = "",
+                  linked: bool = True) -> list[str]:
+    """A claim in the results: statement, verdict, its sentence, one figure, the evidence, the links (to its
+    tables only when ``linked``: a study not in the folder has none to link to)."""
+    tables = ", ".join(f"[{t}.csv]({t}.csv)" for t in c.tables if "/" in t and linked)
     links = (f"Tables: {tables}. " if tables else "") + f"Rule and reasons: [Appendix A](#rule-{anchor_of(c.label)})" \
         + (f"; all of the study's tables: [appendix](#{appendix})." if appendix else ".")
     return [f'<a id="{anchor_of(c.label)}"></a>', "", f"#### {c.label}: {c.statement}", "",
@@ -333,7 +335,7 @@ def results(tables: Tables, found: Found, pages: list[Page], captions: dict, sum
             f = found[c.label][1]
             lines += claim_section(c, f, claim_figure(c, page, captions.get(page.name, {})) if present else [],
                                    ("appendix-stamps" if page is REPRODUCTION else f"appendix-{page.name}")
-                                   if present else "")
+                                   if present else "", linked=present)
     return lines
 
 

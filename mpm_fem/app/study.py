@@ -156,8 +156,8 @@ def add_tier_options(parser: argparse.ArgumentParser, default: str = "quick") ->
     size = parser.add_mutually_exclusive_group()
     size.add_argument("--quick", dest="tier", action="store_const", const="quick",
                       help="the quick tier, the default: a subset of meshes that judges C11 and C13, into "
-                           "figures/quick (under a minute on 2 cores; reproduce leaves out the remedies, drift and "
-                           "budget studies there)")
+                           "figures/quick (under a minute on 2 cores; reproduce leaves out the remedies, drift, "
+                           "budget and mechanism studies there)")
     size.add_argument("--full", dest="tier", action="store_const", const="full",
                       help="every table of the committed record, figures/ (about an hour on 2 cores)")
     size.add_argument("--deep", dest="tier", action="store_const", const="deep",
@@ -201,11 +201,11 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
 
 #: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
 #: layer and import it, never the other way round).
-STUDIES = ("projection", "sod", "burgers", "identification", "budget", "time", "remedies", "drift")
-#: The studies the quick reproduction leaves out: their questions (E5, and the mechanism of C11) are
+STUDIES = ("projection", "sod", "burgers", "identification", "budget", "time", "remedies", "drift", "mechanism")
+#: The studies the quick reproduction leaves out: their questions (E5, the mechanism of C11 and E6a) are
 #: about the plateau of Sod's particle error, which the quick tier's meshes reach at one setting only
 #: (C11's). ``mpm-fem study NAME --quick`` still runs them.
-QUICK_LEAVES_OUT = ("remedies", "drift", "budget")
+QUICK_LEAVES_OUT = ("remedies", "drift", "budget", "mechanism")
 _NO_BUDGET = ("the quick reproduction leaves out the error budget (its exact-stage kernels take about a minute to "
               "compile)")
 #: The verdicts a tier does not judge, ``{tier: {claim: (the tier that judges it, why)}}``: the report
@@ -213,6 +213,8 @@ _NO_BUDGET = ("the quick reproduction leaves out the error budget (its exact-sta
 NOT_JUDGED = {"quick": {
     **{c: ("full", _NO_BUDGET) for c in ("C15 (sod)", "C15 (burgers)", "E1 (sod)", "E1 (burgers)", "E2")},
     "E5": ("full", "the quick reproduction leaves out the remedies study"),
+    **{c: ("full", "the quick reproduction leaves out the mechanism study (the exact-stage kernels)")
+       for c in ("E6a (sod)", "E6a (burgers)")},
 }}
 
 

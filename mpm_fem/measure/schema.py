@@ -202,6 +202,18 @@ IDENTIFICATION_SOD = Table("identification/sod", ("problem", "candidate", "ppc",
 IDENTIFICATION_BURGERS = Table("identification/burgers", ("problem", "candidate", "solution", "dt_rule", "cfl", "ppc",
                                                           "norm", *_IDENTIFIED))
 
+#: One row per problem, basis, run, subset and pair of successive meshes: v(S) on both and the order.
+MECHANISM_GROWTH = Table("mechanism/growth", (
+    "problem", "basis", "ppc", "layout", "seed", "made_exact", "mpm_stages", "h_coarse", "h_fine", "error_coarse",
+    "error_fine", "order"))
+#: One row per problem, basis, particles per cell, subset and mesh pair: the orders over the runs
+#: (``order_regular`` the regular layout's), the runs on which all MPM grows (``mpm_growing``), and of
+#: those the runs on which this subset stops the growth (``stops_growth``) and converges
+#: (``converging_where_mpm_grows``); ``turns_growth``: it converges on every one of them.
+MECHANISM_SUMMARY = Table("mechanism/summary", (
+    "problem", "basis", "ppc", "made_exact", "mpm_stages", "h_coarse", "h_fine", "runs", "order_min", "order_mean",
+    "order_max", "order_regular", "mpm_growing", "stops_growth", "converging_where_mpm_grows", "turns_growth"))
+
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
 #: One row per table: the code version that wrote it and its tier (:func:`mpm_fem.measure.tables.table_tier`;
@@ -218,7 +230,8 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,
     REMEDIES_ERRORS,
     DRIFT,
-    IDENTIFICATION_SOD, IDENTIFICATION_BURGERS)}
+    IDENTIFICATION_SOD, IDENTIFICATION_BURGERS,
+    MECHANISM_GROWTH, MECHANISM_SUMMARY)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}
 

@@ -74,17 +74,17 @@ _add("CONVERGING_ORDER", 0.7,
      "an order at or above this counts as converging (the error falls with h) on a problem with a shock and a "
      "contact, whose L1 orders stay below one",
      _STUDY + ": the source's own Sod orders before the plateau are 0.87-0.94; 0.7 lies below them and above "
-     "the floor", ("C11", "E2", "E5"))
+     "the floor", ("C11", "E2", "E5", "E6a"))
 _add("FLOOR_ORDER", 0.5,
      "an order below this counts as a floor: the error no longer falls with h",
      _STUDY + ": the source says the error 'stops converging' without a number; half the order the source "
      "measures before the plateau", ("C11", "C13", "E2", "E5"))
 _add("GROWTH_ORDER", 0.0,
      "an order below this: the error grows as h shrinks (a divergence, not a plateau)",
-     "the sign of the order: below zero the error is larger on the finer mesh", ("C11", "C13"))
+     "the sign of the order: below zero the error is larger on the finer mesh", ("C11", "C13", "E6a"))
 _add("MIN_RUNS", 6,
      "the runs (the regular layout and five jittered seeds) an order or a ratio is judged over, on each mesh",
-     _STUDY + ": the regular layout and the five jittered seeds the convergence study runs", ("C11", "E3"))
+     _STUDY + ": the regular layout and the five jittered seeds the convergence study runs", ("C11", "E3", "E6a"))
 _add("FLOOR_MESHES", 5,
      "the meshes with MIN_RUNS runs C11 needs: converging orders first, then a levelling",
      "the source's Sod table has six meshes, the first three orders converging; five meshes give four orders, "
@@ -163,6 +163,12 @@ _add("REDUCED", 0.5,
 _add("SAME_NODES", 1e-3,
      "C11's mechanism: nodal errors within this relative distance count as the same motion",
      _STUDY + ": far above round-off, far below the changes a variant makes", ("C11",))
+
+
+_add("MECHANISM_MESHES", 4,
+     "E6a: the meshes every run of a particles-per-cell value needs before its growth is decomposed by stage",
+     "issue 46 asks for at least four meshes: three successive orders, so that a growth and what removes it are "
+     "seen over more than one refinement", ("E6a",))
 
 
 # ----------------------------------------------------------------------------- identification (issue 42, A)
