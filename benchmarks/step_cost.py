@@ -35,6 +35,7 @@ import numpy as np
 from anchor import Anchor  # benchmarks/anchor.py, beside this script
 
 from mpm_fem.app.output import tee_markdown
+from mpm_fem.bases import names
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.solve import Problem
@@ -42,7 +43,7 @@ from mpm_fem.core.step import Stages, Walls, explicit_step
 from mpm_fem.fused.step import FusedStep
 from mpm_fem.problems.sod import SodSettings, initial_particles
 
-BASES = ("mpm", "gimp", "bspline", "bspline_gimp")
+BASES = names()  # every registered basis
 # particle-steps/s of the fused loop at 1e6 particles, one thread (uniform-grid arithmetic in every basis)
 RATE_TARGETS = {"mpm": 3e7, "gimp": 2e7, "bspline": 2.5e7, "bspline_gimp": 1e7}
 PPC = 4
@@ -164,7 +165,7 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max", type=float, default=1e7, help="largest particle count (default 1e7)")
     parser.add_argument("--repeat", type=int, default=3, help="timed steps per size; the best is kept")
-    parser.add_argument("--bases", default=",".join(BASES), help="comma-separated bases (default: all four)")
+    parser.add_argument("--bases", default=",".join(BASES), help="comma-separated bases (default: all registered)")
     parser.add_argument("--no-threads", action="store_true", help="skip the two-thread measurement")
     parser.add_argument("--markdown", metavar="FILE", default=None,
                         help="also write the tables into FILE's generated block (docs/performance.md)")

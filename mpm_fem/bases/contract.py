@@ -139,12 +139,12 @@ DOMAIN_KERNELS = ("scalars", "column")
 
 def missing(basis) -> list[str]:
     """The pieces of the contract ``basis`` lacks or gets wrong (empty: complete), each named with
-    what it is: an attribute unset or of the wrong type, ``shape`` or ``integrals`` not implemented,
-    a kernel that is not a compiled function."""
+    what it is: an attribute unset or of the wrong type, a kernel that is not a compiled function
+    (a subclass without ``shape`` or ``integrals`` cannot be instantiated: the base class names
+    the method)."""
     if not isinstance(basis, Basis):
         return [f"the base class Basis (got {type(basis).__name__})"]
     out = [f"{a} ({what})" for a, (kind, what) in ATTRIBUTES.items() if not _is(getattr(basis, a, None), kind)]
-    out += [f"{m} (not implemented)" for m in sorted(type(basis).__abstractmethods__)]
     kernels = getattr(basis, "kernels", None)
     if isinstance(kernels, Kernels):
         wanted = KERNELS + (DOMAIN_KERNELS if basis.domain is True else ())

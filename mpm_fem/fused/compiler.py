@@ -53,7 +53,7 @@ from pathlib import Path
 from numba import njit
 
 import mpm_fem.bases as bases
-from mpm_fem.bases import Basis, get
+from mpm_fem.bases import Basis, get, names
 from mpm_fem.fused.codes import BURGERS, GAS, MOMENTUM, MUSL, PRESSURE, USF, VISCOUS_STRESS
 from mpm_fem.fused.loop import _advance
 from mpm_fem.fused.passes import _finish, _move, _move_exact, _scatter_pass, _update, _update_exact
@@ -90,7 +90,7 @@ def _basis_globals(constants):
     if "BASIS" not in constants:
         return {}
     basis = constants["BASIS"]
-    if not isinstance(basis, Basis) or get(basis.name) is not basis:
+    if not isinstance(basis, Basis) or basis.name not in names() or get(basis.name) is not basis:
         raise ValueError(f"a variant takes a registered basis (mpm_fem.bases.get), not {basis!r}")
     own, twin = basis.kernels, get(basis.domain_twin).kernels
     return dict(ROW=own.pass_row, SHAPE_ROW=own.row, PROJECT_RUN=own.project, MOVE_RUN=own.move,
