@@ -32,6 +32,7 @@ import numpy as np
 from anchor import Anchor  # benchmarks/anchor.py, beside this script
 from measured import add_markdown_option, measured_block  # benchmarks/measured.py
 
+from mpm_fem.bases import names
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.solve import Problem
@@ -39,7 +40,7 @@ from mpm_fem.core.step import Stages, Walls, explicit_step
 from mpm_fem.fused.step import FusedStep
 from mpm_fem.problems.sod import SodSettings, initial_particles
 
-BASES = ("mpm", "gimp", "bspline", "bspline_gimp")
+BASES = names()  # every registered basis
 # particle-steps/s of the fused loop at 1e6 particles, one thread (uniform-grid arithmetic in every basis)
 RATE_TARGETS = {"mpm": 3e7, "gimp": 2e7, "bspline": 2.5e7, "bspline_gimp": 1e7}
 PPC = 4
@@ -161,7 +162,7 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max", type=float, default=1e7, help="largest particle count (default 1e7)")
     parser.add_argument("--repeat", type=int, default=3, help="timed steps per size; the best is kept")
-    parser.add_argument("--bases", default=",".join(BASES), help="comma-separated bases (default: all four)")
+    parser.add_argument("--bases", default=",".join(BASES), help="comma-separated bases (default: all registered)")
     parser.add_argument("--no-threads", action="store_true", help="skip the two-thread measurement")
     add_markdown_option(parser)
     args = parser.parse_args(argv)

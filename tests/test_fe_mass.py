@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
 
+from mpm_fem.bases import names
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.shape import make_shape
@@ -53,7 +54,7 @@ def rebuilt_fe_mass(grid, basis, fields, t):
     return (E.T @ asm(_density_mass, pieces, rho=rho) @ E).tocsr()
 
 
-@pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline", "bspline_gimp"])
+@pytest.mark.parametrize("basis", names())
 @pytest.mark.parametrize("case", FIELDS)
 def test_the_operator_built_once_equals_scikit_fem_assembling_from_scratch(basis, case):
     """:class:`FEMass` (scikit-fem's basis evaluated once per grid, the density summed per step)
@@ -69,7 +70,7 @@ def test_the_operator_built_once_equals_scikit_fem_assembling_from_scratch(basis
         fe_mass_operator(grid, "bspline" if basis.startswith("bspline") else "mpm")  # built once
 
 
-@pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline", "bspline_gimp"])
+@pytest.mark.parametrize("basis", names())
 @pytest.mark.parametrize("case", FIELDS)
 def test_scikit_fem_mass_equals_the_particle_matrix_on_gauss_points(basis, case):
     """Particles at the Gauss points of :func:`quadrature`, of mass ``w_q rho(x_q)``, give the

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
+from mpm_fem.bases import names
 from mpm_fem.core.grid import grid_from_nodes, uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
@@ -125,7 +126,7 @@ def _pairwise(basis, scheme, model):
     scheme ``s``, 9 of the 18 triples, which still pair every basis with every scheme, every basis
     with both models and every scheme with both models. Each triple is a compiled loop variant of
     its own (about 25 s of numba on a cold cache); the other 9 run with the slow tests."""
-    return model == MODELS[(BASES.index(basis) + SCHEMES.index(scheme)) % 2]
+    return model == MODELS[(names().index(basis) + SCHEMES.index(scheme)) % 2]
 
 
 COMBINATIONS = pytest.mark.parametrize(("basis", "scheme", "model", "boundary"), [
@@ -189,7 +190,7 @@ def _gas_variant_in_the_fast_set(basis, scheme):
 
 @pytest.mark.parametrize(("basis", "scheme"), [
     pytest.param(basis, scheme, marks=() if _gas_variant_in_the_fast_set(basis, scheme) else pytest.mark.slow)
-    for basis in BASES + ("bspline_gimp",) for scheme in SCHEMES])
+    for basis in names() for scheme in SCHEMES])
 @pytest.mark.parametrize("mass", ["lumped", "consistent"])
 def test_a_grid_not_uniform_to_round_off_keeps_the_node_arithmetic_bit_for_bit(basis, scheme, mass):
     """Off a uniform grid every basis keeps the node arithmetic: bit for bit, 200 steps. P1 and GIMP
@@ -325,11 +326,12 @@ def _domain_rows(fused_row, x, V, nodes, K=8):
 
 def test_particle_domain_bspline_row_is_the_formula_float_for_float():
     """The uniform-grid row of the particle-domain B-spline evaluates ``M`` and ``N`` only in the
-    pieces that do not vanish (``_bspline_pieces``): the same floats as the formula of
-    ``mpm_fem.core.shape`` (``_bspline_integral``, ``_quadratic_bspline``) at every node of the row, on
-    domain ends placed at random, on nodes, half-way between nodes and at the grid's ends."""
-    from mpm_fem.core.shape import _bspline_integral, _quadratic_bspline
-    from mpm_fem.fused.basis import _bspline_domain_row
+    pieces that do not vanish (``_pieces``): the same floats as the formula of
+    ``mpm_fem.bases.bspline_gimp`` (``bspline_integral``, ``quadratic_bspline``) at every node of the
+    row, on domain ends placed at random, on nodes, half-way between nodes and at the grid's ends."""
+    from mpm_fem.bases.bspline import quadratic_bspline as _quadratic_bspline
+    from mpm_fem.bases.bspline_gimp import _row as _bspline_domain_row
+    from mpm_fem.bases.bspline_gimp import bspline_integral as _bspline_integral
 
     nodes = np.linspace(0.0, 1.0, 41)
     n_cells = nodes.size - 1
@@ -357,11 +359,11 @@ def test_particle_domain_bspline_row_is_the_formula_float_for_float():
 
 
 def test_the_five_column_bspline_row_is_the_column_rows_float_for_float():
-    """Pass 1's five-column row of the particle-domain B-spline (``_bspline_domain_five``: each end's
-    three pieces placed by selects, ``_five``) gives ``_domain_column``'s floats at every column, for
+    """Pass 1's five-column row of the particle-domain B-spline (``_five_columns``: each end's
+    three pieces placed by selects, ``_five``) gives ``_column``'s floats at every column, for
     domains within two cells placed at random, on nodes and at the grid's ends; ``_five`` is
     ``_piece`` at every start it is used for."""
-    from mpm_fem.fused.basis import _bspline_domain_five, _domain, _domain_column, _five, _piece
+    from mpm_fem.bases.bspline_gimp import _column, _five, _five_columns, _piece, _scalars
 
     for d in range(3):
         assert _five(d, 7.0, 1.0, 2.0, 3.0) == tuple(_piece(k - d, 7.0, 1.0, 2.0, 3.0) for k in range(5))
@@ -372,10 +374,10 @@ def test_the_five_column_bspline_row_is_the_column_rows_float_for_float():
     V = rng.uniform(1e-6, 1.0, x.size) / n_cells
     starts = set()
     for xq, Vq in zip(x, V, strict=False):
-        D = _domain(3, 0.0, 1.0, n_cells - 1, inv_spacing, xq, Vq)
+        D = _scalars(0.0, 1.0, n_cells - 1, inv_spacing, xq, Vq)
         assert D[1] <= 5
         starts.add(D[14] + D[3] - D[2])
-        columns = [_domain_column(3, k, inv_spacing, n_cells, D) for k in range(5)]
-        S, G = np.array(_bspline_domain_five(inv_spacing, D)).reshape(2, 5)
+        columns = [_column(k, inv_spacing, n_cells, D) for k in range(5)]
+        S, G = np.array(_five_columns(inv_spacing, D)).reshape(2, 5)
         assert np.array_equal(S, [c[1] for c in columns]) and np.array_equal(G, [c[2] for c in columns])
     assert starts == {0, 1, 2}  # every start of the high end met

@@ -3,7 +3,8 @@
 The layers are the folders:
 
 1. exact solutions: ``baselines/exact/`` (no project imports);
-2. the MPM core and the fixed-mesh baselines: ``mpm_fem/core/`` (grid, shape, particles, transfer,
+2. the MPM core and the fixed-mesh baselines: ``mpm_fem/bases/`` (the bases behind their contract,
+   and their registry), ``mpm_fem/core/`` (grid, shape, particles, transfer,
    step, solve, models), ``mpm_fem/exact_stages/`` (the exact stages and their kernels),
    ``mpm_fem/fused/`` (the compiled step), ``mpm_fem/problems/`` (the problem set-ups), and
    ``baselines/`` (all but ``baselines/exact/``);
@@ -29,6 +30,7 @@ ROOT = Path(__file__).resolve().parent.parent
 FOLDERS = {
     "baselines.exact": 1,
     "baselines": 2,
+    "mpm_fem.bases": 2,
     "mpm_fem.core": 2,
     "mpm_fem.exact_stages": 2,
     "mpm_fem.fused": 2,

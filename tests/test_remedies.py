@@ -11,6 +11,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from mpm_fem.bases import names
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import make_particles, seed_positions
@@ -122,7 +123,7 @@ def test_reconstructed_force_is_exact_for_a_linear_stress_at_random_particles(ba
 def test_reconstructed_force_sums_to_zero(rng):
     grid = uniform_grid(0.0, 1.0, 0.05)
     x = rng.uniform(0, 1, 400)
-    for basis in ("mpm", "gimp", "bspline", "bspline_gimp"):
+    for basis in names():
         F = reconstructed_force(grid, x, rng.normal(size=x.size), basis)
         assert abs(F.sum()) < 1e-12 * np.abs(F).sum(), basis
 

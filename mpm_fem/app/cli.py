@@ -25,14 +25,14 @@ from mpm_fem.app import guard, output
 from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.guard import UsageError
 from mpm_fem.app.study import add_study_options, add_tier_options, start_study, study_options
+from mpm_fem.bases import get, names
 from mpm_fem.core.grid import GridError
 from mpm_fem.core.particles import LAYOUTS
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS
-from mpm_fem.core.shape import BASES
 from mpm_fem.core.step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, SCHEMES, STAGE_MASS
 from mpm_fem.core.volume import VOLUMES
 
-CHOICES = {"mass": STAGE_MASS, "basis": BASES, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
+CHOICES = {"mass": STAGE_MASS, "basis": names(), "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
            "projection": PROJECTIONS, "interpolation": INTERPOLATIONS}
 # --- remedies (E5): --flip ALPHA, --xpic M, --reconstruct none|taylor, --volume carried|grid, --basis bspline_gimp
 CHOICES.update({"reconstruct": RECONSTRUCTIONS, "volume": VOLUMES, "kernel": ("fused", "numpy")})
@@ -58,8 +58,7 @@ HELP = {
     "refine": "time stage: the time step divided by this integer",
     "kernel": "step implementation: compiled fused passes, or the numpy reference step",
     "threads": "threads of the fused step (deterministic; equal to one thread to round-off)",
-    "basis": "particle basis: point mass (mpm), particle domain (gimp), quadratic B-spline (bspline) or the "
-             "B-spline averaged over the particle domain (bspline_gimp)",
+    "basis": "particle basis (the registry of mpm_fem.bases): " + ", ".join(f"{get(b).title} ({b})" for b in names()),
     "scheme": "stress update order",
     "layout": "initial particle layout in each cell",
     "seed": "random seed (integer >= 0) of jittered/random layouts",

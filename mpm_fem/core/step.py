@@ -24,10 +24,11 @@ from typing import Callable, Protocol
 
 import numpy as np
 
+from mpm_fem.bases import names
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force
-from mpm_fem.core.shape import BASES, make_shape
+from mpm_fem.core.shape import make_shape
 from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
 from mpm_fem.core.volume import VOLUME_RATES, VOLUMES, domain_rate, grid_volume_factor
 from mpm_fem.core.xpic import boundary_change_rule, check_order, xpic_velocity
@@ -81,7 +82,7 @@ class Stages(StageSwitches):
     volume_rate: str = "point"
 
     def __post_init__(self):
-        for name, allowed in (("basis", BASES), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
+        for name, allowed in (("basis", names()), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
                               ("scheme", SCHEMES), ("projection", PROJECTIONS), ("interpolation", INTERPOLATIONS),
                               ("reconstruct", RECONSTRUCTIONS), ("volume", VOLUMES), ("volume_rate", VOLUME_RATES)):
             value = getattr(self, name)

@@ -4,8 +4,9 @@ The volumes carried by the flow, ``V_p^{n+1} = m_p / rho_p^{n+1}``, drift from t
 particles fill (Sod: ``sum_p V_p - 1`` grows as ``h`` shrinks). The grid knows the space: node
 ``i`` owns ``int S_i dx``, and the particle domains ``chi_p = [x_p - V_p/2, x_p + V_p/2]`` claim
 ``V_i = sum_p int S_i chi_p = sum_p V_p Sbar_ip`` of it, with ``Sbar_ip`` the grid function averaged
-over the particle domain (GIMP for the hats, ``"bspline_gimp"`` for the B-splines, whatever the
-step's basis). The reset gives each node's space back to its particles in proportion to their claims,
+over the particle domain (the basis's ``domain_twin``: GIMP for the hats, ``"bspline_gimp"`` for
+the B-splines, whatever the step's basis). The reset gives each node's space back to its particles
+in proportion to their claims,
 
     V_p <- sum_i (V_p Sbar_ip / V_i) int S_i dx = V_p f_p,     f_p = sum_i Sbar_ip (int S_i dx / V_i),
 
@@ -33,6 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mpm_fem.bases import get
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.shape import Shape, basis_integrals, grid_functions, make_shape
 from mpm_fem.core.transfer import divide_by_lumped
@@ -40,7 +42,6 @@ from mpm_fem.core.transfer import divide_by_lumped
 VOLUMES = ("carried", "grid")
 #: The quadrature of the volume rate: at the particle point (``L_p``, the slides') or over its domain.
 VOLUME_RATES = ("point", "domain")
-DOMAIN_BASIS = {"mpm": "gimp", "bspline": "bspline_gimp"}  # grid functions -> their domain averages
 
 
 def grid_volume_factor(grid: Grid, x: np.ndarray, volume: np.ndarray, basis: str = "mpm",
@@ -48,10 +49,10 @@ def grid_volume_factor(grid: Grid, x: np.ndarray, volume: np.ndarray, basis: str
     """``f_p = sum_i Sbar_ip int S_i / V_i`` with ``V_i = sum_p V_p Sbar_ip`` (n_p,), for the grid
     functions ``S_i`` of ``basis`` (module docstring). ``shape``: the step's own ``Sbar_ip`` when
     ``basis`` already averages over the particle domains at these volumes (saves computing it again)."""
-    functions = grid_functions(basis)
-    if shape is None or basis != DOMAIN_BASIS[functions]:
-        shape = make_shape(grid, x, volume, DOMAIN_BASIS[functions])
-    return shape.gather(divide_by_lumped(basis_integrals(grid, functions), shape.scatter(volume)))
+    twin = get(basis).domain_twin
+    if shape is None or basis != twin:
+        shape = make_shape(grid, x, volume, twin)
+    return shape.gather(divide_by_lumped(basis_integrals(grid, grid_functions(basis)), shape.scatter(volume)))
 
 
 def domain_rate(grid: Grid, x: np.ndarray, volume: np.ndarray, v: np.ndarray, basis: str = "mpm") -> np.ndarray:
@@ -60,7 +61,8 @@ def domain_rate(grid: Grid, x: np.ndarray, volume: np.ndarray, v: np.ndarray, ba
     velocities ``v`` (n_nodes,) and the grid functions of ``basis``. ``V_p (1 + dt D_p)`` is then
     ``V_p + dt int_{chi_p} dv_h/dx dx``."""
     half = 0.5 * volume
-    if grid_functions(basis) == "mpm":  # the hats: v_h is the piecewise linear interpolant, constant beyond the ends
+    if get(grid_functions(basis)).degree == 1:  # the hats: v_h is the piecewise linear interpolant, constant beyond
+        # the ends
         return (np.interp(x + half, grid.nodes, v) - np.interp(x - half, grid.nodes, v)) / volume
     a, b = grid.nodes[0], grid.nodes[-1]
     ends = np.concatenate((np.clip(x + half, a, b), np.clip(x - half, a, b)))

@@ -12,10 +12,9 @@ readable reference. Why compiled: ``docs/performance.md``.
                 adds its weights (one after the other, from 0).
     cut_pieces  the pieces (nodes and half cells) that breakpoints cut, their sub-pieces' Gauss
                 points ``x = (a + w/2) + (w/2) xi_g`` and weights ``(w/2) w_g`` and the rows of the
-                grid functions there (:meth:`~mpm_fem.exact_stages.quadrature.QuadratureRule.cuts`): P1 hats
-                ``S = (1 - xi, xi)``, ``G = (-1, 1)/h_c`` or quadratic B-splines (:func:`mpm_fem.core.shape.
-                point_shape`, :func:`~mpm_fem.core.shape.bspline_shape`, their point location
-                :func:`~mpm_fem.core.shape.locate` included).
+                grid functions there (:meth:`~mpm_fem.exact_stages.quadrature.QuadratureRule.cuts`):
+                the compiled row of the grid functions' basis (:mod:`mpm_fem.bases`) in the node
+                arithmetic of its numpy rows, its point location included; one variant per basis.
     splice      the rows of the fixed pieces with each cut piece replaced by its sub-pieces
                 (:meth:`~mpm_fem.exact_stages.quadrature.QuadratureRule.splice`): copies only.
     fe_entries  the entries of the FE mass, ``M_e = sum_q A_eq (dx_q rho_q)`` (scipy's CSR
@@ -30,8 +29,18 @@ readable reference. Why compiled: ``docs/performance.md``.
 
 from __future__ import annotations
 
+import hashlib
+import types
+from functools import lru_cache
+from pathlib import Path
+
 import numpy as np
 from numba import njit
+
+from mpm_fem.bases import get
+from mpm_fem.bases.cells import locate
+
+__all__ = ["corrected", "cut_pieces", "fe_entries", "locate", "project", "splice"]
 
 
 @njit(cache=True)
@@ -52,41 +61,20 @@ def project(nodes, S, G, w, rho, v, sigma, n_nodes, with_mass):
     return m_i, P_i, -F_i
 
 
-@njit(cache=True, inline="always")
-def locate(nodes, inv_spacing, x):
-    """:func:`mpm_fem.core.shape.locate` of one point inside the grid (``inv_spacing``: ``1 / h`` on a
-    uniform grid, else 0): its cell ``c`` and ``xi = (x - x_c)/(x_{c+1} - x_c)``, bit for bit. The
-    one compiled point location: the fused step (:mod:`mpm_fem.fused.step`) uses it too."""
-    last = nodes.size - 2
-    if inv_spacing > 0.0:
-        c = min(max(int((x - nodes[0]) * inv_spacing), 0), last)
-        if x < nodes[c] or (x >= nodes[c + 1] and c < last):
-            c = min(np.searchsorted(nodes, x, side="right") - 1, last)
-    else:
-        c = min(np.searchsorted(nodes, x, side="right") - 1, last)
-    x0 = nodes[c]
-    return c, (x - x0) / (nodes[c + 1] - x0)
+ROW = WIDTH = None  # placeholders: each grid function's variant of _cut_pieces has its own (cut_pieces)
+#: the files whose code a variant of _cut_pieces compiles (the bases' rows are inlined into it)
+SOURCES = sorted((Path(__file__).parent.parent / "bases").glob("*.py")) + [Path(__file__)]
+DIGEST = hashlib.sha1(b"".join(path.read_bytes() for path in SOURCES)).hexdigest()[:8]
 
 
-@njit(cache=True, inline="always")
-def _bspline(r):
-    """``N(r)``, ``N'(r)`` of :func:`mpm_fem.core.shape._quadratic_bspline` at one ``r``."""
-    a = abs(r)
-    if a <= 0.5:
-        return 0.75 - r * r, -2.0 * r
-    if a < 1.5:
-        u = 1.5 - a
-        return 0.5 * (u * u), -u * np.sign(r)
-    return 0.0, 0.0
-
-
-@njit(cache=True)
-def cut_pieces(edges, bp, xi, wq, nodes, h, inv_spacing, bspline):
+def _cut_pieces(edges, bp, xi, wq, nodes, h):
     """The pieces ``edges`` (n_pieces + 1,) that the breakpoints ``bp`` inside them cut, and their
     sub-pieces (module docstring; :meth:`~mpm_fem.exact_stages.quadrature.QuadratureRule.cuts_numpy`):
     ``(cut, first, x, w, rows, S, G, cell)`` with ``first`` each cut piece's first sub-piece and
     then their number, ``x``, ``w``, ``cell`` (n_sub, n_gauss) and ``rows``, ``S``, ``G`` (n_sub,
-    n_gauss, k), ``k = 4`` for the B-splines (``bspline``) and 2 for the hats."""
+    n_gauss, k). The rows are the grid functions' compiled row ``ROW`` in the node arithmetic
+    (``inv_spacing = 0``: the numpy rows bit for bit), ``WIDTH`` = k columns; ``h`` (2, n_cells): the
+    cell sizes and their inverses (:class:`~mpm_fem.bases.contract.Kernels`)."""
     n = edges.size - 1
     piece = np.searchsorted(edges, bp, side="right") - 1
     inside = np.zeros(bp.size, np.bool_)
@@ -101,28 +89,31 @@ def cut_pieces(edges, bp, xi, wq, nodes, h, inv_spacing, bspline):
         keep[j] = c < cut.size and cut[c] == owner[j]
     left, width = ends[:-1][keep], (ends[1:] - ends[:-1])[keep]
     first = np.append(np.searchsorted(owner[keep], cut), left.size)
-    g, k = xi.size, 4 if bspline else 2
+    g, k = xi.size, WIDTH
     x, w, cell = np.empty((left.size, g)), np.empty((left.size, g)), np.empty((left.size, g), np.intp)
     rows, S, G = np.empty((left.size, g, k), np.intp), np.empty((left.size, g, k)), np.empty((left.size, g, k))
-    top = nodes.size - 1
     for p in range(left.size):
         for q in range(g):
             x[p, q] = (left[p] + 0.5 * width[p]) + 0.5 * width[p] * xi[q]
             w[p, q] = 0.5 * width[p] * wq[q]
-            c, t = locate(nodes, inv_spacing, x[p, q])
+            c, _ = ROW(nodes, h, 0.0, x[p, q], 0.0, rows[p, q], S[p, q], G[p, q])
             cell[p, q] = c
-            if bspline:
-                for j in range(4):
-                    rows[p, q, j] = min(max(c + j - 1, 0), top)
-                    value, slope = _bspline(t - (j - 1))
-                    S[p, q, j] = value
-                    G[p, q, j] = slope / h[0]
-            else:
-                inv_h = 1.0 / h[c]
-                rows[p, q, 0], rows[p, q, 1] = c, c + 1
-                S[p, q, 0], S[p, q, 1] = 1.0 - t, t
-                G[p, q, 0], G[p, q, 1] = -inv_h, inv_h
     return cut, first, x, w, rows, S, G, cell
+
+
+@lru_cache(maxsize=None)
+def cut_pieces(functions: str):
+    """:func:`_cut_pieces` compiled for the registered point basis ``functions`` (its row kernel and
+    width as the variant's globals), named by a digest of :data:`SOURCES` so that numba's on-disk
+    cache never serves a variant compiled from other sources."""
+    basis = get(functions)
+    if basis.domain:
+        raise ValueError(f"the exact stages integrate grid functions of a point basis, not {functions!r}")
+    name = f"_cut_pieces_{basis.name}_{DIGEST}"
+    variant = types.FunctionType(_cut_pieces.__code__, dict(_cut_pieces.__globals__, ROW=basis.kernels.row,
+                                                            WIDTH=basis.width), name)
+    variant.__qualname__ = name
+    return njit(cache=True)(variant)
 
 
 @njit(cache=True)

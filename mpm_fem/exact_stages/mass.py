@@ -18,9 +18,10 @@ from functools import lru_cache
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, ElementLineP1, ElementLineP2, MeshLine
+from skfem import Basis, ElementLineP1, ElementLineP2, ElementLinePp, MeshLine
 
 import mpm_fem.exact_stages.grid_kernels as grid_kernels
+from mpm_fem.bases import get
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.shape import grid_functions, make_shape
 from mpm_fem.exact_stages.fields import ExactFields
@@ -115,13 +116,18 @@ class FEMass:
         return self.pattern.data
 
 
+def _element(degree: int):
+    """scikit-fem's line element of polynomials of ``degree`` on each piece: the grid functions of
+    that degree are exactly its combinations (the pieces split at their knots)."""
+    return {1: ElementLineP1, 2: ElementLineP2}.get(degree, lambda: ElementLinePp(degree))()
+
+
 @lru_cache(maxsize=8)
 def fe_mass_operator(grid: Grid, functions: str) -> FEMass:
     """:class:`FEMass` of ``grid`` for the grid functions ``"mpm"`` (P1 hats) or ``"bspline"``; one
     per grid (a run builds it at its first step)."""
     edges = _pieces(grid)
-    pieces = Basis(MeshLine(edges), ElementLineP2() if functions == "bspline" else ElementLineP1(),
-                   intorder=2 * GAUSS_POINTS - 1)
+    pieces = Basis(MeshLine(edges), _element(get(functions).degree), intorder=2 * GAUSS_POINTS - 1)
     points = np.asarray(pieces.global_coordinates()[0])
     if points.shape != (edges.size - 1, GAUSS_POINTS):
         raise RuntimeError(f"scikit-fem's rule has {points.shape[1]} points per piece, not {GAUSS_POINTS}")

@@ -21,7 +21,7 @@ pieces and splices the same :class:`Cuts`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -87,6 +87,11 @@ class QuadratureRule:
     w: np.ndarray  # (n_pieces, GAUSS_POINTS)
     rows: Shape  # rows of the points x, as (n_pieces, GAUSS_POINTS, k) arrays
 
+    @cached_property
+    def _cells(self) -> np.ndarray:
+        """(2, n_cells): the cell sizes ``h_c`` and ``1 / h_c``, as the compiled rows read them."""
+        return np.ascontiguousarray([self.grid.h, 1.0 / self.grid.h], dtype=float)
+
     def __call__(self, breakpoints) -> tuple[np.ndarray, np.ndarray, Shape]:
         """``(x, w, shape)`` of the rule split at ``breakpoints`` (those inside the domain)."""
         return self.splice(self.cuts(breakpoints))
@@ -96,9 +101,8 @@ class QuadratureRule:
         compiled :func:`~mpm_fem.exact_stages.grid_kernels.cut_pieces`, equal bit for bit to :meth:`cuts_numpy`."""
         bp = np.ascontiguousarray(breakpoints, dtype=float).ravel()
         grid = self.grid
-        inv_spacing = 1.0 / grid.uniform_spacing if grid.uniform_spacing is not None else 0.0
-        cut, first, x, w, nodes, S, G, cell = grid_kernels.cut_pieces(
-            self.edges, bp, _XI, _W, grid.nodes, grid.h, inv_spacing, self.functions == "bspline")
+        cut, first, x, w, nodes, S, G, cell = grid_kernels.cut_pieces(self.functions)(
+            self.edges, bp, _XI, _W, grid.nodes, self._cells)
         return Cuts(cut, first, x, w, Shape(nodes, S, G, grid.n_nodes, cell))
 
     def cuts_numpy(self, breakpoints) -> Cuts:

@@ -1,22 +1,14 @@
 """The fused step's codes and named indices.
 
-Compile-time codes: each compiled variant (:mod:`mpm_fem.fused.compiler`) freezes one basis, model,
-scheme and scatter weight as integer globals, so the branches of the others drop out. Named indices:
-the columns of the particle state ``state[cur, IX .. IP]``, of the model constants ``consts[IGM1 ..
-IXPIC]`` and of the loop's nodal scratch, so that no kernel reads a bare column number.
+Compile-time codes: each compiled variant (:mod:`mpm_fem.fused.compiler`) freezes one model, scheme
+and scatter weight as integer globals, so the branches of the others drop out (a basis comes as its
+kernels, :mod:`mpm_fem.bases`). Named indices: the columns of the particle state ``state[cur, IX ..
+IP]``, of the model constants ``consts[IGM1 .. IXPIC]`` and of the loop's nodal scratch, so that no
+kernel reads a bare column number.
 """
 
 # the models
 GAS, BURGERS = 0, 1
-
-# the bases; the particle-domain bases are the odd codes (their rows vary in width and are stored)
-POINT, GIMP, BSPLINE, BSPLINE_GIMP = range(4)
-BASIS_CODE = {"mpm": POINT, "gimp": GIMP, "bspline": BSPLINE, "bspline_gimp": BSPLINE_GIMP}
-DOMAIN_BASES = (GIMP, BSPLINE_GIMP)
-# the particle-domain basis each basis averages over in the grid volume reset (a point basis: its domain twin)
-DOMAIN_OF = {POINT: GIMP, GIMP: GIMP, BSPLINE: BSPLINE_GIMP, BSPLINE_GIMP: BSPLINE_GIMP}
-# nodes per particle a basis starts with (GIMP and its B-spline widen when a domain spans more cells)
-WIDTH_OF = {POINT: 2, GIMP: 3, BSPLINE: 4, BSPLINE_GIMP: 5}
 
 # the update schemes
 USL, USF, MUSL = range(3)

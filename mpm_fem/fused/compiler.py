@@ -2,21 +2,30 @@
 
 A pass is written once, reading a few module globals in capitals; a variant is the same code with
 those globals replaced by constants (:func:`_compile`), so that numba prunes the branches of the
-other bases, models, schemes and remedies before it compiles. Every replacement is named here:
+other models, schemes and remedies before it compiles, and a variant holds one basis's kernels and
+no other's. Every replacement is named here:
 
     global        replaced with                                             in the variants of
-    BASIS         the basis code (codes.POINT, GIMP, BSPLINE, BSPLINE_GIMP)  every pass but _update_exact; the loop
+    BASIS         a registered basis (:func:`mpm_fem.bases.get`), which     every pass but _update_exact; the loop
+                  gives the globals below; the passes read only those
+    ROW, SHAPE_ROW, PROJECT_RUN, MOVE_RUN
+                  the basis's kernels ``pass_row``, ``row``, ``project``,   every variant with BASIS
+                  ``move`` (:class:`mpm_fem.bases.contract.Kernels`)
+    STORED        1 if the basis's rows are pass 1's stored ones (a         every variant with BASIS
+                  particle-domain basis), else 0
+    REGISTERS     1 if the basis has ``move`` (pass 2's sums in registers)  every variant with BASIS
+    ANY_GRID      1 if its ``project``, ``move`` serve any grid, else 0     every variant with BASIS
+                  (then only a grid uniform to round-off)
+    TWIN_ROW, TWIN_SCALARS, TWIN_COLUMN
+                  the kernels ``row``, ``scalars``, ``column`` of the       every variant with BASIS
+                  basis's ``domain_twin``: the rows the volume reset
+                  averages over
     MODEL         the model code (codes.GAS, BURGERS)                       _update, _move, _finish, _taylor_force,
                                                                             _volume_reset, _update_exact; the loop
     WIDTH         K, the nodes per particle (a row's length)                _project, _scatter_pass, _update, _move,
                                                                             _finish, _taylor_force, _move_exact;
                                                                             the loop
     WEIGHT        codes.PRESSURE, VISCOUS_STRESS or MOMENTUM                _scatter_pass
-    ROW           basis._stored_row for the particle-domain bases (pass     every variant with BASIS
-                  1's rows read back), basis._recomputed_row for the point
-                  bases (recomputed: the same numbers, and cheaper)
-    DOMAIN        codes.DOMAIN_OF[BASIS]: the particle-domain basis the     every variant with BASIS
-                  volume reset averages over
     SCHEME        codes.USL, USF or MUSL                                    the loop
     XPIC_ON,      0 or 1: whether the loop runs XPIC, the grid volume       the loop
     VOLUME_ON,    reset, the Taylor force
@@ -26,11 +35,14 @@ other bases, models, schemes and remedies before it compiles. Every replacement 
                   WIDTH (:meth:`_Passes._loop_passes`), ``None`` where its
                   run takes none (the branch calling it is pruned)
 
-``CONSTANTS`` lists the constants each function's variants take, and :func:`_compile` refuses a
-variant that would leave a global it reads unreplaced: the modules define these names only as
-``None`` placeholders. Each variant is named by its constants and a digest of the package's sources
-(:data:`SOURCES`), which keeps numba's on-disk caches apart: numba checks only the stamp of the
-variant's own file, not of the files whose helpers it inlines.
+A basis reaches a variant only as a registered :class:`~mpm_fem.bases.contract.Basis` (checked
+complete when registered): :func:`_basis_globals` refuses anything else, so an unknown basis is
+never compiled into another basis's arithmetic. ``CONSTANTS`` lists the constants each function's
+variants take, and :func:`_compile` refuses a variant that would leave a global it reads unreplaced:
+the modules define these names only as ``None`` placeholders. Each variant is named by its constants
+and a digest of the package's sources (:data:`SOURCES`: this package and the bases'), which keeps
+numba's on-disk caches apart: numba checks only the stamp of the variant's own file, not of the
+files whose helpers it inlines.
 """
 
 import hashlib
@@ -40,17 +52,19 @@ from pathlib import Path
 
 from numba import njit
 
-from mpm_fem.exact_stages.grid_kernels import locate
-from mpm_fem.fused.basis import _recomputed_row, _stored_row
-from mpm_fem.fused.codes import BURGERS, DOMAIN_BASES, DOMAIN_OF, GAS, MOMENTUM, MUSL, PRESSURE, USF, VISCOUS_STRESS
+import mpm_fem.bases as bases
+from mpm_fem.bases import Basis, get, names
+from mpm_fem.fused.codes import BURGERS, GAS, MOMENTUM, MUSL, PRESSURE, USF, VISCOUS_STRESS
 from mpm_fem.fused.loop import _advance
 from mpm_fem.fused.passes import _finish, _move, _move_exact, _scatter_pass, _update, _update_exact
 from mpm_fem.fused.project import _project
 from mpm_fem.fused.remedies import _taylor_force, _volume_reset
 
 LOOP_PASSES = ("PROJECT", "MOVE", "UPDATE", "FINISH", "VISCOUS", "GAS_FORCE", "XPIC", "VOLUME", "TAYLOR")
-REPLACED = frozenset(("BASIS", "MODEL", "WIDTH", "WEIGHT", "ROW", "DOMAIN", "SCHEME", "XPIC_ON", "VOLUME_ON",
-                      "TAYLOR_ON") + LOOP_PASSES)
+BASIS_GLOBALS = ("ROW", "SHAPE_ROW", "PROJECT_RUN", "MOVE_RUN", "STORED", "REGISTERS", "ANY_GRID", "TWIN_ROW",
+                 "TWIN_SCALARS", "TWIN_COLUMN")
+REPLACED = frozenset(("BASIS", "MODEL", "WIDTH", "WEIGHT", "SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON")
+                     + BASIS_GLOBALS + LOOP_PASSES)
 _SHAPE = ("BASIS", "WIDTH")
 _MODEL = ("BASIS", "MODEL", "WIDTH")
 CONSTANTS = {  # the constants of each function's variants (the keywords of _Passes.get)
@@ -65,17 +79,23 @@ CONSTANTS = {  # the constants of each function's variants (the keywords of _Pas
     _update_exact: ("MODEL",),
     _advance: _MODEL + ("SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON"),
 }
-# the files whose code a variant compiles (inlined helpers included): this package and the located cell
-SOURCES = sorted(Path(__file__).parent.glob("*.py")) + [Path(inspect.getsourcefile(locate.py_func))]
+# the files whose code a variant compiles (inlined helpers included): this package and the bases
+SOURCES = sorted(Path(__file__).parent.glob("*.py")) + sorted(Path(inspect.getsourcefile(bases)).parent.glob("*.py"))
 DIGEST = hashlib.sha1(b"".join(path.read_bytes() for path in SOURCES)).hexdigest()[:8]
 
 
 def _basis_globals(constants):
-    """``ROW`` and ``DOMAIN`` of a variant with ``BASIS`` (none without)."""
+    """The globals a variant with ``BASIS`` takes from its basis (module docstring; none without).
+    Raises ``ValueError`` for a ``BASIS`` that is not a registered basis."""
     if "BASIS" not in constants:
         return {}
     basis = constants["BASIS"]
-    return dict(ROW=_stored_row if basis in DOMAIN_BASES else _recomputed_row, DOMAIN=DOMAIN_OF[basis])
+    if not isinstance(basis, Basis) or basis.name not in names() or get(basis.name) is not basis:
+        raise ValueError(f"a variant takes a registered basis (mpm_fem.bases.get), not {basis!r}")
+    own, twin = basis.kernels, get(basis.domain_twin).kernels
+    return dict(ROW=own.pass_row, SHAPE_ROW=own.row, PROJECT_RUN=own.project, MOVE_RUN=own.move,
+                STORED=int(basis.domain), REGISTERS=int(own.move is not None), ANY_GRID=int(own.any_grid),
+                TWIN_ROW=twin.row, TWIN_SCALARS=twin.scalars, TWIN_COLUMN=twin.column)
 
 
 def _compile(fn, parallel, passes=None, **constants):
@@ -86,7 +106,8 @@ def _compile(fn, parallel, passes=None, **constants):
     unset = REPLACED.intersection(fn.__code__.co_names).difference(replaced)
     if unset:
         raise ValueError(f"{fn.__name__} reads {', '.join(sorted(unset))}, which its variant does not replace")
-    suffix = "".join(f"_{k.lower()}{v}" for k, v in constants.items()) + ("_parallel" if parallel else "")
+    suffix = "".join(f"_{k.lower()}{v.name if isinstance(v, Basis) else v}" for k, v in constants.items()) + (
+        "_parallel" if parallel else "")
     variant = types.FunctionType(fn.__code__, dict(fn.__globals__, **replaced), f"{fn.__name__}{suffix}_{DIGEST}",
                                  fn.__defaults__)
     variant.__qualname__ = variant.__name__

@@ -20,11 +20,9 @@ import numpy as np
 from numba import njit, objmode
 
 from mpm_fem.fused.codes import (
-    BSPLINE_GIMP,
     GA,
     GAS,
     GF,
-    GIMP,
     GM,
     GP,
     GPMUSL,
@@ -49,7 +47,7 @@ from mpm_fem.fused.codes import (
 from mpm_fem.fused.sums import _divide_by_lumped
 
 # placeholders: each variant has its own (mpm_fem.fused.compiler)
-BASIS = MODEL = WIDTH = SCHEME = XPIC_ON = VOLUME_ON = TAYLOR_ON = None
+STORED = MODEL = WIDTH = SCHEME = XPIC_ON = VOLUME_ON = TAYLOR_ON = None
 PROJECT = MOVE = UPDATE = FINISH = VISCOUS = GAS_FORCE = XPIC = VOLUME = TAYLOR = None
 
 class Geometry(NamedTuple):
@@ -207,7 +205,7 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     and ``state[1 - cur]`` (columns ``IX .. IP``: x, v, V, m, rho, eps, p; ``consts[IGM1 .. IXPIC]``
     the model's constants, ``chunks`` the particle ranges of the threads). Stops before a step that
     would fail or leave this path (the time step not positive and finite, ``max_steps``, a particle
-    outside the grid, a GIMP row of another width, lost positivity, a non-finite state): the caller
+    outside the grid, a stored row of another width, lost positivity, a non-finite state): the caller
     takes that step with :meth:`~mpm_fem.fused.step.FusedStep.step`, which raises as the numpy step does.
     With ``dirichlet`` the ends take :class:`~mpm_fem.core.step.Dirichlet`'s data instead of the walls'
     zeros (as its ``velocity`` and ``acceleration``: ``v_b = g(t)``, ``a_b = (g(t + dt) - v_b) / dt``,
@@ -231,7 +229,7 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     n = cell.size
     gas = MODEL == GAS
     eps = consts[IEPS]
-    store = BASIS == GIMP or BASIS == BSPLINE_GIMP
+    store = STORED == 1
     m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[GM], grid[GP], grid[GF], grid[GV], grid[GA], grid[GVN], grid[GPMUSL]
     done, dt_min, dt_max = 0, np.inf, -np.inf
     g_t, g_next, known = np.empty(0), np.empty(0), False  # Dirichlet data at t and t + dt

@@ -11,31 +11,23 @@ checks; the PIC/FLIP blend and XPIC replace the velocity's update, MUSL re-proje
 before the force (:func:`_update`); :func:`_scatter_pass` makes the forces that need a pass of their
 own (Burgers' viscous stress, the gas force of a reset volume) and XPIC's momentum. With the exact
 interpolation, :func:`_move_exact` and :func:`_update_exact` take pass 2's place. Every sum is taken
-in the numpy step's order (:mod:`mpm_fem.fused.sums`). ``BASIS``, ``MODEL``, ``WIDTH``, ``WEIGHT`` and
-``ROW`` are compile-time globals of each variant (:mod:`mpm_fem.fused.compiler`).
+in the numpy step's order (:mod:`mpm_fem.fused.sums`). ``MODEL``, ``WIDTH``, ``WEIGHT`` and the
+basis's pieces are compile-time globals of each variant (:mod:`mpm_fem.fused.compiler`): ``ROW``
+(a particle's row after pass 1, :class:`mpm_fem.bases.contract.Kernels`' ``pass_row``), ``STORED``
+(1: the basis's rows are pass 1's stored ones, read in place), ``REGISTERS`` (1: the basis gives
+pass 2's sums with its row in registers, ``MOVE_RUN``) and ``ANY_GRID`` (that function serves any
+grid, else a grid uniform to round-off).
 """
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
-from mpm_fem.fused.basis import _bspline_nearest, _point, _scaled
-from mpm_fem.fused.codes import (
-    BSPLINE,
-    BSPLINE_GIMP,
-    GAS,
-    GIMP,
-    IEPS,
-    IFLIP,
-    IGGM1,
-    IXPIC,
-    POINT,
-    PRESSURE,
-    VISCOUS_STRESS,
-)
+from mpm_fem.fused.codes import GAS, IEPS, IFLIP, IGGM1, IXPIC, PRESSURE, VISCOUS_STRESS
 from mpm_fem.fused.models import _NO_TALLY, _checked, _flags, _new_state
 from mpm_fem.fused.sums import _chunk, _gather, _gather_stored, _one_row, _scatter, _scatter_stored, _sum_chunks
 
-BASIS = MODEL = WIDTH = WEIGHT = ROW = None  # placeholders: each variant has its own (mpm_fem.fused.compiler)
+# placeholders: each variant has its own (mpm_fem.fused.compiler)
+MODEL = WIDTH = WEIGHT = ROW = STORED = REGISTERS = ANY_GRID = MOVE_RUN = None
 
 
 def _scatter_pass(nodes, h, inv_spacing, x, rows, S, G, cell, f_i, a, b, coef, chunks, out):
@@ -56,8 +48,8 @@ def _scatter_pass(nodes, h, inv_spacing, x, rows, S, G, cell, f_i, a, b, coef, c
     for k in prange(chunks):
         r, Sl, Gl = _one_row(K)
         for q in range(*_chunk(n, chunks, k)):
-            # the domain bases: pass 1's stored row read in place (the same sums as a copy into the row scratch)
-            if BASIS == GIMP or BASIS == BSPLINE_GIMP:
+            # stored rows: pass 1's row read in place (the same sums as a copy into the row scratch)
+            if STORED == 1:
                 if WEIGHT == PRESSURE:
                     _scatter_stored(buf, k, rows, q, G, a[q] * b[q], K)
                 elif WEIGHT == VISCOUS_STRESS:
@@ -65,7 +57,7 @@ def _scatter_pass(nodes, h, inv_spacing, x, rows, S, G, cell, f_i, a, b, coef, c
                 else:
                     _scatter_stored(buf, k, rows, q, S, a[q] * _gather_stored(S, q, f_i, rows, K), K)
                 continue
-            ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             if WEIGHT == PRESSURE:
                 _scatter(buf, k, r, Gl, a[q] * b[q], K)
             elif WEIGHT == VISCOUS_STRESS:
@@ -88,7 +80,7 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
         tally = _NO_TALLY
         r, Sl, Gl = _one_row(K)
         for q in range(*_chunk(n, chunks, k)):
-            c = ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            c = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             L = _gather(Gl, v_i, r, K)
             tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts,
                                tally)
@@ -97,41 +89,6 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
         _flags(k, tally, flags, values)
     if force:
         _sum_chunks(buf, 0, F_i, 1.0)
-
-
-@njit(cache=True, inline="always")
-def _move_point(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, gas, lo, hi,
-                x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally):
-    """Pass 2 of the point mass, USL, over particles ``lo .. hi-1``: :func:`_move`'s arithmetic with
-    the row ``(c, c + 1)``, ``(1 - xi, xi)``, ``(-1, 1)/h_c`` held in registers. Returns the tally."""
-    for q in range(lo, hi):
-        c, xi, inv_h = _point(nodes, h, inv_spacing, x[q])
-        S0 = 1.0 - xi
-        v_new[q] = v[q] + dt * (S0 * a_i[c] + xi * a_i[c + 1])
-        x_new[q] = x[q] + dt * (S0 * v_n[c] + xi * v_n[c + 1])
-        L = -inv_h * v_n[c] + inv_h * v_n[c + 1]
-        tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, tally)
-        tally = _checked(gas, q, tally[6], x_new, v_new, rho_new, e_new, p_new, V_new, tally)
-    return tally
-
-
-@njit(cache=True, inline="always")
-def _move_bspline(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, gas, lo, hi,
-                  x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally):
-    """Pass 2 of the B-spline on a uniform grid, USL, over particles ``lo .. hi-1``: :func:`_move`'s
-    arithmetic with the row of :func:`~mpm_fem.fused.basis._bspline_nearest` in registers. Returns the tally."""
-    top = nodes.size - 1
-    for q in range(lo, hi):
-        s, c = _scaled(nodes, inv_spacing, x[q])
-        n, t, w_l, w_0, w_r = _bspline_nearest(s, top)
-        i_l, i_r = max(n - 1, 0), min(n + 1, top)
-        v_new[q] = v[q] + dt * (w_l * a_i[i_l] + w_0 * a_i[n] + w_r * a_i[i_r])
-        x_new[q] = x[q] + dt * (w_l * v_n[i_l] + w_0 * v_n[n] + w_r * v_n[i_r])
-        L = ((t - 0.5) * inv_spacing) * v_n[i_l] + ((-2.0 * t) * inv_spacing) * v_n[n] \
-            + ((t + 0.5) * inv_spacing) * v_n[i_r]
-        tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, tally)
-        tally = _checked(gas, q, tally[6], x_new, v_new, rho_new, e_new, p_new, V_new, tally)
-    return tally
 
 
 def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
@@ -152,19 +109,19 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
         tally = _NO_TALLY
         r, Sl, Gl = _one_row(K)
         lo, hi = _chunk(n, chunks, k)
-        if BASIS == POINT and usl and flip == 1.0 and not pic:  # point mass, USL, FLIP: its own loop, the row in
-            # registers (the loop below then skipped)
-            tally = _move_point(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, gas, lo, hi,
-                                x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally)
-            lo = hi
-        if BASIS == BSPLINE and inv_spacing > 0.0 and usl and flip == 1.0 and not pic:  # the B-spline on a uniform
-            # grid, likewise
-            tally = _move_bspline(nodes, h, inv_spacing, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, gas, lo, hi,
-                                  x_new, v_new, V_new, m_new, rho_new, e_new, p_new, tally)
-            lo = hi
+        if REGISTERS == 1:  # USL, FLIP: the basis's sums with the row in registers (the loop below then skipped)
+            if (ANY_GRID == 1 or inv_spacing > 0.0) and usl and flip == 1.0 and not pic:
+                for q in range(lo, hi):
+                    c, acc, vel, L = MOVE_RUN(nodes, h, inv_spacing, x[q], a_i, v_n)
+                    v_new[q] = v[q] + dt * acc
+                    x_new[q] = x[q] + dt * vel
+                    tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new,
+                                       consts, tally)
+                    tally = _checked(gas, q, tally[6], x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+                lo = hi
         for q in range(lo, hi):
-            # the domain bases: pass 1's stored row read in place, and USL's L_p (_gather's sum) in the same loop
-            if BASIS == GIMP or BASIS == BSPLINE_GIMP:
+            # stored rows: pass 1's row read in place, and USL's L_p (_gather's sum) in the same loop
+            if STORED == 1:
                 cq = cell[q]
                 i = rows[q, 0]
                 acc, vel, L = S[q, 0] * a_i[i], S[q, 0] * v_n[i], G[q, 0] * v_n[i]
@@ -174,7 +131,7 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
                     vel += S[q, j] * v_n[i]
                     L += G[q, j] * v_n[i]
             else:
-                cq = ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+                cq = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
                 acc = Sl[0] * a_i[r[0]]
                 vel = Sl[0] * v_n[r[0]]
                 for j in range(1, K):
@@ -188,13 +145,13 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
                     v_new[q] = flip * v_new[q] + (1.0 - flip) * vel
             x_new[q] = x[q] + dt * vel
             if musl:
-                if BASIS == GIMP or BASIS == BSPLINE_GIMP:
+                if STORED == 1:
                     _scatter_stored(buf, k, rows, q, S, m[q] * v_new[q], K)
                 else:
                     _scatter(buf, k, r, Sl, m[q] * v_new[q], K)
                 continue
             if usl:
-                if BASIS != GIMP and BASIS != BSPLINE_GIMP:
+                if STORED == 0:
                     L = _gather(Gl, v_n, r, K)
                 tally = _new_state(gas, q, L, dt, h[0, cq], V, m, rho, e, p,
                                    V_new, m_new, rho_new, e_new, p_new, consts, tally)
@@ -218,7 +175,7 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
         r, Sl, Gl = _one_row(K)
         tally = _NO_TALLY
         for q in range(*_chunk(n, chunks, k)):
-            cq = ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            cq = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[0, cq], V, m, rho, e, p,
                                V_new, m_new, rho_new, e_new, p_new, consts, tally)
             tally = _checked(gas, q, tally[6], x_new, v, rho_new, e_new, p_new, V_new, tally)
@@ -239,7 +196,7 @@ def _move_exact(nodes, h, inv_spacing, rows, S, G, cell, a_c, v_c, p_v, p_a, x, 
     for k in prange(chunks):
         r, Sl, Gl = _one_row(K)
         for q in range(*_chunk(n, chunks, k)):
-            ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+            ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             acc = p_a[q] + _gather(Sl, a_c, r, K)
             moving = p_v[q] + dt * p_a[q] + _gather(Sl, v_c, r, K)
             v_new[q] = v[q] + dt * acc

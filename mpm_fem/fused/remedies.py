@@ -8,16 +8,17 @@ and the force of the fit by quadrature. Both in the numpy step's operations and 
 remedies live in the passes they change: the PIC/FLIP blend and XPIC's interpolation in pass 2
 (:func:`mpm_fem.fused.passes._move`), XPIC's projections in the scatter pass
 (:func:`mpm_fem.fused.passes._scatter_pass` with ``MOMENTUM``) and the loop's XPIC iteration
-(:mod:`mpm_fem.fused.loop`). ``BASIS``, ``MODEL``, ``WIDTH``, ``ROW`` and ``DOMAIN`` are compile-time
-globals of each variant (:mod:`mpm_fem.fused.compiler`).
+(:mod:`mpm_fem.fused.loop`). ``MODEL``, ``WIDTH``, ``ROW``, ``STORED`` and the twin's kernels
+``TWIN_ROW``, ``TWIN_SCALARS``, ``TWIN_COLUMN`` (the particle-domain basis the volume reset
+averages over, the basis's ``domain_twin``) are compile-time globals of each variant
+(:mod:`mpm_fem.fused.compiler`).
 """
 
 import numpy as np
 from numba import prange
 
-from mpm_fem.exact_stages.grid_kernels import locate as _locate
-from mpm_fem.fused.basis import _domain, _domain_column, _domain_shape_row
-from mpm_fem.fused.codes import BSPLINE_GIMP, GAS, GIMP, IGM1
+from mpm_fem.bases.cells import locate as _locate
+from mpm_fem.fused.codes import GAS, IGM1
 from mpm_fem.fused.models import _first
 from mpm_fem.fused.sums import (
     _chunk,
@@ -30,7 +31,8 @@ from mpm_fem.fused.sums import (
     _sum_chunks,
 )
 
-BASIS = MODEL = WIDTH = ROW = DOMAIN = None  # placeholders: each variant has its own (mpm_fem.fused.compiler)
+# placeholders: each variant has its own (mpm_fem.fused.compiler)
+MODEL = WIDTH = ROW = STORED = TWIN_ROW = TWIN_SCALARS = TWIN_COLUMN = None
 
 
 def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks, width,
@@ -45,29 +47,29 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
     ``values[k, 0]`` that density or volume."""
     n = x.size
     gas = MODEL == GAS
-    # Sbar_ip: the step's stored rows (the domain bases), or the rows of DOMAIN (the point bases: GIMP
-    # for the point mass, the particle-domain B-spline for the B-spline), on a uniform grid from
-    # scalars as pass 1 of those bases builds them. The basis is tested in the loop, on the
-    # compile-time constants: flags set in branches before a prange loop (`fresh = ... and ...`)
-    # gave NaN particles in a parallel variant called by the loop (numba 0.68.1). The scalar rows
-    # are written out here because an inlined helper handed `buf` or `ratio` costs reference counting
+    # Sbar_ip: the step's stored rows (a particle-domain basis), or the rows of its twin (a point
+    # basis: the particle-domain basis over its grid functions), on a uniform grid from scalars as
+    # pass 1 of the twin builds them. The basis is tested in the loop, on the compile-time
+    # constants: flags set in branches before a prange loop (`fresh = ... and ...`) gave NaN
+    # particles in a parallel variant called by the loop (numba 0.68.1). The scalar rows are
+    # written out here because an inlined helper handed `buf` or `ratio` costs reference counting
     a, b, last = nodes[0], nodes[nodes.size - 1], nodes.size - 1
     buf = np.zeros((chunks, 1, V_i.size))
     for k in prange(chunks):
         r, Sl, Gl = _one_row(width)
         need = 0
         for q in range(*_chunk(n, chunks, k)):
-            if BASIS == GIMP or BASIS == BSPLINE_GIMP:  # the step's own rows, read where they lie
+            if STORED == 1:  # the step's own rows, read where they lie
                 need = width
                 _scatter_stored(buf, k, rows, q, S, V[q], width)
             elif inv_spacing > 0.0:
-                D = _domain(DOMAIN, a, b, last - 1, inv_spacing, x[q], V[q])
+                D = TWIN_SCALARS(a, b, last - 1, inv_spacing, x[q], V[q])
                 need = max(need, D[1])
                 for j in range(width):
-                    i, s, _ = _domain_column(DOMAIN, j, inv_spacing, last, D)
+                    i, s, _ = TWIN_COLUMN(j, inv_spacing, last, D)
                     buf[k, 0, i] += s * V[q]
             else:
-                need = max(need, _domain_shape_row(DOMAIN, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)[1])
+                need = max(need, TWIN_ROW(nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)[1])
                 _scatter(buf, k, r, Sl, V[q], width)
         flags[k, 1] = need
     _sum_chunks(buf, 0, V_i, 1.0)
@@ -77,17 +79,17 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
         r, Sl, Gl = _one_row(width)
         bad, value = -1.0, 0.0
         for q in range(*_chunk(n, chunks, k)):
-            if BASIS == GIMP or BASIS == BSPLINE_GIMP:
+            if STORED == 1:
                 V_r[q] = V[q] * _gather_stored(S, q, ratio, rows, width)
             elif inv_spacing > 0.0:  # sum_j Sbar_qj ratio_j, left to right (_gather's order)
-                D = _domain(DOMAIN, a, b, last - 1, inv_spacing, x[q], V[q])
+                D = TWIN_SCALARS(a, b, last - 1, inv_spacing, x[q], V[q])
                 f = 0.0
                 for j in range(width):
-                    i, s, _ = _domain_column(DOMAIN, j, inv_spacing, last, D)
+                    i, s, _ = TWIN_COLUMN(j, inv_spacing, last, D)
                     f = s * ratio[i] if j == 0 else f + s * ratio[i]
                 V_r[q] = V[q] * f
             else:
-                _domain_shape_row(DOMAIN, nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
+                TWIN_ROW(nodes, h, inv_spacing, x[q], V[q], r, Sl, Gl)
                 V_r[q] = V[q] * _gather(Sl, ratio, r, width)
             if gas:
                 rho_r[q] = m[q] / V_r[q]
@@ -119,7 +121,7 @@ def _taylor_force(nodes, h, inv_spacing, x, rows, S, G, cell, p, v_i, eps, point
             if gas:
                 sigma = -p[q]
             else:
-                ROW(BASIS, nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+                ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
                 sigma = eps * _gather(Gl, v_i, r, K)
             c, xi = _locate(nodes, inv_spacing, x[q])
             d = xi - 0.5

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mpm_fem.bases import get
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
@@ -31,10 +32,7 @@ from mpm_fem.core.transfer import solve_consistent
 from mpm_fem.core.xpic import boundary_change_rule
 from mpm_fem.exact_stages import ExactFields, ExactGridStage, GridData
 from mpm_fem.fused.codes import (
-    BASIS_CODE,
     BURGERS,
-    DOMAIN_BASES,
-    DOMAIN_OF,
     FIELDS,
     GAS,
     IEPS,
@@ -48,7 +46,6 @@ from mpm_fem.fused.codes import (
     PRESSURE,
     SCHEME_CODE,
     VISCOUS_STRESS,
-    WIDTH_OF,
 )
 from mpm_fem.fused.compiler import PASSES
 from mpm_fem.fused.loop import _LOOP_CALLS, Clock, Conditions, Geometry, Remedies, Scratch, _advance, _nodal_rows
@@ -87,7 +84,7 @@ def check_kernel(kernel: str, threads: int) -> None:
 def _uniform_to_round_off(grid: Grid) -> bool:
     """Whether the grid is uniform (``grid.uniform_spacing``) and its nodes lie within ``1e-9 h`` of
     ``x_0 + i h`` (a ``linspace``): then the uniform-grid arithmetic of every basis
-    (:func:`~mpm_fem.fused.basis._point`, :func:`~mpm_fem.fused.basis._scaled`) agrees with the node
+    (the bases' compiled rows, :class:`mpm_fem.bases.contract.Kernels`) agrees with the node
     arithmetic to round-off. A grid uniform only to ``grid.uniform_spacing``'s 1e-6 takes the node
     arithmetic (and bisection to locate the particles, in every basis)."""
     h = grid.uniform_spacing
@@ -123,10 +120,9 @@ class FusedStep:
         self.threads = int(threads)
         passes = PASSES[self.threads > 1]
         self.kind = GAS if isinstance(model, IdealGas) else BURGERS
-        self.basis = BASIS_CODE[stages.basis]
+        self.basis = get(stages.basis)  # the registered basis: its kernels are the variants' globals
         self._passes = passes
-        if stages.basis in ("bspline", "bspline_gimp"):
-            make_shape(grid, grid.nodes[:1], basis="bspline")  # raises on a non-uniform grid
+        self.basis.check_grid(grid)
         self.nodes = np.ascontiguousarray(grid.nodes, dtype=float)
         self.h = np.ascontiguousarray([grid.h, 1.0 / grid.h], dtype=float)  # h_c and 1/h_c: read, not divided
         self.inv_spacing = 1.0 / grid.uniform_spacing if _uniform_to_round_off(grid) else 0.0
@@ -139,7 +135,7 @@ class FusedStep:
             self.consts[IEPS] = model.eps
         self.consts[IFLIP], self.consts[IXPIC] = float(stages.flip), float(stages.xpic)
         self.slides = self.kind == BURGERS and getattr(model, "force", "weak") == "slides"
-        self._width(WIDTH_OF[self.basis])
+        self._width(self.basis.width)
         self.speed, self.finite = np.nan, True
         # advance's tables: the last call's steady dt, the tables, the dt and the rows ahead they were built with
         self._steady_dt, self._table = None, (np.empty(0), np.empty((0, 0)), np.empty((0, 0)))
@@ -153,7 +149,7 @@ class FusedStep:
         self._h_min = float(grid.h.min())
         self.integrals = (np.ascontiguousarray(basis_integrals(grid, stages.basis), dtype=float)
                           if stages.volume == "grid" else np.empty(0))  # the volume reset: int S_i
-        self.volume_width = WIDTH_OF[DOMAIN_OF[self.basis]]  # the volume reset's domain rows
+        self.volume_width = get(self.basis.domain_twin).width  # the volume reset's domain rows
         self.quadrature = (np.empty((0, 2), np.intp), np.empty((0, 2)), np.empty(0), np.empty(0))
         if stages.reconstruct == "taylor":  # the reconstructed force's points: their nodes, S_i', weights
             points, weights = force_quadrature(grid, stages.basis)
@@ -161,7 +157,8 @@ class FusedStep:
                                np.ascontiguousarray(weights), np.ascontiguousarray(OFFSETS))
 
     def _width(self, K):
-        """Use the passes compiled for K nodes per particle (GIMP: 2 + the cells a domain spans)."""
+        """Use the passes compiled for K nodes per particle (a particle-domain basis widens its rows
+        as a domain spans more cells)."""
         self.K = K
         constants = dict(BASIS=self.basis, MODEL=self.kind, WIDTH=K)
         self.project = self._passes.get(_project, BASIS=self.basis, WIDTH=K)
@@ -218,7 +215,7 @@ class FusedStep:
         :meth:`step` takes with the time step :func:`mpm_fem.core.solve.run` takes after its first step
         (from :attr:`speed`): the same numbers bit for bit. Returns ``(particles, t, steps taken,
         dt_min, dt_max)``; zero steps when the next step must go through :meth:`step` (it fails, or
-        a GIMP particle's row changes width)."""
+        a stored row changes width)."""
         n, chunks = particles.n, max(1, min(self.threads, particles.n))
         spare = (lambda k: k // 16) if problem.particle_boundary is not None else (lambda k: 0)  # a reservoir's inflow
         if self._out is not particles or self._state.shape[2] < n + _PAD:
@@ -230,7 +227,7 @@ class FusedStep:
                 self._state[:, j, :n] = getattr(particles, name)
             self._pools = ({}, {})  # the per-step arrays: refilled if a step falls back to step()
             self._cur = 0
-        rows_n = n if self.basis in DOMAIN_BASES else 0
+        rows_n = n if self.basis.domain else 0
         volume, taylor = self.stages.volume == "grid", self.stages.reconstruct == "taylor"
         kept = self._scratch
         if (kept is None or kept.cell.size < n or kept.rows.shape[0] < rows_n or kept.rows.shape[1] != self.K
@@ -317,7 +314,7 @@ class FusedStep:
         V_i, ratio = self._empty("V_i", n_nodes), self._empty("ratio", n_nodes)
         flags, values = np.empty((chunks, 2), np.int64), np.zeros((chunks, 2))
         while True:
-            width = self.K if self.basis in DOMAIN_BASES else self.volume_width
+            width = self.K if self.basis.domain else self.volume_width
             reset(*geometry, x, rows, S, V, m, rho, e, p, self.integrals, self.consts, chunks, width,
                   V_i, ratio, V_r, rho_r, p_r, flags, values)
             need = int(flags[:, 1].max(initial=0))
@@ -347,11 +344,11 @@ class FusedStep:
 
     def _pass1(self, particles: Particles, gas_force: bool, store: bool, chunks: int):
         """Pass 1 (:func:`~mpm_fem.fused.project._project`): ``(shape, m_i, P_i, F_i, flags)``, the rows in ``shape`` if
-        ``store`` (the domain bases store theirs always), the cells always; raises the numpy step's
+        ``store`` (the particle-domain bases store theirs always), the cells always; raises the numpy step's
         error for a particle outside the grid or without volume."""
         grid, n = self.grid, particles.n
         x, V, m, v, p = particles.x, particles.volume, particles.mass, particles.velocity, particles.pressure
-        store = store or self.basis in DOMAIN_BASES
+        store = store or self.basis.domain
         n_nodes = grid.n_nodes
         empty = self._empty
         m_i, P_i, F_i = empty("m_i", n_nodes), empty("P_i", n_nodes), empty("F_i", n_nodes)
@@ -367,9 +364,9 @@ class FusedStep:
                 make_shape(grid, x, V, self.stages.basis)  # raises the numpy step's error
                 raise ValueError("a particle lies outside the grid or has no volume")  # not reached
             need = int(flags[:, 2].max(initial=2))
-            if self.basis not in DOMAIN_BASES or need == self.K or n == 0:
+            if not self.basis.domain or need == self.K or n == 0:
                 break
-            self._width(need)  # GIMP: a particle domain spans another cell; redo with the wider rows
+            self._width(need)  # a particle domain spans another cell; redo with the wider rows
         return Shape(rows, S, G, n_nodes, cell), m_i, P_i, F_i, flags
 
     def step(self, particles: Particles, t: float, dt: float) -> tuple[Particles, GridState]:
@@ -465,7 +462,7 @@ class FusedStep:
         self._turn = 1 - self._turn
         empty = self._empty
         interpolate = self.stages.interpolation == "exact"
-        shape, m_i, P_i, F_i, flags = self._pass1(particles, self.stages.projection == "mpm", False, chunks)
+        shape, m_i, P_i, F_i, flags = self._pass1(particles, self.stages.projection != "exact", False, chunks)
         stage = ExactGridStage(self.grid, self.boundary, self.stages, self.exact, GridData(shape, m, m_i, P_i), t, dt)
         a_i = stage.acceleration(F_i)
         v_n = stage.v_i + dt * a_i
