@@ -37,10 +37,10 @@ from anchor import Anchor  # benchmarks/anchor.py, beside this script
 from mpm_fem.app.output import tee_markdown
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
-from mpm_fem.core.solve import Problem
 from mpm_fem.core.step import Stages, Walls, explicit_step
 from mpm_fem.fused.step import FusedStep
 from mpm_fem.problems.sod import SodSettings, initial_particles
+from mpm_fem.run.solve import Problem
 
 BASES = ("mpm", "gimp", "bspline", "bspline_gimp")
 # particle-steps/s of the fused loop at 1e6 particles, one thread (uniform-grid arithmetic in every basis)
