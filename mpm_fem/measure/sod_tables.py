@@ -33,7 +33,14 @@ def error(r: dict, field: str = "density", where: str = "nodes", norm: str = "L1
 
 
 def _settings(runs: dict) -> list[tuple]:
-    return list(dict.fromkeys(key[:2] for key in runs))
+    """The settings ``(ppc, cfl)`` of ``runs`` (``{(ppc, cfl, h): run}``), in their order."""
+    return list(dict.fromkeys((n, cfl) for n, cfl, _ in runs))
+
+
+def _seed_order(run: tuple) -> tuple:
+    """The order of the seeds table: by decreasing ppc, by CFL, by decreasing h, by seed."""
+    (n, cfl, h, _, seed), _ = run
+    return -n, cfl, -h, seed
 
 
 def seed_rows(regular: dict, jittered: dict) -> list[dict]:
@@ -41,7 +48,7 @@ def seed_rows(regular: dict, jittered: dict) -> list[dict]:
     runs = [((n, cfl, h, "regular", 0), r) for (n, cfl, h), r in regular.items()]
     runs += [((n, cfl, h, "jittered", seed), r) for (n, cfl, h, seed), r in jittered.items()]
     rows = []
-    for (n, cfl, h, layout, seed), r in sorted(runs, key=lambda kv: (-kv[0][0], kv[0][1], -kv[0][2], kv[0][4])):
+    for (n, cfl, h, layout, seed), r in sorted(runs, key=_seed_order):
         rows.append({"h": h, "ppc": n, "cfl": cfl, "layout": layout, "seed": seed, "ok": bool(r.get("ok")),
                      **{k: error(r, *where) for k, where in SEED_ERRORS.items()},
                      "volume_drift": r.get("volume_drift", math.nan), "steps": r.get("steps"),
