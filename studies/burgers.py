@@ -257,14 +257,22 @@ def run(options: StudyOptions) -> None:
 
 #: Each method's marker and line, and its colour in every figure; a second grouping of the curves (the
 #: mesh, eps, mass) is drawn in the line styles of LINES, the colour kept.
-STYLE = {"mpm_calculated": ("o-", "tab:blue"), "mpm_calculated_8": ("o-.", "tab:cyan"),
-         "mpm_calculated_16": ("o--", "tab:purple"), "mpm_exact": ("s-", "tab:orange"),
-         "mpm_exact_dt_h": ("D-", "tab:red"), "fem_consistent": ("^--", "tab:green"),
-         "fem_lumped": ("v--", "tab:olive")}
+class Style(NamedTuple):
+    """A method's curves: matplotlib's format (marker and line) and colour."""
+
+    fmt: str
+    color: str
+
+
+STYLE = {"mpm_calculated": Style("o-", "tab:blue"), "mpm_calculated_8": Style("o-.", "tab:cyan"),
+         "mpm_calculated_16": Style("o--", "tab:purple"), "mpm_exact": Style("s-", "tab:orange"),
+         "mpm_exact_dt_h": Style("D-", "tab:red"), "fem_consistent": Style("^--", "tab:green"),
+         "fem_lumped": Style("v--", "tab:olive")}
 LINES = ("-", "--", ":")
 #: The diagnosis' variants' colours: a method's for the variant that is one (the first, the last two).
-_VARIANT_COLOURS = dict(zip(DIAGNOSIS, (STYLE["mpm_calculated"][1], "tab:brown", "tab:pink", "tab:gray", "black",
-                                        "gold", STYLE["mpm_calculated_16"][1], STYLE["mpm_exact"][1]), strict=True))
+_VARIANT_COLOURS = dict(zip(DIAGNOSIS, (STYLE["mpm_calculated"].color, "tab:brown", "tab:pink", "tab:gray", "black",
+                                        "gold", STYLE["mpm_calculated_16"].color, STYLE["mpm_exact"].color),
+                             strict=True))
 
 
 def _y(m: str) -> str:
@@ -277,8 +285,8 @@ def _curves(methods, label="{m}", y=None, by="", values=(), **where) -> tuple[Cu
     ``by`` in ``values`` (``{v}`` in ``label``) in the line styles of :data:`LINES`; ``y`` defaults to
     the compared error."""
     return tuple(Curve(label.format(m=METHODS[m].label, v=v), y or _y(m),
-                       STYLE[m][0] if not by else STYLE[m][0][0] + LINES[k % len(LINES)],
-                       {**where, "method": m, **({by: v} if by else {})}, options={"color": STYLE[m][1]})
+                       STYLE[m].fmt if not by else STYLE[m].fmt[0] + LINES[k % len(LINES)],
+                       {**where, "method": m, **({by: v} if by else {})}, options={"color": STYLE[m].color})
                  for m in methods for k, v in enumerate(values or ("",)))
 
 
@@ -294,14 +302,14 @@ def _range(m: str, labels=("_{m} mean", "_{m} lo", "_{m} hi"), panel: str = "", 
     """The mean (crosses) and the least and largest (dotted) compared error over the runs of seeded
     ``m``, labelled ``labels`` (``{m}``: its name; a label from ``_`` stays out of the legend)."""
     return tuple(Curve(label.format(m=METHODS[m].label), f"{_y(m)}_{k}", fmt, {**where, "method": m}, panel,
-                       options={"color": STYLE[m][1], "lw": 0.8})
+                       options={"color": STYLE[m].color, "lw": 0.8})
                  for label, k, fmt in zip(labels, ("mean", "lo", "hi"), ("+", ":", ":"), strict=True))
 
 
 def _seed_panel(m: str) -> tuple[Curve, ...]:
     """The panel of seeded ``m``: its regular layout's run, the mean and range over its runs, the source."""
     name, row, where = METHODS[m].label, METHODS[m].source_row, {"method": m, "solution": DEFAULT, "eps": EPS[0]}
-    return (Curve("regular layout", _y(m), STYLE[m][0], where, name, options={"color": STYLE[m][1]}),
+    return (Curve("regular layout", _y(m), STYLE[m].fmt, where, name, options={"color": STYLE[m].color}),
             *_range(m, ("mean over the layouts", "least", "largest"), name, solution=DEFAULT, eps=EPS[0]),
             Curve(f"source, {row} a", "source", "ks" if row == "exact" else "ko", where, name))
 
@@ -350,7 +358,7 @@ def _profiles(path, got) -> None:
             p, mpm = got["profile"][(m, eps)]["profile"], METHODS[m].solver == "mpm"
             x, u = (np.array(p[k]) for k in (("x", "velocity") if mpm else ("nodes", "nodal_velocity")))
             rows[row].append((METHODS[m].label, x, {"velocity": u, "error at T": u - v(x, T)}, "." if mpm else "-",
-                              {"ms" if mpm else "lw": 1.5 if mpm else 0.9, "color": STYLE[m][1]}))
+                              {"ms" if mpm else "lw": 1.5 if mpm else 0.9, "color": STYLE[m].color}))
     if rows:
         plots.profile_grid(path, exact, rows,
                            f"{DEFAULT} solution at T = {T}, h = {PROFILE_H}: particles (MPM), nodes (FEM)")

@@ -26,6 +26,9 @@ SEED_ERRORS = {"particles_L1": ("density", "particles", "L1"), "particles_L2": (
 SPREAD_OF = ("particles_L1", "energy_L1", "nodes_L1")
 STATS = ("mean", "lo", "hi")
 
+#: the smooth region's column of a run's regions (:data:`REGION_NAMES`)
+SMOOTH = REGION_NAMES.index("smooth")
+
 
 def error(r: dict, field: str = "density", where: str = "nodes", norm: str = "L1") -> float:
     """One norm of a run's error; NaN when the run failed."""
@@ -106,8 +109,8 @@ def _blank(value: float, n: int):
 
 def _diagnostics(r: dict, fem: dict) -> dict:
     ok = r.get("ok")
-    return {"mpm_particles_mean_error_smooth": r["mean_error"]["particles"][2] if ok else "",
-            "mpm_nodes_mean_error_smooth": r["mean_error"]["nodes"][2] if ok else "",
+    return {"mpm_particles_mean_error_smooth": r["mean_error"]["particles"][SMOOTH] if ok else "",
+            "mpm_nodes_mean_error_smooth": r["mean_error"]["nodes"][SMOOTH] if ok else "",
             "mpm_volume_drift": r.get("volume_drift", ""), "mpm_head_shift": r.get("head_shift", ""),
             "fem_consistent_head_shift": fem.get("head_shift", ""), "mpm_steps": r.get("steps"),
             "mpm_particles": r.get("particles"), "mpm_wall_s": round(r.get("wall_s", math.nan), 2),
