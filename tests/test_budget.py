@@ -106,6 +106,9 @@ def test_exact_stages_without_exact_fields_stop_with_a_message():
     particles = sod.initial_particles(settings, grid)
     with pytest.raises(ValueError, match="exact fields"):
         explicit_step(grid, particles, IdealGas(), Walls(), 0.0, 1e-3, Stages(projection="exact"))
+    with pytest.raises(TypeError, match="FieldStages"):  # the fields alone are not the stages the step reaches
+        explicit_step(grid, particles, IdealGas(), Walls(), 0.0, 1e-3, Stages(projection="exact"),
+                      exact=sod.exact_fields(settings))
     with pytest.raises(ValueError, match="USL and USF"):
         Stages(interpolation="exact", scheme="musl")
 
