@@ -35,10 +35,10 @@ from measured import add_markdown_option, measured_block  # benchmarks/measured.
 from mpm_fem.bases import names
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
-from mpm_fem.core.solve import Problem
 from mpm_fem.core.step import Stages, Walls, explicit_step
 from mpm_fem.fused.step import FusedStep
 from mpm_fem.problems.sod import SodSettings, initial_particles
+from mpm_fem.run.solve import Problem
 
 BASES = names()  # every registered basis
 # particle-steps/s of the fused loop at 1e6 particles, one thread (uniform-grid arithmetic in every basis)

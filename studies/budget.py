@@ -139,8 +139,8 @@ def plan(tier: str) -> dict:
     budget = {(p, h, b): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K} for p, h, b in keys}
     e2 = {(h, b): {"kind": "bases", "h": h, "basis": b}
           for h in (QUICK["bases_h"] if quick else BASES_H) for b in BASES}
-    roundoff = {key: {**case, "kernel": "numpy"} for key, case in budget.items()
-                if key[::2] == ROUNDOFF and not quick and (tier == "deep" or key[1] in ROUNDOFF_H)}
+    roundoff = {(p, h, b): {**case, "kernel": "numpy"} for (p, h, b), case in budget.items()
+                if (p, b) == ROUNDOFF and not quick and (tier == "deep" or h in ROUNDOFF_H)}
     layouts = {(p, h, b, n, lay, s): {"kind": "budget", "problem": p, "h": h, "basis": b, "K": K,
                                        **_layout_changes(p, n, lay, s)}
                for (p, b), meshes in LAYOUT_H[tier].items() for h in meshes

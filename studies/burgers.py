@@ -38,13 +38,25 @@ MPM = dict(ppc=4, cfl=0.5, mass="lumped", basis="mpm", scheme="usl", layout="reg
 FEM = dict(cfl=0.5, cfl_visc=0.3)
 #: The calculated acceleration at each number of particles per cell: the source's 4-8 and 16.
 CALCULATED = {4: "mpm_calculated", 8: "mpm_calculated_8", 16: "mpm_calculated_16"}
-METHODS = {  # name: (label, solver, settings, the source's row it stands beside)
-    **{m: (f"MPM calculated a, {n} ppc", "mpm", {"acceleration": "calculated", "ppc": n}, "calculated")
+
+
+class Method(NamedTuple):
+    """A method of the tables: its label, its solver (``"mpm"`` or ``"fem"``), its settings beside the
+    solver's defaults (:data:`MPM`, :data:`FEM`), and the source's row it stands beside (``None``: none)."""
+
+    label: str
+    solver: str
+    settings: dict
+    source_row: str | None
+
+
+METHODS = {
+    **{m: Method(f"MPM calculated a, {n} ppc", "mpm", {"acceleration": "calculated", "ppc": n}, "calculated")
        for n, m in CALCULATED.items()},
-    "mpm_exact": ("MPM exact a", "mpm", {"acceleration": "exact"}, "exact"),
-    "mpm_exact_dt_h": ("MPM exact a, dt ~ h", "mpm", {"acceleration": "exact", "dt_rule": "advective"}, "exact"),
-    "fem_consistent": ("FEM consistent", "fem", {"mass": "consistent"}, None),
-    "fem_lumped": ("FEM lumped", "fem", {"mass": "lumped"}, None),
+    "mpm_exact": Method("MPM exact a", "mpm", {"acceleration": "exact"}, "exact"),
+    "mpm_exact_dt_h": Method("MPM exact a, dt ~ h", "mpm", {"acceleration": "exact", "dt_rule": "advective"}, "exact"),
+    "fem_consistent": Method("FEM consistent", "fem", {"mass": "consistent"}, None),
+    "fem_lumped": Method("FEM lumped", "fem", {"mass": "lumped"}, None),
 }
 #: The jittered layouts' seeds (the regular layout is seed 0), and the settings run on them (C13's).
 SEEDS, SEEDED = (1, 2, 3, 4, 5), (*CALCULATED.values(), "mpm_exact_dt_h")
@@ -149,7 +161,7 @@ def _rounded(arrays: dict) -> dict:
 
 def method_case(method: str, solution: str, eps: float, h: float, **changes) -> dict:
     """The case of ``method`` (a key of :data:`METHODS`) with ``changes`` to its settings."""
-    _, solver, fixed, _ = METHODS[method]
+    solver, fixed = METHODS[method].solver, METHODS[method].settings
     return {"solver": solver, "solution": solution, "eps": eps, "h": h, **(FEM if solver == "fem" else MPM), **fixed,
             **changes}
 
@@ -188,7 +200,7 @@ def _plan(tier: str) -> dict:
                 for n in q.get("PPC", PPC)},
         "lumping": {**{(m, mass, h): method_case(m, DEFAULT, EPS[0], h, mass=mass, cfl=LUMPING_CFL)
                        for h in q.get("lumping_H", H[:3]) for m in _MPM for mass in ("lumped", "consistent")},
-                    **{(m, METHODS[m][2]["mass"], h): method_case(m, DEFAULT, EPS[0], h)
+                    **{(m, METHODS[m].settings["mass"], h): method_case(m, DEFAULT, EPS[0], h)
                        for h in q.get("lumping_H", H[:3]) for m in fem}},
         "diagnosis": {(label, h): method_case("mpm_calculated", DEFAULT, EPS[0], h, **changes)
                       for h in q.get("diagnosis_H", H[:3]) for label, changes in DIAGNOSIS.items()},
@@ -203,10 +215,10 @@ def run(options: StudyOptions) -> None:
     """Every case in one sweep (shared cases run once, the longest first), then tables and figures."""
     got = options.sweep_plan(NAME, run_case, _plan(options.tier), cost=_cost)
     folder = options.folder(NAME)
-    full = {m: {**(MPM if v[1] == "mpm" else FEM), **v[2]} for m, v in METHODS.items()}
+    full = {m: {**(MPM if v.solver == "mpm" else FEM), **v.settings} for m, v in METHODS.items()}
     settings = {"quick": options.quick, "tier": options.tier, "T": T, "domain": [0, 2], "default_solution": DEFAULT,
                 "compared_norm": f"{NORM} over {WHERE}",
-                "methods": {m: {"label": v[0], "solver": v[1], "settings": full[m], "source_row": v[3]}
+                "methods": {m: {"label": v.label, "solver": v.solver, "settings": full[m], "source_row": v.source_row}
                             for m, v in METHODS.items()},
                 "force": f"{burgers.BurgersSettings.force} (the viscous force in weak form, weights V_p = "
                          f"{burgers.BurgersSettings.weights}); the slides' second difference and weights h/N_p^i: "
@@ -218,11 +230,11 @@ def run(options: StudyOptions) -> None:
                     "fem": f"dt = min(cfl h/max|v(x,0)|, cfl_visc h^2/(2 eps)), cfl {FEM['cfl']}, "
                            f"cfl_visc {FEM['cfl_visc']}, SSP-RK3"},
                 "source_corrections": "exponents of the entries marked * in docs/claims.md moved by one power of ten"}
-    methods = {m: {"source_row": v[3], "ppc": full[m].get("ppc", "")} for m, v in METHODS.items()}
+    methods = {m: {"source_row": v.source_row, "ppc": full[m].get("ppc", "")} for m, v in METHODS.items()}
     errors, orders = tables.errors_and_orders(got["table"], got["seeds"], methods, SOLUTIONS, DEFAULT, WHERE, NORM)
     time_h = QUICK["TIME_H"] if options.quick else TIME_H
     rows = {"errors": errors, BURGERS_ORDERS: orders, BURGERS_SEEDS: tables.seeds_rows(got["seeds"], full),
-            "norms": tables.norms_rows(got["table"], {m: v[3] for m, v in METHODS.items()}),
+            "norms": tables.norms_rows(got["table"], {m: v.source_row for m, v in METHODS.items()}),
             "timestep": tables.timestep_rows(got["timestep"], time_h, REFINE, WHERE, NORM),
             BURGERS_PPC: tables.ppc_rows(got["ppc"], EPS[0], WHERE, NORM),
             BURGERS_LUMPING: tables.lumping_rows(got["lumping"], EPS[0], WHERE),
@@ -245,14 +257,22 @@ def run(options: StudyOptions) -> None:
 
 #: Each method's marker and line, and its colour in every figure; a second grouping of the curves (the
 #: mesh, eps, mass) is drawn in the line styles of LINES, the colour kept.
-STYLE = {"mpm_calculated": ("o-", "tab:blue"), "mpm_calculated_8": ("o-.", "tab:cyan"),
-         "mpm_calculated_16": ("o--", "tab:purple"), "mpm_exact": ("s-", "tab:orange"),
-         "mpm_exact_dt_h": ("D-", "tab:red"), "fem_consistent": ("^--", "tab:green"),
-         "fem_lumped": ("v--", "tab:olive")}
+class Style(NamedTuple):
+    """A method's curves: matplotlib's format (marker and line) and colour."""
+
+    fmt: str
+    color: str
+
+
+STYLE = {"mpm_calculated": Style("o-", "tab:blue"), "mpm_calculated_8": Style("o-.", "tab:cyan"),
+         "mpm_calculated_16": Style("o--", "tab:purple"), "mpm_exact": Style("s-", "tab:orange"),
+         "mpm_exact_dt_h": Style("D-", "tab:red"), "fem_consistent": Style("^--", "tab:green"),
+         "fem_lumped": Style("v--", "tab:olive")}
 LINES = ("-", "--", ":")
 #: The diagnosis' variants' colours: a method's for the variant that is one (the first, the last two).
-_VARIANT_COLOURS = dict(zip(DIAGNOSIS, (STYLE["mpm_calculated"][1], "tab:brown", "tab:pink", "tab:gray", "black",
-                                        "gold", STYLE["mpm_calculated_16"][1], STYLE["mpm_exact"][1]), strict=True))
+_VARIANT_COLOURS = dict(zip(DIAGNOSIS, (STYLE["mpm_calculated"].color, "tab:brown", "tab:pink", "tab:gray", "black",
+                                        "gold", STYLE["mpm_calculated_16"].color, STYLE["mpm_exact"].color),
+                             strict=True))
 
 
 def _y(m: str) -> str:
@@ -264,31 +284,32 @@ def _curves(methods, label="{m}", y=None, by="", values=(), **where) -> tuple[Cu
     """A curve per method in its style (``{m}`` in ``label``: its name), and per value ``v`` of column
     ``by`` in ``values`` (``{v}`` in ``label``) in the line styles of :data:`LINES`; ``y`` defaults to
     the compared error."""
-    return tuple(Curve(label.format(m=METHODS[m][0], v=v), y or _y(m),
-                       STYLE[m][0] if not by else STYLE[m][0][0] + LINES[k % len(LINES)],
-                       {**where, "method": m, **({by: v} if by else {})}, options={"color": STYLE[m][1]})
+    return tuple(Curve(label.format(m=METHODS[m].label, v=v), y or _y(m),
+                       STYLE[m].fmt if not by else STYLE[m].fmt[0] + LINES[k % len(LINES)],
+                       {**where, "method": m, **({by: v} if by else {})}, options={"color": STYLE[m].color})
                  for m in methods for k, v in enumerate(values or ("",)))
 
 
 def _sources(methods, **where) -> tuple[Curve, ...]:
     """The source's entries beside ``methods`` (open black: squares for the exact, circles for the
     calculated acceleration)."""
-    return tuple(Curve(f"source, {METHODS[m][3]} a", "source", "ks" if METHODS[m][3] == "exact" else "ko",
-                       {**where, "method": m}) for m in methods)
+    rows = {m: METHODS[m].source_row for m in methods}
+    return tuple(Curve(f"source, {rows[m]} a", "source", "ks" if rows[m] == "exact" else "ko", {**where, "method": m})
+                 for m in methods)
 
 
 def _range(m: str, labels=("_{m} mean", "_{m} lo", "_{m} hi"), panel: str = "", **where) -> tuple[Curve, ...]:
     """The mean (crosses) and the least and largest (dotted) compared error over the runs of seeded
     ``m``, labelled ``labels`` (``{m}``: its name; a label from ``_`` stays out of the legend)."""
-    return tuple(Curve(label.format(m=METHODS[m][0]), f"{_y(m)}_{k}", fmt, {**where, "method": m}, panel,
-                       options={"color": STYLE[m][1], "lw": 0.8})
+    return tuple(Curve(label.format(m=METHODS[m].label), f"{_y(m)}_{k}", fmt, {**where, "method": m}, panel,
+                       options={"color": STYLE[m].color, "lw": 0.8})
                  for label, k, fmt in zip(labels, ("mean", "lo", "hi"), ("+", ":", ":"), strict=True))
 
 
 def _seed_panel(m: str) -> tuple[Curve, ...]:
     """The panel of seeded ``m``: its regular layout's run, the mean and range over its runs, the source."""
-    name, row, where = METHODS[m][0], METHODS[m][3], {"method": m, "solution": DEFAULT, "eps": EPS[0]}
-    return (Curve("regular layout", _y(m), STYLE[m][0], where, name, options={"color": STYLE[m][1]}),
+    name, row, where = METHODS[m].label, METHODS[m].source_row, {"method": m, "solution": DEFAULT, "eps": EPS[0]}
+    return (Curve("regular layout", _y(m), STYLE[m].fmt, where, name, options={"color": STYLE[m].color}),
             *_range(m, ("mean over the layouts", "least", "largest"), name, solution=DEFAULT, eps=EPS[0]),
             Curve(f"source, {row} a", "source", "ks" if row == "exact" else "ko", where, name))
 
@@ -334,10 +355,10 @@ def _profiles(path, got) -> None:
         exact[row] = {"velocity": (xe, v(xe, T)), "error at T": (xe, 0 * xe)}
         rows[row] = [("exact, t = 0", xe, {"velocity": v(xe, 0.0)}, "k:", {"lw": 0.8})]
         for m in (m for m in METHODS if got["profile"].get((m, eps), {}).get("ok")):
-            p, mpm = got["profile"][(m, eps)]["profile"], METHODS[m][1] == "mpm"
+            p, mpm = got["profile"][(m, eps)]["profile"], METHODS[m].solver == "mpm"
             x, u = (np.array(p[k]) for k in (("x", "velocity") if mpm else ("nodes", "nodal_velocity")))
-            rows[row].append((METHODS[m][0], x, {"velocity": u, "error at T": u - v(x, T)}, "." if mpm else "-",
-                              {"ms" if mpm else "lw": 1.5 if mpm else 0.9, "color": STYLE[m][1]}))
+            rows[row].append((METHODS[m].label, x, {"velocity": u, "error at T": u - v(x, T)}, "." if mpm else "-",
+                              {"ms" if mpm else "lw": 1.5 if mpm else 0.9, "color": STYLE[m].color}))
     if rows:
         plots.profile_grid(path, exact, rows,
                            f"{DEFAULT} solution at T = {T}, h = {PROFILE_H}: particles (MPM), nodes (FEM)")

@@ -39,7 +39,6 @@ import dataclasses
 import sys
 
 from mpm_fem.app.study import StudyOptions, publish, script_main
-from mpm_fem.core import solve
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import PositivityError
@@ -48,6 +47,7 @@ from mpm_fem.measure.claims.drift import STUDY
 from mpm_fem.measure.claims.rows import successive_orders
 from mpm_fem.measure.schema import DRIFT
 from mpm_fem.problems import sod
+from mpm_fem.run import solve
 from studies.sod import MPM
 
 NAME = "drift"
@@ -77,7 +77,7 @@ SEEDS = (1, 2, 3, 4, 5)
 SEED_H = (0.00125, 0.000625)
 SEEDED = (STUDY, "grid volume")
 DEEP_SEEDED = ("V + dt int dv/dx",)
-#: The quick tier's cases run on the numpy step (the same steps bit for bit, mpm_fem.core.solve.run): on
+#: The quick tier's cases run on the numpy step (the same steps bit for bit, mpm_fem.run.solve.run): on
 #: its two coarsest meshes they cost less than compiling the fused variants they need (the grid volume's
 #: alone: 34 CPU-s, docs/performance.md)
 QUICK = dict(H=(0.02, 0.01), SEED_H=(0.02, 0.01), SEEDS=SEEDS[:2], SEEDED=(STUDY,), kernel="numpy")

@@ -103,6 +103,12 @@ def _inside(quantity: str, order: float, reference: dict) -> bool:
     return band[0] - TOLERANCE <= order <= band[1] + TOLERANCE
 
 
+def _quantities_first(item) -> tuple:
+    """The order of the error rows: by quantity (in :data:`QUANTITIES`' order), then by the rest of the key."""
+    (quantity, *rest), _ = item
+    return (QUANTITIES.index(quantity), *rest)
+
+
 def tables(results: list[tuple[dict, dict]]) -> dict[str, list[dict]]:
     """Aggregate the case results over seeds into the study's tables."""
     errs = defaultdict(list)  # (quantity, layout, weights, basis, N_p, cells, norm) -> values over seeds
@@ -118,7 +124,7 @@ def tables(results: list[tuple[dict, dict]]) -> dict[str, list[dict]]:
             bounds[(check, c["layout"], c["ppc"], c["cells"])].append(b)
 
     error_rows = []
-    by_quantity = sorted(errs.items(), key=lambda kv: (QUANTITIES.index(kv[0][0]),) + kv[0][1:])
+    by_quantity = sorted(errs.items(), key=_quantities_first)
     for (q, lay, weights, basis, n, k, norm), v in by_quantity:
         v = np.asarray(v)
         error_rows.append({"quantity": q, "layout": lay, "weights": weights, "basis": basis, "N_p": n, "h": 1.0 / k,

@@ -43,6 +43,8 @@ MPM = dict(ppc=16, cfl=0.05, av_linear=0.5, av_quadratic=2.0, mass="lumped", sch
 FEM = dict(cfl=0.3, viscosity_linear=0.1, viscosity_quadratic=1.0, compression_only=False)
 FV = dict(cfl=0.8, limiter="mc")
 REGION_HALF_WIDTH = 0.02  # every wave, every mesh: two cells of the coarsest mesh on each side
+#: the regions the plateau table names (columns of a run's ``regions``, :data:`REGION_NAMES`)
+SMOOTH, BEHIND_SHOCK = REGION_NAMES.index("smooth"), REGION_NAMES.index("behind shock")
 PROFILE_H = (0.01, 0.0025)
 PPC = (1, 2, 4, 8, 16, 32)
 PPC_H = (0.01, 0.0025, 0.000625)
@@ -125,6 +127,13 @@ class SettingKey(NamedTuple):
     h: float
 
 
+class PpcKey(NamedTuple):
+    """A case of the ``ppc`` plan (C3): mesh, particles per cell (the study's other settings)."""
+
+    h: float
+    ppc: int
+
+
 class SeedKey(NamedTuple):
     """A case of the ``seeds`` plan: particles per cell, CFL, mesh, seed of the jittered layout."""
 
@@ -163,7 +172,7 @@ def _plan(tier: str) -> dict:
         "fem_consistent": {h: fem_case(h, "consistent") for h in refs},
         "fem_lumped": {h: fem_case(h, "lumped") for h in refs},
         "fv": {h: {"solver": "fv", "h": h, **FV} for h in refs},
-        "ppc": {(h, n): mpm_case(h, ppc=n) if n != MPM["ppc"] else mpm_case(h) for h in ppc_h for n in PPC},
+        "ppc": {PpcKey(h, n): mpm_case(h, ppc=n) if n != MPM["ppc"] else mpm_case(h) for h in ppc_h for n in PPC},
         "plateau": {(h, name): mpm_case(h, **change) if change else mpm_case(h)
                     for h in plateau_h for name, change in PLATEAU_VARIANTS.items()},
     }
@@ -210,9 +219,10 @@ def _L1(r, where="nodes", norm="L1"):
 
 def _ppc(got) -> list[dict]:
     rows = []
-    for (h, n), r in sorted(got["ppc"].items(), key=lambda kv: (-kv[0][0], kv[0][1])):
+    for k in sorted(got["ppc"], key=lambda k: (-k.h, k.ppc)):
+        r = got["ppc"][k]
         ok = r["ok"]
-        rows.append({"h": h, "ppc": n, "ok": ok,
+        rows.append({"h": k.h, "ppc": k.ppc, "ok": ok,
                      **{f"{w}_{k}": _L1(r, w, k) if ok else "" for w in ("nodes", "particles") for k in ("L1", "L2")},
                      "steps": r.get("steps"), "wall_s": round(r["wall_s"], 2) if ok else "",
                      "error": "" if ok else r["error"]})
@@ -241,8 +251,9 @@ def _plateau(got) -> list[dict]:
         if r["ok"]:
             row.update({"nodes_L1": _L1(r), "particles_L1": _L1(r, "particles"), "nodes_vs_study": _L1(r) / _L1(base),
                         "particles_vs_study": _L1(r, "particles") / _L1(base, "particles"),
-                        "nodes_smooth_L1": r["regions"]["nodes"][2], "nodes_behind_shock_L1": r["regions"]["nodes"][5],
-                        "particles_behind_shock_L1": r["regions"]["particles"][5],
+                        "nodes_smooth_L1": r["regions"]["nodes"][SMOOTH],
+                        "nodes_behind_shock_L1": r["regions"]["nodes"][BEHIND_SHOCK],
+                        "particles_behind_shock_L1": r["regions"]["particles"][BEHIND_SHOCK],
                         "density_new_extrema_per_step": r["extrema"]["density"]["new_per_step"],
                         "volume_drift": r["volume_drift"], "head_shift": r["head_shift"], "steps": r["steps"],
                         "error": ""})

@@ -22,7 +22,6 @@ from mpm_fem.app.plots import Curve, Plot, draw, plt, save
 from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
-from mpm_fem.core.solve import Problem
 from mpm_fem.core.step import Dirichlet
 from mpm_fem.measure.schema import TIME_CROSSING_SUMMARY, TIME_LOCAL_ERROR, TIME_ORDER
 from mpm_fem.measure.timing import (
@@ -37,6 +36,7 @@ from mpm_fem.measure.timing import (
     state_at,
 )
 from mpm_fem.problems import burgers
+from mpm_fem.run.solve import Problem
 
 NAME = "time"
 BASES = ("mpm", "gimp", "bspline")

@@ -12,6 +12,7 @@ from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.shape import make_shape
 from mpm_fem.core.step import Stages, Walls, explicit_step
 from mpm_fem.core.transfer import nodal_internal_force
+from mpm_fem.exact_stages import FieldStages
 from mpm_fem.exact_stages.projection import exact_projection
 from mpm_fem.exact_stages.quadrature import quadrature
 from mpm_fem.measure.decomposition import decompose, label
@@ -92,7 +93,7 @@ def test_exact_projection_and_mass_give_the_exact_nodal_values(basis):
     exact = burgers.exact_fields(settings)
     model = burgers.ViscousBurgers(settings.eps)
     _, state = explicit_step(grid, noisy, model, burgers.Dirichlet(settings.exact.v), 0.1, 1e-3, settings.stages,
-                             exact=exact)
+                             exact=FieldStages(exact))
     v, _, a = exact.reference(grid.nodes, 0.1)
     inner = slice(1, -1)
     assert np.abs(state.velocity - v).max() < 1e-14
@@ -105,6 +106,9 @@ def test_exact_stages_without_exact_fields_stop_with_a_message():
     particles = sod.initial_particles(settings, grid)
     with pytest.raises(ValueError, match="exact fields"):
         explicit_step(grid, particles, IdealGas(), Walls(), 0.0, 1e-3, Stages(projection="exact"))
+    with pytest.raises(TypeError, match="FieldStages"):  # the fields alone are not the stages the step reaches
+        explicit_step(grid, particles, IdealGas(), Walls(), 0.0, 1e-3, Stages(projection="exact"),
+                      exact=sod.exact_fields(settings))
     with pytest.raises(ValueError, match="USL and USF"):
         Stages(interpolation="exact", scheme="musl")
 

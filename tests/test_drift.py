@@ -10,7 +10,6 @@ import dataclasses
 import numpy as np
 import pytest
 
-from mpm_fem.core import solve
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import PositivityError, make_particles
@@ -20,6 +19,7 @@ from mpm_fem.core.volume import domain_rate
 from mpm_fem.measure.claims.drift import GROWTH_ORDER, REDUCED, STUDY, mechanism
 from mpm_fem.measure.schema import DRIFT
 from mpm_fem.problems import sod
+from mpm_fem.run import solve
 from studies import drift
 
 # ----------------------------------------------------------------------------- the options of the numpy step

@@ -8,10 +8,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mpm_fem.core.grid import uniform_grid
-from mpm_fem.core.solve import _keeps_particles
 from mpm_fem.measure.regions import ExtremaCounter, _cells, _strict_extrema, cells, strict_extrema
 from mpm_fem.measure.timing import Recorder
 from mpm_fem.problems import burgers, sod
+from mpm_fem.run.solve import _keeps_particles
 
 NODES = uniform_grid(0.0, 1.0, 0.1).nodes
 STRETCHED = np.array([0.0, 0.05, 0.3, 0.31, 0.7, 1.0])

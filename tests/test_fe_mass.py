@@ -11,7 +11,7 @@ from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.shape import make_shape
 from mpm_fem.core.step import Stages, Walls, explicit_step
 from mpm_fem.core.transfer import particle_mass_matrix
-from mpm_fem.exact_stages import projection
+from mpm_fem.exact_stages import FieldStages, projection
 from mpm_fem.exact_stages.grid_data import nodal_values
 from mpm_fem.exact_stages.mass import fe_mass, fe_mass_operator
 from mpm_fem.exact_stages.projection import exact_projection
@@ -117,7 +117,8 @@ def _sod_step(stages):
     settings = sod.SodSettings(h=0.05, ppc=4)
     grid = uniform_grid(0.0, 1.0, settings.h)
     particles = sod.initial_particles(settings, grid)
-    return explicit_step(grid, particles, IdealGas(), Walls(), 0.1, 1e-3, stages, exact=sod.exact_fields(settings))
+    return explicit_step(grid, particles, IdealGas(), Walls(), 0.1, 1e-3, stages,
+                         exact=FieldStages(sod.exact_fields(settings)))
 
 
 def test_only_the_exact_mass_stage_assembles_with_scikit_fem(monkeypatch):

@@ -21,11 +21,11 @@ from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import PositivityError, make_particles, seed_positions
 from mpm_fem.core.shape import OutsideGridError
-from mpm_fem.core.solve import Problem, run
 from mpm_fem.core.step import SCHEMES, Dirichlet, Stages, Walls
 from mpm_fem.fused.step import FusedStep, supported
 from mpm_fem.problems.burgers import Reservoir
 from mpm_fem.problems.sod import SodSettings, simulate
+from mpm_fem.run.solve import Problem, run
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 STEPS = 1000

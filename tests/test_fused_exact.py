@@ -12,15 +12,15 @@ import numpy as np
 import pytest
 from test_fused import TOLERANCE, _assert_same, _drifting_grid, _worst
 
-from mpm_fem.core import solve
 from mpm_fem.core.grid import grid_from_nodes, uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import make_particles, seed_positions
-from mpm_fem.core.solve import Problem, run
 from mpm_fem.core.step import Stages, Walls
 from mpm_fem.fused.step import FusedStep, supported
 from mpm_fem.problems.sod import RiemannFields
+from mpm_fem.run import solve
+from mpm_fem.run.solve import Problem, run
 
 #: the seven subsets with an exact stage: which of projection, mass, interpolation are exact
 SUBSETS = [dict(projection=p, mass=m, interpolation=i)

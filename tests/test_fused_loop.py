@@ -17,10 +17,10 @@ from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import make_particles, seed_positions
-from mpm_fem.core.solve import Problem, run
 from mpm_fem.core.step import Dirichlet, Stages, Walls, at_times
 from mpm_fem.problems import burgers
 from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
+from mpm_fem.run.solve import Problem, run
 
 FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 TOLERANCE = 1e-12  # as tests/test_fused.py: max_p |u_fused - u_numpy| <= TOLERANCE max_p |u_numpy|, each field

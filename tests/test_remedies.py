@@ -17,13 +17,13 @@ from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import make_particles, seed_positions
 from mpm_fem.core.reconstruction import reconstructed_force, taylor_fit
 from mpm_fem.core.shape import basis_integrals, bspline_shape, make_shape
-from mpm_fem.core.solve import run
 from mpm_fem.core.step import Stages, explicit_step
 from mpm_fem.core.transfer import nodal_internal_force
 from mpm_fem.core.volume import grid_volume_factor
 from mpm_fem.measure.errors import fitted_order
 from mpm_fem.measure.timing import PulseSettings, field_difference, pulse_setup
 from mpm_fem.problems import burgers
+from mpm_fem.run.solve import run
 
 
 @pytest.fixture

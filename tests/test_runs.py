@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from mpm_fem.core.particles import PositivityError
-from mpm_fem.core.solve import Problem
 from mpm_fem.problems import burgers, sod
+from mpm_fem.run.solve import Problem
 
 SOURCE_SOD_L1_H001 = 0.00830833  # slides, "Final Error Combination(cont.)"
 

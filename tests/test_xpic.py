@@ -17,12 +17,12 @@ import pytest
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import seed_positions
 from mpm_fem.core.shape import make_shape
-from mpm_fem.core.solve import run
 from mpm_fem.core.step import Dirichlet, Stages, Walls, explicit_step
 from mpm_fem.core.xpic import boundary_change_rule, xpic_grid_velocity, xpic_velocity
 from mpm_fem.measure.errors import fitted_order
 from mpm_fem.measure.timing import PulseSettings, field_difference, pulse_setup
 from mpm_fem.problems import burgers, sod
+from mpm_fem.run.solve import run
 
 
 @pytest.fixture

@@ -34,7 +34,7 @@ from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.convergence import FIELDS, SOLVERS, Convergence, measured, summarise
 from mpm_fem.app.guard import LONG_RUN_S, UsageError, check_cost
 from mpm_fem.core.particles import Particles
-from mpm_fem.core.solve import Result
+from mpm_fem.run.solve import Result
 
 #: The fields whose error a convergence study can measure, by problem.
 MEASURED = {"sod": ("density", "velocity", "pressure"), "burgers": ("velocity",)}
@@ -44,7 +44,7 @@ YES_LONG = "yes_long=True"
 
 @dataclass(frozen=True, eq=False, repr=False)
 class RunResult(Result):
-    """The solver's :class:`~mpm_fem.core.solve.Result`, shown in one line (no arrays)."""
+    """The solver's :class:`~mpm_fem.run.solve.Result`, shown in one line (no arrays)."""
 
     def __repr__(self) -> str:
         return (f"Result(t={self.t:.6g}, {self.steps} steps, dt {self.dt_min:.3g} to {self.dt_max:.3g}, "
@@ -57,7 +57,7 @@ class Run:
     ``nodes`` (n_nodes,) and ``nodal`` fields on them (``density``, ``velocity`` for Sod; ``velocity``
     for Burgers); ``exact`` the exact solution at ``"particles"`` and ``"nodes"`` (the same fields);
     ``errors`` ``{field: {"particles" | "nodes": {"L1", "L2", "max"}}}``; ``result`` the solver's
-    :class:`~mpm_fem.core.solve.Result` (steps, time steps, wall time). Shown in one line."""
+    :class:`~mpm_fem.run.solve.Result` (steps, time steps, wall time). Shown in one line."""
 
     settings: object
     particles: Particles

@@ -1,6 +1,6 @@
 """Field output over time for ParaView: VTU snapshots written with meshio and a ``.pvd`` series.
 
-``FieldWriter`` is an observer of :func:`mpm_fem.core.solve.run`: at every ``every``-th step it writes the
+``FieldWriter`` is an observer of :func:`mpm_fem.run.solve.run`: at every ``every``-th step it writes the
 particles (points with their state as point data) and the grid (P1 line cells with nodal mass,
 velocity, acceleration and density ``m_i / int S_i dx``) to ``folder/particles_NNNNN.vtu`` and
 ``folder/grid_NNNNN.vtu``, and ``close()`` adds the final frame at ``T`` and writes ``particles.pvd``
@@ -76,7 +76,7 @@ class FieldWriter:
     the problem's ``exact`` solution, its values and the errors beside the fields; ``basis``: the
     run's (the nodal density's ``int S_i dx``)."""
 
-    keeps_particles = False  # it writes what it is handed at once (mpm_fem.core.solve.run may reuse the arrays)
+    keeps_particles = False  # it writes what it is handed at once (mpm_fem.run.solve.run may reuse the arrays)
 
     def __init__(self, folder, grid: Grid, every: int = 20, exact: Exact | None = None, basis: str = "mpm"):
         if every < 1:

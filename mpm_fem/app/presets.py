@@ -49,7 +49,7 @@ def changes(problem: str, preset: str) -> dict:
 
         mpm = dict(study.MPM)
         return mpm if preset == "study" else {**mpm, "ppc": SOURCE_PPC, "cfl": SodSettings.cfl}
-    return {**study.MPM, **study.METHODS["mpm_calculated"][2], "solution": study.DEFAULT, "eps": study.EPS[0]}
+    return {**study.MPM, **study.METHODS["mpm_calculated"].settings, "solution": study.DEFAULT, "eps": study.EPS[0]}
 
 
 def settings_type(problem: str):

@@ -20,6 +20,7 @@ import sys
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
+from typing import Any, NamedTuple
 
 from mpm_fem.app import paper
 from mpm_fem.app.markdown import anchor_of, bullets, cell, figure, markdown_table  # noqa: F401  (cell: interface)
@@ -247,6 +248,14 @@ def write_report(out: Path, pages: list[Page] | None = None) -> Path:
     return path
 
 
+class Planned(NamedTuple):
+    """A case of ``reproduce``'s one sweep: its estimated cost, its study and its task."""
+
+    cost: float
+    study: str
+    task: Any
+
+
 def reproduce(options) -> Path:
     """Run every study with ``options`` (:class:`mpm_fem.app.study.StudyOptions`), then write the report;
     a folder holding tables of another tier is refused first (:func:`mpm_fem.app.study.check_folder`).
@@ -269,22 +278,23 @@ def reproduce(options) -> Path:
     total = {name: sum(s for s, _ in found[name]) for name in studies}
     # the studies in order of their total cost, each one's cases the longest first: a cheap study's tables and
     # figures are written while the costly studies' cases run, not after the last case
-    planned = sorted(((s, name, t) for name in studies for s, t in found[name]), key=lambda p: (total[p[1]], -p[0]))
-    left = {name: sum(1 for _, n, _ in planned if n == name) for name in studies}
+    planned = sorted((Planned(s, name, t) for name in studies for s, t in found[name]),
+                     key=lambda p: (total[p.study], -p.cost))
+    left = {name: sum(1 for p in planned if p.study == name) for name in studies}
     published = []
     # a study's tables and figures, in a worker: every case is in the cache by then, so it runs none
     writer = replace(options, jobs=1, progress=False)
 
     def done(k: int):
-        name = planned[k][1]
+        name = planned[k].study
         left[name] -= 1
         if left[name] == 0:
             published.append(name)
             return partial(run_study, name, writer)
         return None
 
-    run_tasks([t for _, _, t in planned], jobs=options.jobs, desc=f"reproduce --{options.tier}",
-              scheduler=options.scheduler, progress=options.progress, done=done, costs=[s for s, _, _ in planned])
+    run_tasks([p.task for p in planned], jobs=options.jobs, desc=f"reproduce --{options.tier}",
+              scheduler=options.scheduler, progress=options.progress, done=done, costs=[p.cost for p in planned])
     for name in (n for n in studies if n not in published):  # a study without a cost model, or no case
         run_study(name, options)
     return write_report(options.out)

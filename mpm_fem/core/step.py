@@ -12,9 +12,11 @@ The particle state (density, energy, pressure) is updated from the velocity grad
     MUSL (modified USL): as USL, with v_i^{n+1} re-projected from the updated particle velocities.
 
 Each stage of the step has a switch (:class:`Stages`); the exact forms used by the error budget
-are supplied by the problem (``exact_acceleration``, and :class:`~mpm_fem.exact_stages.fields.
-ExactFields` for the projection, mass and interpolation switches; their equations are in
-:mod:`mpm_fem.exact_stages.stage`). The default stages run the plain MPM step below, untouched.
+are supplied by the caller (``exact_acceleration``, and for the projection, mass and interpolation
+switches an :class:`ExactStages`, which :class:`mpm_fem.exact_stages.FieldStages` implements on a
+problem's exact fields; their equations are in :mod:`mpm_fem.exact_stages.stage`). This module
+imports no package above the core: the exact stages reach the step through that protocol. The
+default stages run the plain MPM step below, untouched.
 """
 
 from __future__ import annotations
@@ -28,11 +30,10 @@ from mpm_fem.bases import names
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force
-from mpm_fem.core.shape import make_shape
+from mpm_fem.core.shape import Shape, make_shape
 from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
 from mpm_fem.core.volume import VOLUME_RATES, VOLUMES, domain_rate, grid_volume_factor
 from mpm_fem.core.xpic import boundary_change_rule, check_order, xpic_velocity
-from mpm_fem.exact_stages import ExactFields, ExactGridStage, GridData
 
 SCHEMES = ("usl", "usf", "musl")
 ACCELERATIONS = ("calculated", "exact")
@@ -114,7 +115,7 @@ class Stages(StageSwitches):
 
     @property
     def uses_exact_fields(self) -> bool:
-        """Whether a stage needs the problem's :class:`~mpm_fem.exact_stages.fields.ExactFields`."""
+        """Whether a stage needs the problem's exact fields (an :class:`ExactStages`)."""
         return self.projection == "exact" or self.interpolation == "exact" or self.mass == "exact"
 
 
@@ -138,7 +139,7 @@ def numpy_only(model: Model, stages: Stages) -> str | None:
     """Why only the numpy step (:func:`explicit_step`) can take ``model`` and ``stages``, or ``None``:
     the drift study's options, the volume rate over the particle domain (``stages.volume_rate``) and
     a density update other than the slides' (``model.density_update``,
-    :mod:`mpm_fem.core.models.euler`), have no compiled form; :func:`mpm_fem.core.solve.run` then
+    :mod:`mpm_fem.core.models.euler`), have no compiled form; :func:`mpm_fem.run.solve.run` then
     steps with the numpy step."""
     if stages.volume_rate != "point":
         return f"the volume rate {stages.volume_rate!r} runs in the numpy step only"
@@ -225,6 +226,40 @@ class Dirichlet:
         return a
 
 
+class ExactGrid(Protocol):
+    """The grid stage of one step with exact stages (built by :meth:`ExactStages.grid_stage`; the
+    equations are :class:`mpm_fem.exact_stages.ExactGridStage`'s), all (n_nodes,): ``v_i`` the nodal
+    velocity, ``star_v`` and ``star_a`` the exact nodal ``v*`` and ``a*`` with the boundary rule,
+    ``star_new = star_v + dt star_a``; :meth:`acceleration` gives ``a_i`` from the particles'
+    force ``F_i`` (None where the projection is exact)."""
+
+    v_i: np.ndarray
+    star_v: np.ndarray
+    star_a: np.ndarray
+
+    @property
+    def star_new(self) -> np.ndarray: ...
+
+    def acceleration(self, F_mpm: np.ndarray | None) -> np.ndarray: ...
+
+
+class ExactStages(Protocol):
+    """The exact projection, mass and interpolation stages as the numpy step reaches them, passed in
+    by the caller (:class:`mpm_fem.exact_stages.FieldStages` on a problem's exact fields), so that
+    the step imports no package above the core.
+
+    ``reference(x, t) -> (v*, v*_x, a*)`` and ``velocity_gradient(x, t) -> v*_x`` at the particles
+    (arrays of the shape of ``x``); ``grid_stage`` the step's :class:`ExactGrid` from the particles'
+    sums: ``shape`` their rows, ``mass`` (n_p,) their masses, ``m_i`` and ``P_i`` (n_nodes,)."""
+
+    def reference(self, x: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+    def velocity_gradient(self, x: np.ndarray, t: float) -> np.ndarray: ...
+
+    def grid_stage(self, grid: Grid, boundary: Boundary, stages: Stages, shape: Shape, mass: np.ndarray,
+                   m_i: np.ndarray, P_i: np.ndarray, t: float, dt: float) -> ExactGrid: ...
+
+
 @dataclass(frozen=True, eq=False)
 class GridState:
     """What the grid held during one step, all (n_nodes,): ``m_i``, ``v_i^n``, ``a_i``, ``v_i^{n+1}``."""
@@ -244,9 +279,10 @@ def explicit_step(
     dt: float,
     stages: Stages = Stages(),
     exact_acceleration: Callable[[np.ndarray, float], np.ndarray] | None = None,
-    exact: ExactFields | None = None,
+    exact: ExactStages | None = None,
 ) -> tuple[Particles, GridState]:
-    """Advance the particles from ``t`` to ``t + dt``; returns the new particles and the grid state."""
+    """Advance the particles from ``t`` to ``t + dt``; returns the new particles and the grid state.
+    ``exact`` serves the exact projection, mass and interpolation stages (:class:`ExactStages`)."""
     if stages.uses_exact_fields:
         return _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exact_acceleration, exact)
     shape = make_shape(grid, particles.x, particles.volume, stages.basis)
@@ -338,11 +374,14 @@ def _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exa
     """
     if exact is None:
         raise ValueError("the exact projection, mass and interpolation stages need the problem's exact fields")
+    if not hasattr(exact, "grid_stage"):
+        raise TypeError(f"the exact stages take an ExactStages (mpm_fem.exact_stages.FieldStages(fields)), "
+                        f"got {type(exact).__name__}")
     shape = make_shape(grid, particles.x, particles.volume, stages.basis)
     h_p = grid.h[shape.cell]
     m = particles.mass
-    mpm = GridData(shape, m, nodal_mass(shape, m), nodal_momentum(shape, m, particles.velocity))
-    stage = ExactGridStage(grid, boundary, stages, exact, mpm, t, dt)
+    m_i = nodal_mass(shape, m)
+    stage = exact.grid_stage(grid, boundary, stages, shape, m, m_i, nodal_momentum(shape, m, particles.velocity), t, dt)
     v_i, star_v, star_a = stage.v_i, stage.star_v, stage.star_a
     exact_at_particles = stages.interpolation == "exact"
     if exact_at_particles:
@@ -377,4 +416,4 @@ def _step_with_exact_stages(grid, particles, model, boundary, t, dt, stages, exa
     particles = particles.replace(x=particles.x + dt * moving, velocity=particles.velocity + dt * acceleration)
     if stages.scheme == "usl":
         particles = model.update(particles, gradient(v_new, star_new, t + dt), dt, h_p)
-    return particles, GridState(mpm.m_i, v_i, a_i, v_new)
+    return particles, GridState(m_i, v_i, a_i, v_new)

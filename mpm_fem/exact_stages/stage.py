@@ -34,7 +34,9 @@ point values for the projection integrals, and the *reference* fields ``v*``, ``
 Dv*/Dt`` that grid and particle values approximate (point values for Burgers, averages over a
 particle domain across Sod's shock: :mod:`mpm_fem.problems.burgers`, :mod:`mpm_fem.problems.sod`).
 
-:class:`ExactGridStage` is the grid stage of a step with any of these exact forms. The exact forms
+:class:`ExactGridStage` is the grid stage of a step with any of these exact forms; :class:`FieldStages`
+hands it, with the fields at the particles, to the numpy step (which reaches it through the
+protocol :class:`mpm_fem.core.step.ExactStages`, never by importing this package). The exact forms
 themselves: the quadrature (:mod:`mpm_fem.exact_stages.quadrature`), the projection
 (:mod:`mpm_fem.exact_stages.projection`), the FE mass (:mod:`mpm_fem.exact_stages.mass`), the nodal
 data and their solves (:mod:`mpm_fem.exact_stages.grid_data`).
@@ -42,10 +44,13 @@ data and their solves (:mod:`mpm_fem.exact_stages.grid_data`).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 import mpm_fem.exact_stages.grid_kernels as grid_kernels
 from mpm_fem.core.grid import Grid
+from mpm_fem.core.shape import Shape
 from mpm_fem.exact_stages.fields import ExactFields
 from mpm_fem.exact_stages.grid_data import GridData, nodal_values
 from mpm_fem.exact_stages.projection import exact_projection
@@ -110,3 +115,26 @@ class ExactGridStage:
     def star_new(self) -> np.ndarray:
         """``star_v + dt star_a``: the exact nodal ``v^{n+1}`` the exact interpolation corrects against."""
         return self.star_v + self.dt * self.star_a
+
+
+@dataclass(frozen=True, eq=False)
+class FieldStages:
+    """The exact stages on a problem's exact fields, as the numpy step takes them
+    (:class:`mpm_fem.core.step.ExactStages`): the reference fields at the particles are the
+    fields' own, and :meth:`grid_stage` is the :class:`ExactGridStage` of the particles' sums."""
+
+    fields: ExactFields
+
+    def reference(self, x: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(v*, v*_x, a*)`` at ``x`` (:meth:`ExactFields.reference`)."""
+        return self.fields.reference(x, t)
+
+    def velocity_gradient(self, x: np.ndarray, t: float) -> np.ndarray:
+        """``v*_x`` at ``x`` (:meth:`ExactFields.velocity_gradient`)."""
+        return self.fields.velocity_gradient(x, t)
+
+    def grid_stage(self, grid: Grid, boundary, stages, shape: Shape, mass: np.ndarray, m_i: np.ndarray,
+                   P_i: np.ndarray, t: float, dt: float) -> ExactGridStage:
+        """The grid stage of the step from ``t`` to ``t + dt`` on the particles' rows ``shape``, masses
+        ``mass`` (n_p,), ``m_i`` and ``P_i`` (n_nodes,)."""
+        return ExactGridStage(grid, boundary, stages, self.fields, GridData(shape, mass, m_i, P_i), t, dt)

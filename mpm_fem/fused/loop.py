@@ -1,7 +1,7 @@
 """The compiled loop (:func:`_advance`): many steps of the fused step in one call.
 
 Between walls or Dirichlet ends with the lumped mass, a run takes its steps here: per step the time
-step of :func:`mpm_fem.core.solve.run`, pass 1, the grid stage (``v_i = P_i / m_i``, ``a_i = F_i /
+step of :func:`mpm_fem.run.solve.run`, pass 1, the grid stage (``v_i = P_i / m_i``, ``a_i = F_i /
 m_i``, the end conditions), the remedies' passes and pass 2, in the order and with the operations
 of the per-step path :meth:`mpm_fem.fused.step.FusedStep.step`, so the same numbers bit for bit.
 The Dirichlet data come from a table the caller evaluates ahead, at the times the loop will reach
@@ -71,7 +71,7 @@ class Conditions(NamedTuple):
 
 
 class Clock(NamedTuple):
-    """The run's time control (:func:`mpm_fem.core.solve.run`'s time step)."""
+    """The run's time control (:func:`mpm_fem.run.solve.run`'s time step)."""
 
     t: float
     T: float  # the final time
@@ -116,7 +116,7 @@ class Remedies(NamedTuple):
 
 @njit(cache=True, inline="always")
 def _pymin(a, b):
-    """Python's ``min(a, b)``: ``b`` only if ``b < a`` (NaN and ties as in :func:`mpm_fem.core.solve.run`)."""
+    """Python's ``min(a, b)``: ``b`` only if ``b < a`` (NaN and ties as in :func:`mpm_fem.run.solve.run`)."""
     return b if b < a else a
 
 
@@ -200,7 +200,7 @@ def _nodal_rows(xpic_on, volume_on):
 
 def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, remedies):
     """Up to ``clock.budget`` steps of :meth:`~mpm_fem.fused.step.FusedStep.step` with the lumped mass, each
-    with the time step :func:`mpm_fem.core.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL`` from the
+    with the time step :func:`mpm_fem.run.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL`` from the
     previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between ``state[cur]``
     and ``state[1 - cur]`` (columns ``IX .. IP``: x, v, V, m, rho, eps, p; ``consts[IGM1 .. IXPIC]``
     the model's constants, ``chunks`` the particle ranges of the threads). Stops before a step that

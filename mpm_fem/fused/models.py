@@ -4,15 +4,32 @@ From the velocity gradient ``L_p = sum_i G_ip v_i``: the ideal gas (:meth:`Ideal
 ``rho <- rho (1 - L dt)``, ``eps <- eps - p/rho L dt``, ``p = (gamma - 1) rho eps + q``, ``V = m/rho``,
 the sound speed) or viscous Burgers (``V <- V (1 + L dt)``, ``m = V``), the numpy model's
 operations in its order. A pass's checks (the first particle whose factor or energy is not
-positive, the first non-finite one, the largest signal speed) travel as a tally of seven floats
-through the particle loop, so that they stay in registers and numba's parallel analysis accepts them.
+positive, the first non-finite one, the largest signal speed) travel as a :class:`Tally` of seven
+floats through the particle loop, so that they stay in registers and numba's parallel analysis
+accepts them.
 Inlined into the passes, except :func:`all_finite`, the run's own check.
 """
+
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from mpm_fem.fused.codes import IGGM1, IGM1, ILIN, IQUAD
+
+
+class Tally(NamedTuple):
+    """A pass's checks so far, seven floats (particle indices < 2^53 are exact; -1: none yet). Floats,
+    not arrays: the tally stays in registers, and numba's parallel analysis takes it (it mistakes
+    integer tuples for shapes)."""
+
+    bad_factor: float  # the first particle whose factor (1 - L dt, Burgers 1 + L dt) is not > 0
+    bad_energy: float  # the first particle whose energy is not > 0 (gas)
+    bad_finite: float  # the first particle with a non-finite state
+    factor: float  # the factor of ``bad_factor``
+    energy: float  # the energy of ``bad_energy``
+    speed: float  # the largest signal speed, ``max c_p + |v_p|`` (gas) or ``max |v_p|``
+    sound_speed: float  # the sound speed of the particle last updated (what :func:`_checked` reads)
 
 
 @njit(cache=True, inline="always")
@@ -54,10 +71,8 @@ def _first(bad, value_at_bad, q, value):
 @njit(cache=True, inline="always")
 def _new_state(gas, q, L, dt, l, V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, tally):
     """The model's update of particle q from ``L_p`` (gas: :meth:`IdealGas.update`; Burgers:
-    ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``). ``tally = (first particle with a factor <= 0, first
-    with an energy <= 0 (gas), first non-finite, their two values, max speed, this particle's sound
-    speed)`` is returned updated. Seven floats (indices < 2^53 are exact), not arrays: the tally
-    stays in registers, and numba's parallel analysis takes it (it mistakes integer tuples for shapes)."""
+    ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``). Returns the :class:`Tally` updated, with this
+    particle's sound speed."""
     bad_f, bad_e, bad_n, val_f, val_e, top, _ = tally
     if gas:
         factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
@@ -68,7 +83,7 @@ def _new_state(gas, q, L, dt, l, V, m, rho, e, p, V_new, m_new, rho_new, e_new, 
         V_new[q] = V[q] * factor
         m_new[q] = V_new[q]
     bad_f, val_f = _first(bad_f, val_f, q, factor)
-    return bad_f, bad_e, bad_n, val_f, val_e, top, c
+    return Tally(bad_f, bad_e, bad_n, val_f, val_e, top, c)
 
 
 @njit(cache=True, inline="always")
@@ -84,18 +99,18 @@ def _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, tally):
         ok = _finite(x_new[q], v_new[q], V_new[q], 0.0, 0.0, 0.0)
     if bad_n < 0 and not ok:
         bad_n = float(q)
-    return bad_f, bad_e, bad_n, val_f, val_e, top, c
+    return Tally(bad_f, bad_e, bad_n, val_f, val_e, top, c)
 
 
 @njit(cache=True, inline="always")
 def _flags(k, tally, flags, values):
     """Chunk k's tally into the pass's outputs: ``flags[k]`` (the first bad particles: factor,
     energy and, if it has three columns, non-finite), ``values[k]`` (the two values); returns the speed."""
-    flags[k, 0], flags[k, 1] = int(tally[0]), int(tally[1])
+    flags[k, 0], flags[k, 1] = int(tally.bad_factor), int(tally.bad_energy)
     if flags.shape[1] > 2:
-        flags[k, 2] = int(tally[2])
-    values[k, 0], values[k, 1] = tally[3], tally[4]
-    return tally[5]
+        flags[k, 2] = int(tally.bad_finite)
+    values[k, 0], values[k, 1] = tally.factor, tally.energy
+    return tally.speed
 
 
-_NO_TALLY = (-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0)  # no bad particle yet, speed 0
+_NO_TALLY = Tally(-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0)  # no bad particle yet, speed 0

@@ -117,7 +117,7 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
                     x_new[q] = x[q] + dt * vel
                     tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new,
                                        consts, tally)
-                    tally = _checked(gas, q, tally[6], x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+                    tally = _checked(gas, q, tally.sound_speed, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
                 lo = hi
         for q in range(lo, hi):
             # stored rows: pass 1's row read in place, and USL's L_p (_gather's sum) in the same loop
@@ -155,7 +155,7 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
                     L = _gather(Gl, v_n, r, K)
                 tally = _new_state(gas, q, L, dt, h[0, cq], V, m, rho, e, p,
                                    V_new, m_new, rho_new, e_new, p_new, consts, tally)
-                c = tally[6]
+                c = tally.sound_speed
             else:
                 c = np.sqrt(g_gm1 * max(e_new[q], 0.0)) if gas else 0.0
             tally = _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
@@ -178,7 +178,7 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
             cq = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[0, cq], V, m, rho, e, p,
                                V_new, m_new, rho_new, e_new, p_new, consts, tally)
-            tally = _checked(gas, q, tally[6], x_new, v, rho_new, e_new, p_new, V_new, tally)
+            tally = _checked(gas, q, tally.sound_speed, x_new, v, rho_new, e_new, p_new, V_new, tally)
         speed[k] = _flags(k, tally, flags, values)
 
 
@@ -215,6 +215,6 @@ def _update_exact(h, cell, L, x_new, v_new, V, m, rho, e, p, dt, consts, chunks,
         for q in range(*_chunk(n, chunks, k)):
             tally = _new_state(gas, q, L[q], dt, h[0, cell[q]], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new,
                                consts, tally)
-            tally = _checked(gas, q, tally[6], x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+            tally = _checked(gas, q, tally.sound_speed, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
         speed[k] = _flags(k, tally, flags, values)
 

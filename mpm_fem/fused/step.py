@@ -102,7 +102,7 @@ class FusedStep:
     ``reuse`` the step writes into two alternating sets of arrays instead of fresh ones (no page
     faults on a new 8 MB array per field and step): the particles a step returns are overwritten
     two steps later, so a run that hands them to an observer reuses only if the observer keeps none
-    of them (:func:`mpm_fem.core.solve._keeps_particles`)."""
+    of them (:func:`mpm_fem.run.solve._keeps_particles`)."""
 
     def __init__(self, grid: Grid, model, boundary, stages: Stages = Stages(), exact_acceleration=None,
                  threads: int = 1, reuse: bool = False, exact: ExactFields | None = None):
@@ -212,7 +212,7 @@ class FusedStep:
 
     def advance(self, particles: Particles, t: float, problem, steps: int, max_steps: int, budget: int):
         """Up to ``budget`` steps from ``t`` in one compiled loop (:func:`~mpm_fem.fused.loop._advance`), each the step
-        :meth:`step` takes with the time step :func:`mpm_fem.core.solve.run` takes after its first step
+        :meth:`step` takes with the time step :func:`mpm_fem.run.solve.run` takes after its first step
         (from :attr:`speed`): the same numbers bit for bit. Returns ``(particles, t, steps taken,
         dt_min, dt_max)``; zero steps when the next step must go through :meth:`step` (it fails, or
         a stored row changes width)."""

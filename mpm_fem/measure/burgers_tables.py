@@ -71,8 +71,11 @@ def errors_and_orders(table: Mapping, seeds: Mapping, methods: Mapping[str, dict
     compared = f"{where}_{norm}"
     rows, series = [], defaultdict(dict)
     names = list(methods)
-    key = lambda kv: (solutions.index(kv[0][0]), names.index(kv[0][1]), -kv[0][2], -kv[0][3])  # noqa: E731
-    for (sol, m, eps, h), r in sorted(runs.items(), key=key):
+    def order(run):  # by solution and method in their orders, then decreasing eps and h
+        (sol, m, eps, h), _ = run
+        return solutions.index(sol), names.index(m), -eps, -h
+
+    for (sol, m, eps, h), r in sorted(runs.items(), key=order):
         src_row = methods[m]["source_row"]
         src = source.burgers_value(src_row, eps, h)
         row = {"solution": sol, "method": m, "ppc": methods[m]["ppc"], "eps": eps, "h": h, **norms_of(r)}
@@ -133,8 +136,11 @@ def seeds_rows(seeds: Mapping, settings: Mapping[str, dict]) -> list[dict]:
     """One row per run of ``seeds`` (``{(method, eps, h, layout, seed): run}``): its settings (the
     method's ``settings``: ``acceleration``, ``dt_rule``, ``ppc``) and its errors."""
     rows = []
-    for (m, eps, h, layout, seed), r in sorted(seeds.items(), key=lambda kv: (kv[0][0], -kv[0][1], -kv[0][2],
-                                                                              kv[0][3] != "regular", kv[0][4])):
+    def order(run):  # by method, decreasing eps and h, the regular layout first, by seed
+        (m, eps, h, layout, seed), _ = run
+        return m, -eps, -h, layout != "regular", seed
+
+    for (m, eps, h, layout, seed), r in sorted(seeds.items(), key=order):
         s = settings[m]
         rows.append({"method": m, "acceleration": s["acceleration"], "dt_rule": s.get("dt_rule", "stable"),
                      "ppc": s["ppc"], "eps": eps, "h": h, "layout": layout, "seed": seed, **norms_of(r),
@@ -170,7 +176,11 @@ def timestep_rows(runs: Mapping, time_h: float, refine: Sequence[int], where: st
     """``runs``: ``{(method, eps, k): run}`` at ``h = time_h`` with ``dt / k`` for ``k`` in ``refine``;
     the time error of each ``dt`` estimated against the finest, ``dt / refine[-1]``."""
     rows = []
-    for (m, eps, k), r in sorted(runs.items(), key=lambda kv: (kv[0][0], -kv[0][1], kv[0][2])):
+    def order(run):  # by method, decreasing eps, increasing refinement
+        (m, eps, k), _ = run
+        return m, -eps, k
+
+    for (m, eps, k), r in sorted(runs.items(), key=order):
         finest = runs[(m, eps, refine[-1])]
         row = {"method": m, "eps": eps, "h": time_h, "refine": k, "steps": r.get("steps", ""), "dt": r.get("dt", "")}
         for n in NORMS:
@@ -186,9 +196,13 @@ def timestep_rows(runs: Mapping, time_h: float, refine: Sequence[int], where: st
 def ppc_rows(runs: Mapping, eps: float, where: str, norm: str) -> list[dict]:
     """``runs``: ``{(method, h, ppc): run}``; ``best_ppc``: the particles per cell of the smallest
     compared error of the method and mesh."""
+    def order(run):  # by method, decreasing h, increasing ppc
+        (m, h, n), _ = run
+        return m, -h, n
+
     rows = [{"method": m, "eps": eps, "h": h, "ppc": n, **norms_of(r), "steps": r.get("steps", ""),
              "error": r.get("error", "")}
-            for (m, h, n), r in sorted(runs.items(), key=lambda kv: (kv[0][0], -kv[0][1], kv[0][2]))]
+            for (m, h, n), r in sorted(runs.items(), key=order)]
     for m, h in {(r["method"], r["h"]) for r in rows}:
         sub = [r for r in rows if r["method"] == m and r["h"] == h and np.isfinite(r[f"{where}_{norm}"])]
         for r in sub:
@@ -201,10 +215,14 @@ def lumping_rows(runs: Mapping, eps: float, where: str) -> list[dict]:
     def place(m):
         return "nodes" if m.startswith("fem") else where
 
+    def order(run):  # by method, mass, decreasing h
+        (m, mass, h), _ = run
+        return m, mass, -h
+
     return [{"method": m, "mass": mass, "eps": eps, "h": h, "where": place(m),
              **{k: value(r, place(m), k) for k in NORMS}, "nodes_L2": value(r, "nodes", "L2"), "dt": r.get("dt", ""),
              "error": r.get("error", "")}
-            for (m, mass, h), r in sorted(runs.items(), key=lambda kv: (kv[0][0], kv[0][1], -kv[0][2]))]
+            for (m, mass, h), r in sorted(runs.items(), key=order)]
 
 
 def diagnosis_rows(runs: Mapping, variants: Mapping[str, dict], eps: float, where: str) -> list[dict]:

@@ -203,7 +203,7 @@ def _extrema_in_particle_order(q: np.ndarray, x: np.ndarray, rtol: float) -> np.
 
 @dataclass(eq=False)
 class ExtremaCounter:
-    """An observer for :func:`mpm_fem.core.solve.run` that counts new extrema of density and energy
+    """An observer for :func:`mpm_fem.run.solve.run` that counts new extrema of density and energy
     per step (module docstring), at crossings, at the other particles and at the other particles
     that move faster than ``moving_speed``. After the run, :meth:`summary` gives the totals. It keeps
     no particles (``keeps_particles``): a run may hand it arrays it overwrites two steps later."""

@@ -26,6 +26,9 @@ SEED_ERRORS = {"particles_L1": ("density", "particles", "L1"), "particles_L2": (
 SPREAD_OF = ("particles_L1", "energy_L1", "nodes_L1")
 STATS = ("mean", "lo", "hi")
 
+#: the smooth region's column of a run's regions (:data:`REGION_NAMES`)
+SMOOTH = REGION_NAMES.index("smooth")
+
 
 def error(r: dict, field: str = "density", where: str = "nodes", norm: str = "L1") -> float:
     """One norm of a run's error; NaN when the run failed."""
@@ -33,7 +36,14 @@ def error(r: dict, field: str = "density", where: str = "nodes", norm: str = "L1
 
 
 def _settings(runs: dict) -> list[tuple]:
-    return list(dict.fromkeys(key[:2] for key in runs))
+    """The settings ``(ppc, cfl)`` of ``runs`` (``{(ppc, cfl, h): run}``), in their order."""
+    return list(dict.fromkeys((n, cfl) for n, cfl, _ in runs))
+
+
+def _seed_order(run: tuple) -> tuple:
+    """The order of the seeds table: by decreasing ppc, by CFL, by decreasing h, by seed."""
+    (n, cfl, h, _, seed), _ = run
+    return -n, cfl, -h, seed
 
 
 def seed_rows(regular: dict, jittered: dict) -> list[dict]:
@@ -41,7 +51,7 @@ def seed_rows(regular: dict, jittered: dict) -> list[dict]:
     runs = [((n, cfl, h, "regular", 0), r) for (n, cfl, h), r in regular.items()]
     runs += [((n, cfl, h, "jittered", seed), r) for (n, cfl, h, seed), r in jittered.items()]
     rows = []
-    for (n, cfl, h, layout, seed), r in sorted(runs, key=lambda kv: (-kv[0][0], kv[0][1], -kv[0][2], kv[0][4])):
+    for (n, cfl, h, layout, seed), r in sorted(runs, key=_seed_order):
         rows.append({"h": h, "ppc": n, "cfl": cfl, "layout": layout, "seed": seed, "ok": bool(r.get("ok")),
                      **{k: error(r, *where) for k, where in SEED_ERRORS.items()},
                      "volume_drift": r.get("volume_drift", math.nan), "steps": r.get("steps"),
@@ -99,8 +109,8 @@ def _blank(value: float, n: int):
 
 def _diagnostics(r: dict, fem: dict) -> dict:
     ok = r.get("ok")
-    return {"mpm_particles_mean_error_smooth": r["mean_error"]["particles"][2] if ok else "",
-            "mpm_nodes_mean_error_smooth": r["mean_error"]["nodes"][2] if ok else "",
+    return {"mpm_particles_mean_error_smooth": r["mean_error"]["particles"][SMOOTH] if ok else "",
+            "mpm_nodes_mean_error_smooth": r["mean_error"]["nodes"][SMOOTH] if ok else "",
             "mpm_volume_drift": r.get("volume_drift", ""), "mpm_head_shift": r.get("head_shift", ""),
             "fem_consistent_head_shift": fem.get("head_shift", ""), "mpm_steps": r.get("steps"),
             "mpm_particles": r.get("particles"), "mpm_wall_s": round(r.get("wall_s", math.nan), 2),

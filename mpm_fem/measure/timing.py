@@ -31,8 +31,9 @@ import numpy as np
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import Particles, make_particles, seed_positions
-from mpm_fem.core.solve import Problem, Result, run
 from mpm_fem.core.step import Stages, Walls, explicit_step
+from mpm_fem.exact_stages import FieldStages
+from mpm_fem.run.solve import Problem, Result, run
 
 
 @dataclass(frozen=True)
@@ -111,10 +112,13 @@ def local_errors(problem: Problem, grid, particles: Particles, stages: Stages, t
                  exact=None) -> list[dict]:
     """One step of each ``dt`` in ``dts`` from ``(particles, t)`` against ``substeps`` steps of
     ``dt / substeps`` over the same interval: ``max_p |x_p - x_p^ref|`` and ``max_p |v_p - v_p^ref|``."""
+    fields = problem.exact if exact is None else exact
+    exact_stages = FieldStages(fields) if fields is not None else None
+
     def advance(p, t0, dt, n):
         for k in range(n):
             p, _ = explicit_step(grid, p, problem.model, problem.boundary, t0 + k * dt, dt, stages,
-                                 problem.exact_acceleration, problem.exact if exact is None else exact)
+                                 problem.exact_acceleration, exact_stages)
         return p
 
     rows = []
@@ -146,7 +150,7 @@ class Track:
 
 
 class Recorder:
-    """An observer for :func:`mpm_fem.core.solve.run` that records particle ``index`` (a :class:`Track`).
+    """An observer for :func:`mpm_fem.run.solve.run` that records particle ``index`` (a :class:`Track`).
 
     The index must stay valid: no particle before it may be removed (true for a particle that does
     not leave, with inflow particles appended at the end).

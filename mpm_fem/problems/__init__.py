@@ -63,7 +63,7 @@ class RunSettings(StageSwitches):
     particles per cell ``ppc`` and their ``layout`` (``seed`` for the random ones), the final time
     ``T`` and CFL number ``cfl``, the stage switches (:class:`~mpm_fem.core.step.StageSwitches`; a
     problem adds ``acceleration`` where it has an exact one), and the step's implementation (``kernel``,
-    ``threads``; :func:`mpm_fem.core.solve.run`). A problem's settings subclass this one, adding its own
+    ``threads``; :func:`mpm_fem.run.solve.run`). A problem's settings subclass this one, adding its own
     parameters and changing the defaults it needs."""
 
     # the mesh and the particles

@@ -17,7 +17,7 @@ h/N_p^i``: every particle of cell ``I_i`` weighs ``h / N_p^i``, reset after ever
 count-normalised second difference ``eps (v_{i+1} - 2 v_i + v_{i-1})/h^2``, point mass only);
 ``dt_rule`` ``"stable"`` (``dt = CFL min(h/max|v|, h^2/(2 eps))``) or ``"advective"`` (``CFL
 h/max|v|``: no viscous limit, for the exact acceleration, which computes no viscous force).
-``kernel`` and ``threads`` choose the step's implementation (:func:`mpm_fem.core.solve.run`).
+``kernel`` and ``threads`` choose the step's implementation (:func:`mpm_fem.run.solve.run`).
 """
 
 from __future__ import annotations
@@ -32,10 +32,10 @@ from mpm_fem.core.models.burgers import FORCES, ViscousBurgers
 from mpm_fem.core.norms import norms
 from mpm_fem.core.particles import Particles, make_particles, seed_positions
 from mpm_fem.core.shape import locate
-from mpm_fem.core.solve import Problem, Result, run
 from mpm_fem.core.step import ACCELERATIONS, Dirichlet
 from mpm_fem.fused.step import check_kernel
 from mpm_fem.problems import Cost, RunSettings, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
+from mpm_fem.run.solve import Problem, Result, run
 
 WEIGHTS = ("volume", "cell")
 DT_RULES = ("stable", "advective")
@@ -175,7 +175,7 @@ def exact_fields(settings: BurgersSettings) -> SmoothBurgersFields:
 
 
 def simulate(settings: BurgersSettings = BurgersSettings(), progress: bool | None = None, observer=None) -> Result:
-    """Run MPM on viscous Burgers with ``settings`` through :func:`mpm_fem.core.solve.run`."""
+    """Run MPM on viscous Burgers with ``settings`` through :func:`mpm_fem.run.solve.run`."""
     solution = settings.exact
     grid = uniform_grid(*solution.domain, settings.h)
     problem = Problem(

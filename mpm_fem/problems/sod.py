@@ -19,7 +19,6 @@ from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.norms import norms
 from mpm_fem.core.particles import make_particles, seed_positions
-from mpm_fem.core.solve import Problem, Result, run
 from mpm_fem.core.step import Walls
 from mpm_fem.exact_stages import kernels
 from mpm_fem.fused.step import check_kernel
@@ -33,6 +32,7 @@ from mpm_fem.problems import (
     run_cost,
     totals,
 )
+from mpm_fem.run.solve import Problem, Result, run
 
 DOMAIN = (0.0, 1.0)
 

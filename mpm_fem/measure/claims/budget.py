@@ -94,7 +94,8 @@ def _e1_text(found: dict) -> str:
     if undecided:
         head += "; the attributions disagree for " + ", ".join(undecided)
     (k0, (h0, f0)) = next(iter(finest.items()))
-    head += (f"; e.g. {names[k0]} at h = {h0:g}: {f0['alone'][0]} alone adds {f0['alone'][1]:.3g} against "
+    stage, effect = f0["alone"]
+    head += (f"; e.g. {names[k0]} at h = {h0:g}: {stage} alone adds {effect:.3g} against "
              f"v(all MPM) = {f0['mpm']:.3g} and v(all exact) = {f0['exact']:.3g}")
     trend = ", ".join(f"{names[k]} " + " -> ".join(f"{f['interactions']:.2g}" for _, f in series)
                       for k, series in found.items())

@@ -164,11 +164,12 @@ def _c13(t: Tables) -> Finding:
     lines.append(f"exact a with the viscous dt ({BURGERS_SHOWN['solution']}) "
                  f"{span(c13_order(select(t[BURGERS_ORDERS.name], **BURGERS_SHOWN), 'mpm_exact')['single'])}")
     diagnosis = t.get(BURGERS_DIAGNOSIS.name)
-    c = next((s, o, label) for s, o, label in found if s["row"] == "calculated")
-    e = next((s, o, label) for s, o, label in found if s["row"] == "exact")
-    sentence = (f"on Burgers the particle velocity error's order in h ({c[0]['solution']}, {c[0]['norm']} norm) is "
-                f"{c[1]['mean']:.2f} ({c[1]['lo']:.2f} to {c[1]['hi']:.2f}) with the calculated acceleration at "
-                f"{c[0]['ppc']} per cell and {e[1]['mean']:.2f} with the exact acceleration ({e[0]['solution']})")
+    calc_shown, calc_order = next((s, o) for s, o, _ in found if s["row"] == "calculated")
+    exact_shown, exact_order = next((s, o) for s, o, _ in found if s["row"] == "exact")
+    sentence = (f"on Burgers the particle velocity error's order in h ({calc_shown['solution']}, "
+                f"{calc_shown['norm']} norm) is {calc_order['mean']:.2f} ({calc_order['lo']:.2f} to "
+                f"{calc_order['hi']:.2f}) with the calculated acceleration at {calc_shown['ppc']} per cell and "
+                f"{exact_order['mean']:.2f} with the exact acceleration ({exact_shown['solution']})")
     return Finding(verdict, "; ".join(lines + ([diagnosis_text(diagnosis)] if diagnosis else [])), sentence,
                    _solutions_table(t, judged))
 

@@ -120,8 +120,8 @@ def mechanism(tables) -> str:
             spreads.append(max(p) - min(p))
     band = max(spreads, default=0)
     measured = {n: (_ok(series[n])[-2:], _order(series[n], hs)) for n in names}
-    measured = {n: m for n, m in measured.items() if math.isfinite(m[1])}
-    p_study = measured[STUDY][1]
+    measured = {n: (pair, order) for n, (pair, order) in measured.items() if math.isfinite(order)}
+    _, p_study = measured[STUDY]
     drift = {n: num(pair[-1], "volume_drift") for n, (pair, _) in measured.items()}
     resolution = (f"a growth counts below {GROWTH_ORDER - band:.2f}, the spread of an order over the jittered seeds"
                   if spreads else "one layout, no spread over seeds in the table")

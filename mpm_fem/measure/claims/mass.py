@@ -64,6 +64,7 @@ _SECOND_READING = {CONFIRMED: "with the consistent mass the error is smaller on 
 def mass_finding(t: Tables, problem: str, second: tuple[str, str], sentence_name: str) -> Finding:
     """C15 on ``problem`` from the budget's mass stage, with the consistent/lumped reading ``second``
     (its verdict and evidence) beside."""
+    second_verdict, second_evidence = second
     cases = mass_stage(select(t[SUBSETS], problem=problem))
     if not cases:
         return Finding("not measured", f"no complete budget of the {BASIS} basis on {problem}")
@@ -86,7 +87,7 @@ def mass_finding(t: Tables, problem: str, second: tuple[str, str], sentence_name
                 f"{sum(separable.values())} of {n}); "
                 + "; ".join(f"{r['norm']} h = {r['h']}: alone {r['mass alone / all-MPM']}, interactions "
                             f"{r['its interactions / its effect']}, Shapley {r['Shapley / gap']}" for r in table)
-                + f". Second reading, consistent against lumped mass ({second[0]}): {second[1]}")
+                + f". Second reading, consistent against lumped mass ({second_verdict}): {second_evidence}")
     if hits:
         sentence = (f"on {sentence_name} the lumped-mass FE stage alone adds {lo:.0%} to {hi:.0%} of MPM's error to "
                     f"the error with every stage exact, but its interactions with the other stages are {t_lo:.2g} "
@@ -94,7 +95,7 @@ def mass_finding(t: Tables, problem: str, second: tuple[str, str], sentence_name
     else:
         sentence = (f"on {sentence_name} the lumped-mass FE stage alone changes the all-exact error by {lo:.0%} to "
                     f"{hi:.0%} of MPM's error")
-    sentence += "; " + _SECOND_READING.get(second[0], "consistent against lumped mass not measured")
+    sentence += "; " + _SECOND_READING.get(second_verdict, "consistent against lumped mass not measured")
     return Finding(verdict, evidence, sentence, table)
 
 

@@ -37,7 +37,8 @@ def _inside(t: Tables, quantity: str) -> dict[str, tuple[int, int]]:
             ref = select(t[ORDERS], quantity=band, layout=r["layout"], N_p=r["N_p"], **_SHOWN)
             ok = bool(ref) and abs(order - num(ref[0], "order")) <= BAND_TOLERANCE
         else:
-            ok = in_band(order, band[0], band[1])
+            lo, hi = band
+            ok = in_band(order, lo, hi)
         hits, total = found.get(r["layout"], (0, 0))
         found[r["layout"]] = (hits + ok, total + 1)
     return found

@@ -156,17 +156,17 @@ def _matching(t: Tables) -> tuple[dict, str]:
         found.setdefault(Setting(int(num(r, "ppc")), num(r, "cfl")), f"{r['quantity']} {r['norm']}, rank {r['rank']}")
     if found:
         return found, "the identification table"
-    rows, best = t.get(CONVERGENCE, []), None
+    rows, misfit, closest, what = t.get(CONVERGENCE, []), math.inf, None, ""
     for k in _settings(rows):
         for q in ("nodes", "particles"):
             for norm in ("L1", "L2"):
                 m = shape.misfit(select(rows, ppc=k.ppc, cfl=k.cfl), f"ratio_{q}_{norm}")
-                if math.isfinite(m) and (best is None or m < best[0]):
-                    best = (m, k, f"{q} {norm}, closest in {CONVERGENCE}")
-    if best is None:
+                if math.isfinite(m) and (closest is None or m < misfit):
+                    misfit, closest, what = m, k, f"{q} {norm}, closest in {CONVERGENCE}"
+    if closest is None:
         return {}, "no identification table and no ratio to the source"
-    return {best[1]: best[2]}, (f"no identification table: the closest setting of the study's "
-                                f"({CONVERGENCE}, mean |log ratio| {best[0]:.2f})")
+    return {closest: what}, (f"no identification table: the closest setting of the study's "
+                             f"({CONVERGENCE}, mean |log ratio| {misfit:.2f})")
 
 
 def _reproduction(t: Tables, matching: dict) -> str:

@@ -24,7 +24,7 @@ from mpm_fem.core.particles import Particles, PositivityError
 from mpm_fem.core.shape import basis_integrals, make_shape
 from mpm_fem.core.step import Boundary, GridState, Model, Stages, explicit_step, numpy_only
 from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_mass, nodal_momentum
-from mpm_fem.exact_stages import ExactFields
+from mpm_fem.exact_stages import ExactFields, FieldStages
 from mpm_fem.fused import FusedStep, all_finite, check_kernel, supported
 
 LOOP_WORK = 4_000_000  # particle-steps per compiled loop of the fused step (about 0.1 s)
@@ -151,6 +151,7 @@ def run(
     # when it acts: steps in compiled loops of about LOOP_WORK particle-steps each (the bar and
     # Ctrl-C are served between them); a loop stops after a step the particle boundary acts on
     loop = fused is not None and observer is None and fused.loops(problem)
+    exact = FieldStages(problem.exact) if problem.exact is not None else None  # the numpy step's exact stages
     start = time.perf_counter()
     t, steps = 0.0, 0
     dt_min, dt_max = np.inf, -np.inf
@@ -186,7 +187,7 @@ def run(
                     new, state = fused.step(particles, t, dt)
                 else:
                     new, state = explicit_step(grid, particles, problem.model, problem.boundary, t, dt, stages,
-                                               problem.exact_acceleration, problem.exact)
+                                               problem.exact_acceleration, exact)
             except PositivityError as err:
                 raise err.at(steps, t) from None
             if problem.particle_boundary is not None:
