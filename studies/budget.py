@@ -206,17 +206,24 @@ def _run(problem: str, settings, points: np.ndarray) -> tuple[dict, dict]:
             "nodes_L1": errors["nodes"]["L1"], **extra}, fields
 
 
+def norm_points(problem: str, settings) -> tuple[np.ndarray, np.ndarray]:
+    """The points of the budget's particle norm and their trapezoid weights, both (n,): equal spacing
+    over Sod's domain, or Burgers' domain without 5 % at each end, at least 4 points per particle
+    (and 4001)."""
+    a, b = sod.DOMAIN if problem == "sod" else settings.exact.domain
+    margin = 0.0 if problem == "sod" else 0.05 * (b - a)
+    points = np.linspace(a + margin, b - margin, max(4001, 4 * round((b - a) / settings.h) * settings.ppc + 1))
+    return points, np.r_[0, np.diff(points) / 2] + np.r_[np.diff(points) / 2, 0]
+
+
 def subset_fields(problem: str, h: float, basis: str, settings: dict | None = None) -> tuple:
     """Error fields of the sixteen subsets (module docstring): ``(fields, weights, points, runs)``
     with ``fields[S][norm]`` and the norm's quadrature ``weights[norm]``; ``fields`` is None when a
     run fails. ``settings`` replace the study's (tests run small cases)."""
-    base = _settings(problem, h, basis, settings or {})
-    a, b = sod.DOMAIN if problem == "sod" else base.exact.domain
-    margin = 0.0 if problem == "sod" else 0.05 * (b - a)
-    points = np.linspace(a + margin, b - margin, max(4001, 4 * round((b - a) / h) * base.ppc + 1))
-    weights = {"particles": np.r_[0, np.diff(points) / 2] + np.r_[np.diff(points) / 2, 0]}  # trapezoid rule
+    points, trapezoid = norm_points(problem, _settings(problem, h, basis, settings or {}))
+    weights = {"particles": trapezoid}
     if problem == "sod":
-        weights["nodes"] = uniform_grid(a, b, h).lumped_mass
+        weights["nodes"] = uniform_grid(*sod.DOMAIN, h).lumped_mass
     runs, e = [], {}
     for S3 in subsets(STAGES[:3]):
         changes = {k: v for s in STAGES[:3] if s not in S3 for k, v in EXACT_FORM[s].items()}

@@ -42,7 +42,6 @@ from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.measure.claims.mechanism import summary_rows
 from mpm_fem.measure.decomposition import label
 from mpm_fem.measure.schema import MECHANISM_GROWTH, MECHANISM_SUMMARY
-from mpm_fem.problems import sod
 from studies.budget import (
     BURGERS,
     EXACT_FORM,
@@ -54,6 +53,7 @@ from studies.budget import (
     _run,
     _settings,
     _steps,
+    norm_points,
     setting_of,
 )
 
@@ -109,14 +109,6 @@ def cost(case: dict) -> float:
 
 # ---------------------------------------------------------------- one case
 
-def _points(problem: str, settings) -> tuple[np.ndarray, np.ndarray]:
-    """The budget's points and trapezoid weights of the particle norm (:func:`studies.budget.subset_fields`)."""
-    a, b = sod.DOMAIN if problem == "sod" else settings.exact.domain
-    margin = 0.0 if problem == "sod" else 0.05 * (b - a)
-    points = np.linspace(a + margin, b - margin, max(4001, 4 * round((b - a) / settings.h) * settings.ppc + 1))
-    return points, np.r_[0, np.diff(points) / 2] + np.r_[np.diff(points) / 2, 0]
-
-
 def run_case(case: dict) -> dict:
     """v(S) of the case's subsets (:data:`CASES`), by what is exact: the runs in MPM form but the exact
     stages, at dt and, where time is made exact too, at dt / K, extrapolated point by point (the budget's
@@ -125,7 +117,7 @@ def run_case(case: dict) -> dict:
     changes = {k: case[k] for k in ("ppc", "layout", "seed") if k in case}
     exact = () if case["made_exact"] == "time" else STAGES[:3] if case["made_exact"] == "all" else (case["made_exact"],)
     forms = {k: v for s in exact for k, v in EXACT_FORM[s].items()}
-    points, weights = _points(problem, _settings(problem, h, BASIS, changes))
+    points, weights = norm_points(problem, _settings(problem, h, BASIS, changes))
     refines = (1, K) if case["made_exact"] in ("time", "all") else (1,)
     fields, runs = {}, []
     for refine in refines:
