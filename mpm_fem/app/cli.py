@@ -25,14 +25,14 @@ from mpm_fem.app import guard, output
 from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.guard import UsageError
 from mpm_fem.app.study import add_study_options, add_tier_options, start_study, study_options
-from mpm_fem.bases import get, names
+from mpm_fem.bases import get, names, plugins
 from mpm_fem.core.grid import GridError
 from mpm_fem.core.particles import LAYOUTS
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS
 from mpm_fem.core.step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, SCHEMES, STAGE_MASS
 from mpm_fem.core.volume import VOLUMES
 
-CHOICES = {"mass": STAGE_MASS, "basis": names(), "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
+CHOICES = {"mass": STAGE_MASS, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
            "projection": PROJECTIONS, "interpolation": INTERPOLATIONS}
 # --- remedies (E5): --flip ALPHA, --xpic M, --reconstruct none|taylor, --volume carried|grid, --basis bspline_gimp
 CHOICES.update({"reconstruct": RECONSTRUCTIONS, "volume": VOLUMES, "kernel": ("fused", "numpy")})
@@ -58,7 +58,6 @@ HELP = {
     "refine": "time stage: the time step divided by this integer",
     "kernel": "step implementation: compiled fused passes, or the numpy reference step",
     "threads": "threads of the fused step (deterministic; equal to one thread to round-off)",
-    "basis": "particle basis (the registry of mpm_fem.bases): " + ", ".join(f"{get(b).title} ({b})" for b in names()),
     "scheme": "stress update order",
     "layout": "initial particle layout in each cell",
     "seed": "random seed (integer >= 0) of jittered/random layouts",
@@ -79,20 +78,35 @@ BURGERS_HELP = {
 HELP.update(REMEDY_HELP)
 
 
+def basis_option(spec: str) -> str:
+    """The ``--basis`` value: a registered name, an installed entry point's or a ``package.module:Name``
+    checked against the contract (:mod:`mpm_fem.bases.plugins`); a refusal is argparse's one-line error."""
+    try:
+        return plugins.resolve(spec)
+    except (ValueError, TypeError) as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def basis_help() -> str:
+    """The ``--basis`` help: every registered basis (installed entry points included)."""
+    return ("particle basis (the registry of mpm_fem.bases, or package.module:Name of one outside it): "
+            + ", ".join(f"{get(b).title} ({b})" for b in names()))
+
+
 def _add_settings_options(parser: argparse.ArgumentParser, settings_cls, extra_choices=None, extra_help=None) -> None:
     choices = {**CHOICES, **(extra_choices or {})}
-    helps = {**HELP, **(extra_help or {})}
+    helps = {**HELP, "basis": basis_help(), **(extra_help or {})}
     for f in dataclasses.fields(settings_cls):
         if isinstance(f.default, tuple):
             continue  # initial states stay in the settings JSON, not on the command line
-        kind = type(f.default)
+        kind = basis_option if f.name == "basis" else type(f.default)
         parser.add_argument(
             f"--{f.name.replace('_', '-')}",
             dest=f.name,
             type=kind,
             default=f.default,
             choices=choices.get(f.name),
-            metavar=None if f.name in choices else f.name.upper(),
+            metavar="|".join(names()) if f.name == "basis" else None if f.name in choices else f.name.upper(),
             help=f"{helps[f.name]} (default: %(default)s)",
         )
     parser.add_argument("--out", default=None,
@@ -113,6 +127,7 @@ def build_parser() -> argparse.ArgumentParser:
     from mpm_fem.problems.burgers import DT_RULES, FORCES, WEIGHTS, BurgersSettings
     from mpm_fem.problems.sod import SodSettings
 
+    plugins.discover()  # installed bases join the choices
     parser = guard.OneLineParser(
         prog="mpm-fem",
         description="Where does the error of the Material Point Method come from? "
@@ -181,7 +196,9 @@ def _prepare(args, problem: str, module, settings_cls):
     except (PermissionError, FileExistsError) as err:
         raise UsageError(str(err)) from None
     if not args.quiet:
-        print(f"{problem}: {guard.describe(cost)}", file=sys.stderr)
+        slower = (f" on the numpy step: the basis {settings.basis} has no compiled kernels"
+                  if cost.kernel == "numpy" and settings.kernel == "fused" and not get(settings.basis).compiled else "")
+        print(f"{problem}: {guard.describe(cost)}{slower}", file=sys.stderr)
     return settings, cost, out
 
 
@@ -213,6 +230,7 @@ def _record(folder: Path, problem: str, settings, cost, result, errors: dict, co
         "dt_min": result.dt_min,
         "dt_max": result.dt_max,
         "wall_s": round(result.wall_s, 4),
+        "kernel": result.kernel,
         "estimate": cost.as_dict(),
         "settings": settings.as_dict(),
         "versions": output.versions(),

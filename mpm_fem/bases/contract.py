@@ -85,7 +85,8 @@ class Basis(ABC):
     degree          the polynomial degree of ``S_i`` on each piece between nodes and half cells: the
                     exact stages integrate with elements of that degree
     uniform         whether the basis needs a uniform grid (:meth:`check_grid` raises otherwise)
-    kernels         the compiled pieces (:class:`Kernels`)
+    kernels         the compiled pieces (:class:`Kernels`), or ``None`` for a basis that runs on the numpy
+                    step only (a researcher's first version, :mod:`mpm_fem.bases.plugins`)
     """
 
     name: str
@@ -96,7 +97,7 @@ class Basis(ABC):
     domain_twin: str
     degree: int
     uniform: bool
-    kernels: Kernels
+    kernels: Kernels | None
 
     @abstractmethod
     def shape(self, grid: Grid, x: np.ndarray, volume: np.ndarray | None = None) -> Shape:
@@ -116,6 +117,13 @@ class Basis(ABC):
         if self.uniform and np.ptp(h) > 1e-9 * h.max():
             raise ValueError(f"the {self.name} basis needs a uniform grid")
 
+    @property
+    def compiled(self) -> bool:
+        """Whether the fused step can take this basis: it and its particle-domain twin ship kernels."""
+        from mpm_fem.bases.registry import get  # the registry imports this module
+
+        return self.kernels is not None and get(self.domain_twin).kernels is not None
+
     def __repr__(self) -> str:
         return f"<basis {self.name}>"
 
@@ -130,7 +138,7 @@ ATTRIBUTES = {
     "domain_twin": (str, "the particle-domain basis of the grid volume reset"),
     "degree": (int, "the polynomial degree of its S_i for the exact stages"),
     "uniform": (bool, "whether it needs a uniform grid"),
-    "kernels": (Kernels, "its compiled Kernels"),
+    "kernels": ((Kernels, type(None)), "its compiled Kernels, or None: the numpy step only"),
 }
 #: the kernels every basis needs; a particle-domain basis needs ``DOMAIN_KERNELS`` too
 KERNELS = ("row", "pass_row", "project")

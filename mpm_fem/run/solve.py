@@ -19,6 +19,7 @@ from typing import Callable
 import numpy as np
 from tqdm.auto import tqdm
 
+from mpm_fem.bases import get as get_basis
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles, PositivityError
 from mpm_fem.core.shape import basis_integrals, make_shape
@@ -61,7 +62,8 @@ class Problem:
 
 @dataclass(frozen=True, eq=False)
 class Result:
-    """Final particles, the grid fields projected from them, and run statistics."""
+    """Final particles, the grid fields projected from them, and run statistics; ``kernel`` the step that
+    ran: ``"fused"`` (compiled) or ``"numpy"``."""
 
     particles: Particles
     grid: Grid
@@ -73,6 +75,7 @@ class Result:
     dt_min: float = 0.0
     dt_max: float = 0.0
     basis: str = "mpm"
+    kernel: str = "numpy"
 
     @property
     def nodal_density(self) -> np.ndarray:
@@ -144,7 +147,8 @@ def run(
     only for the call if it says it keeps none (:func:`_keeps_particles`)."""
     check_kernel(kernel, threads)
     fused = None
-    if kernel == "fused" and supported(problem.model, stages) is None and numpy_only(problem.model, stages) is None:
+    if (kernel == "fused" and supported(problem.model, stages) is None and numpy_only(problem.model, stages) is None
+            and get_basis(stages.basis).compiled):
         fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads,
                           reuse=not _keeps_particles(observer), exact=problem.exact)
     # walls or Dirichlet ends, lumped mass, no observer, and no particle boundary or one that says
@@ -215,4 +219,5 @@ def run(
         dt_min=dt_min if steps else 0.0,
         dt_max=dt_max if steps else 0.0,
         basis=stages.basis,
+        kernel="numpy" if fused is None else "fused",
     )

@@ -1,0 +1,83 @@
+"""A basis from outside the package (issue 45): loaded by ``module:Name`` or an entry point, checked on
+numbers before any run, and run on the numpy step when it has no compiled kernels."""
+
+from __future__ import annotations
+
+from importlib.metadata import EntryPoint
+
+import numpy as np
+import pytest
+
+from mpm_fem.app.cli import main
+from mpm_fem.bases import names, plugins, registry
+from mpm_fem.problems import sod
+
+
+@pytest.fixture(autouse=True)
+def own_registry(monkeypatch):
+    """Each test registers into a copy of the registry: no test's basis leaks into another test."""
+    monkeypatch.setattr(registry, "_BASES", dict(registry._BASES))
+    monkeypatch.setattr(plugins, "_LOADED", {})
+    monkeypatch.setattr(plugins, "_FAILED", {})
+
+
+def test_a_numpy_only_basis_runs_on_the_numpy_step_and_gives_the_point_mass_numbers():
+    assert plugins.resolve("plugin_bases:Hats") == "hats" and "hats" in names()
+    assert plugins.resolve("plugin_bases:Hats") == "hats"  # the same spec again: registered once
+    settings = dict(h=0.05, ppc=2, T=0.02)
+    ours = sod.simulate(sod.SodSettings(basis="hats", **settings), progress=False)
+    reference = sod.simulate(sod.SodSettings(basis="mpm", kernel="numpy", **settings), progress=False)
+    assert ours.kernel == "numpy" and reference.kernel == "numpy" and ours.steps == reference.steps > 5
+    assert np.array_equal(ours.particles.density, reference.particles.density)
+    cost = sod.cost(sod.SodSettings(basis="hats", **settings))
+    assert cost.kernel == "numpy" and sod.cost(sod.SodSettings(**settings)).kernel == "fused"
+
+
+def test_a_basis_with_kernels_that_agree_passes_every_check():
+    assert plugins.verify(__import__("plugin_bases").HatsCompiled()) is None
+    assert plugins.resolve("plugin_bases:HatsCompiled") == "hats_compiled"
+
+
+@pytest.mark.parametrize("name, check", [
+    ("Heavy", "no partition of unity: |sum_i S_ip - 1| up to 0.01"),
+    ("NotFinite", "weights S_ip or G_ip are not finite"),
+    ("Ragged", "its rows have shapes"),
+    ("WrongKernel", "its compiled row differs from its numpy rows"),
+    ("Nameless", "lacks the base class Basis"),
+    ("NOT_A_CLASS", "lacks the base class Basis"),
+    ("Missing", "cannot be loaded"),
+])
+def test_a_basis_that_breaks_its_contract_is_refused_naming_the_check(name, check, capsys):
+    with pytest.raises(plugins.ContractError, match="plugin_bases:" + name):
+        plugins.resolve(f"plugin_bases:{name}")
+    before = set(names())
+    with pytest.raises(SystemExit) as stop:
+        main(["sod", "--basis", f"plugin_bases:{name}", "--h", "0.1", "--quiet"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert check in err and "\n" not in err, err
+    assert set(names()) == before  # nothing registered
+
+
+def test_entry_points_register_their_bases_and_a_broken_one_refuses_only_itself(monkeypatch):
+    found = [EntryPoint("hats_ep", "plugin_bases:Hats", plugins.ENTRY_POINT_GROUP),
+             EntryPoint("heavy_ep", "plugin_bases:Heavy", plugins.ENTRY_POINT_GROUP)]
+    monkeypatch.setattr(plugins, "entry_points", lambda group: [e for e in found if e.group == group])
+    assert plugins.discover() == ("hats",)
+    assert "hats" in names() and "heavy" not in names()
+    assert plugins.resolve("hats") == "hats"
+    with pytest.raises(plugins.ContractError, match="no partition of unity"):
+        plugins.resolve("heavy_ep")
+    with pytest.raises(ValueError, match="unknown basis 'cubic5'"):
+        plugins.resolve("cubic5")
+
+
+def test_the_command_line_runs_a_spec_and_says_which_kernel_ran(tmp_path, capsys):
+    import json
+
+    out = tmp_path / "run"
+    assert main(["sod", "--basis", "plugin_bases:Hats", "--h", "0.1", "--ppc", "2", "--T", "0.01", "--out",
+                 str(out)]) == 0
+    assert "on the numpy step: the basis hats has no compiled kernels" in capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["kernel"] == "numpy" and summary["settings"]["basis"] == "hats"
