@@ -57,7 +57,7 @@ def _without(cls, **changed):
     ({"kernels": Point.kernels._replace(project=None)}, "kernels.project (a compiled function)"),
     ({"kernels": Point.kernels._replace(row=lambda *a: a)}, "kernels.row (a compiled function)"),
     ({"domain": True}, "kernels.scalars (a compiled function); kernels.column (a compiled function)"),
-    ({"kernels": (1, 2, 3)}, "kernels (its compiled Kernels)"),
+    ({"kernels": (1, 2, 3)}, "kernels (its compiled Kernels, or None: the numpy step only)"),
 ])
 def test_registration_refuses_a_basis_missing_a_piece_and_names_the_piece(change, piece):
     incomplete = _without(_Cubic, **change)()

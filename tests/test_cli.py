@@ -51,7 +51,7 @@ BAD = [
     (["sod", "--cfl", "0"], "CFL"),
     (["sod", "--cfl", "1.5"], "CFL"),
     (["sod", "--mass", "diagonal"], "invalid choice"),
-    (["sod", "--basis", "bspline9"], "invalid choice"),
+    (["sod", "--basis", "bspline9"], "unknown basis 'bspline9'; choose one of mpm, gimp"),
     (["sod", "--h", "abc"], "invalid float"),
     (["burgers", "--eps", "0"], "eps must be positive"),
     (["burgers", "--eps", "-0.1"], "eps must be positive"),

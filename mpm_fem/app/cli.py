@@ -25,7 +25,7 @@ from mpm_fem.app import guard, output
 from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.guard import UsageError
 from mpm_fem.app.study import add_study_options, add_tier_options, start_study, study_options
-from mpm_fem.bases import get, names, plugins
+from mpm_fem.bases import compiled, get, names, plugins
 from mpm_fem.core.grid import GridError
 from mpm_fem.core.particles import LAYOUTS
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS
@@ -197,7 +197,7 @@ def _prepare(args, problem: str, module, settings_cls):
         raise UsageError(str(err)) from None
     if not args.quiet:
         slower = (f" on the numpy step: the basis {settings.basis} has no compiled kernels"
-                  if cost.kernel == "numpy" and settings.kernel == "fused" and not get(settings.basis).compiled else "")
+                  if cost.kernel == "numpy" and settings.kernel == "fused" and not compiled(settings.basis) else "")
         print(f"{problem}: {guard.describe(cost)}{slower}", file=sys.stderr)
     return settings, cost, out
 

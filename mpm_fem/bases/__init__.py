@@ -19,7 +19,7 @@ from mpm_fem.bases.bspline_gimp import BSplineGimp
 from mpm_fem.bases.contract import Basis, Kernels
 from mpm_fem.bases.gimp import Gimp
 from mpm_fem.bases.point import Point
-from mpm_fem.bases.registry import IncompleteBasisError, get, names, register
+from mpm_fem.bases.registry import IncompleteBasisError, compiled, get, names, register
 from mpm_fem.bases.shape import OutsideGridError, Shape, locate
 
 register(Point())
@@ -27,5 +27,5 @@ register(Gimp())
 register(BSpline())
 register(BSplineGimp())
 
-__all__ = ["Basis", "IncompleteBasisError", "Kernels", "OutsideGridError", "Shape", "get", "locate", "names",
-           "register"]
+__all__ = ["Basis", "IncompleteBasisError", "Kernels", "OutsideGridError", "Shape", "compiled", "get", "locate",
+           "names", "register"]

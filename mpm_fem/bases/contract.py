@@ -117,13 +117,6 @@ class Basis(ABC):
         if self.uniform and np.ptp(h) > 1e-9 * h.max():
             raise ValueError(f"the {self.name} basis needs a uniform grid")
 
-    @property
-    def compiled(self) -> bool:
-        """Whether the fused step can take this basis: it and its particle-domain twin ship kernels."""
-        from mpm_fem.bases.registry import get  # the registry imports this module
-
-        return self.kernels is not None and get(self.domain_twin).kernels is not None
-
     def __repr__(self) -> str:
         return f"<basis {self.name}>"
 

@@ -44,3 +44,10 @@ def get(name: str | Basis) -> Basis:
 def names() -> tuple[str, ...]:
     """The registered bases' names, in the order they were registered."""
     return tuple(_BASES)
+
+
+def compiled(name: str | Basis) -> bool:
+    """Whether the fused step can take the basis ``name``: it and its particle-domain twin (the grid
+    volume reset's) ship compiled kernels; a basis without them runs on the numpy step."""
+    basis = get(name)
+    return basis.kernels is not None and get(basis.domain_twin).kernels is not None

@@ -10,7 +10,7 @@ from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 
-from mpm_fem.bases import get as get_basis
+from mpm_fem.bases import compiled
 from mpm_fem.core.grid import n_cells_for
 from mpm_fem.core.particles import LAYOUTS
 from mpm_fem.core.step import Stages, StageSwitches
@@ -99,7 +99,7 @@ def run_cost(settings, domain: tuple[float, float], max_speed: float, dt_cap: fl
     steps = math.ceil(ratio)
     stages = settings.stages
     fused = (settings.kernel == "fused" and not (stages.uses_exact_fields or stages.reconstruct != "none")
-             and get_basis(stages.basis).compiled)  # a basis without compiled kernels: the numpy step
+             and compiled(stages.basis))  # a basis without compiled kernels: the numpy step
     return Cost(particles=n_cells * settings.ppc, nodes=n_cells + 1, steps=steps, kernel="fused" if fused else "numpy")
 
 

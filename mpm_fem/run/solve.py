@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 from tqdm.auto import tqdm
 
-from mpm_fem.bases import get as get_basis
+from mpm_fem.bases import compiled
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles, PositivityError
 from mpm_fem.core.shape import basis_integrals, make_shape
@@ -148,7 +148,7 @@ def run(
     check_kernel(kernel, threads)
     fused = None
     if (kernel == "fused" and supported(problem.model, stages) is None and numpy_only(problem.model, stages) is None
-            and get_basis(stages.basis).compiled):
+            and compiled(stages.basis)):
         fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads,
                           reuse=not _keeps_particles(observer), exact=problem.exact)
     # walls or Dirichlet ends, lumped mass, no observer, and no particle boundary or one that says
