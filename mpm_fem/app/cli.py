@@ -160,6 +160,17 @@ def build_parser() -> argparse.ArgumentParser:
                                "prints the estimate first. A folder holds one tier: a folder with tables of another "
                                "tier is refused unless --overwrite.")
     add_tier_options(reproduce, "quick")
+    method = sub.add_parser("method", help="a basis (yours: package.module:Name or an entry point) beside the "
+                            "package's: projection orders, Sod and Burgers convergence, the study's verdicts",
+                            description="Measure one basis beside mpm, gimp, bspline and bspline_gimp: the "
+                            "projection orders on regular and jittered particles, Sod's and Burgers' convergence at "
+                            "the study's settings over seeds, and the verdicts M1-M3 (METHOD.md), into "
+                            "OUT/method/<basis>/ (default runs/); prints the estimate first; cases are cached.")
+    method.add_argument("basis", help="a registered basis, an installed entry point's, or package.module:Name")
+    method.add_argument("--full", action="store_true", help="finer meshes and five seeds (the quick plan otherwise)")
+    method.add_argument("--jobs", type=int, default=None, help="worker processes (default: the cores, at most 8)")
+    method.add_argument("--out", default="runs", help="folder holding method/<basis>/ (default: runs)")
+    method.add_argument("--quiet", action="store_true", help="no estimate or progress output")
     add_study_options(reproduce, quick_flag=False,
                        out_help="figures folder (default: figures/quick, figures or figures/deep by tier)")
     return parser
@@ -313,7 +324,25 @@ def cmd_reproduce(args) -> dict:
     return {"line": f"report written to {path}"}
 
 
-COMMANDS = {"sod": cmd_sod, "burgers": cmd_burgers, "study": cmd_study, "reproduce": cmd_reproduce}
+def cmd_method(args) -> dict:
+    import importlib
+
+    from mpm_fem.app.study import StudyOptions
+
+    study = importlib.import_module("studies.method")  # the top layer, loaded by name (app.study)
+    try:
+        basis = plugins.resolve(args.basis)
+    except (ValueError, TypeError) as err:
+        raise UsageError(str(err)) from None
+    options = StudyOptions(quick=not args.full, jobs=guard.cap_jobs(args.jobs), out=Path(args.out),
+                           progress=False if args.quiet else None)
+    if not args.quiet:
+        print(f"method {basis}: {study.describe_estimate(basis, args.basis, options)}", file=sys.stderr)
+    return {"line": f"verdicts written to {study.run(args.basis, options)}"}
+
+
+COMMANDS = {"sod": cmd_sod, "burgers": cmd_burgers, "study": cmd_study, "reproduce": cmd_reproduce,
+            "method": cmd_method}
 
 
 def main(argv=None) -> int:
