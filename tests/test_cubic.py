@@ -85,7 +85,7 @@ def test_c2_across_the_nodes():
     nodes = GRID.nodes[1:-1]
     S_l, S_r = _dense(nodes - d), _dense(nodes + d)
     G_l, G_r = _dense(nodes - d, True), _dense(nodes + d, True)
-    assert np.abs(S_r - S_l).max() < 2 * d / H  # |G| <= 1/(2h)... continuous value
+    assert np.abs(S_r - S_l).max() < 2 * d / H  # continuous value (|G| <= 1/(2h))
     assert np.abs(G_r - G_l).max() < 4 * d / H**2  # continuous slope (|S''| <= 2/h^2)
     e = 1e-4
     curvature_l = (_dense(nodes - e, True) - _dense(nodes - 2 * e, True)) / e
