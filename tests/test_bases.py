@@ -20,23 +20,32 @@ from mpm_fem.core.shape import basis_integrals, make_shape
 from mpm_fem.core.step import Stages, Walls
 
 
-def test_the_registry_lists_the_four_bases_and_refuses_an_unknown_name_listing_the_known():
-    assert names() == ("mpm", "gimp", "bspline", "bspline_gimp")
+def test_the_registry_lists_the_five_bases_and_refuses_an_unknown_name_listing_the_known():
+    assert names() == ("mpm", "gimp", "bspline", "bspline_gimp", "cubic")
     assert all(get(name).name == name and get(get(name)) is get(name) for name in names())
-    with pytest.raises(ValueError, match="unknown basis 'cubic'; choose one of mpm, gimp, bspline, bspline_gimp"):
-        get("cubic")
+    with pytest.raises(ValueError,
+                       match="unknown basis 'quartic'; choose one of mpm, gimp, bspline, bspline_gimp, cubic"):
+        get("quartic")
     with pytest.raises(ValueError, match="unknown basis"):
-        make_shape(uniform_grid(0.0, 1.0, 0.1), np.array([0.5]), basis="cubic")
-    with pytest.raises(ValueError, match="unknown basis 'cubic'"):
-        Stages(basis="cubic")
+        make_shape(uniform_grid(0.0, 1.0, 0.1), np.array([0.5]), basis="quartic")
+    with pytest.raises(ValueError, match="unknown basis 'quartic'"):
+        Stages(basis="quartic")
 
 
 def test_each_basis_names_a_registered_point_basis_and_particle_domain_twin():
+    """Each basis names its point basis and its particle-domain twin; a point basis without a
+    particle-domain basis over its functions yet (the cubic B-splines) names itself, and the grid
+    volume reset, which needs the twin, is refused for it."""
     for basis in map(get, names()):
         functions, twin = get(basis.grid_functions), get(basis.domain_twin)
         assert not functions.domain and functions.grid_functions == functions.name, basis
-        assert twin.domain and twin.grid_functions == basis.grid_functions and twin.domain_twin == twin.name, basis
+        assert twin.grid_functions == basis.grid_functions and twin.domain_twin == twin.name, basis
+        assert twin.domain or twin is basis, basis
         assert (basis.name == functions.name) != basis.domain, basis
+        if not twin.domain:
+            with pytest.raises(ValueError, match=f"the basis {basis.name} has no particle-domain twin"):
+                Stages(basis=basis.name, volume="grid")
+    assert [b for b in names() if not get(get(b).domain_twin).domain] == ["cubic"]
 
 
 class _Cubic(Point):
@@ -81,7 +90,7 @@ def test_registration_refuses_a_basis_without_numpy_rows_or_base_class_and_a_nam
         register(object())
     with pytest.raises(ValueError, match="registered already"):
         register(_without(_Cubic, name="gimp")())
-    assert names() == ("mpm", "gimp", "bspline", "bspline_gimp")
+    assert names() == ("mpm", "gimp", "bspline", "bspline_gimp", "cubic")
 
 
 def test_a_complete_basis_registers_and_is_read_everywhere_by_its_name(monkeypatch):
@@ -179,7 +188,7 @@ def test_an_unknown_basis_never_reaches_the_kernel():
 
     grid = uniform_grid(0.0, 1.0, 0.1)
     with pytest.raises(ValueError, match="unknown basis"):
-        fused.FusedStep(grid, IdealGas(), Walls(), Stages(basis="cubic"))
+        fused.FusedStep(grid, IdealGas(), Walls(), Stages(basis="quartic"))
     for bad in (0, 3, "gimp", _Cubic(), object()):
         with pytest.raises(ValueError, match="registered basis"):
             _basis_globals({"BASIS": bad})

@@ -3,9 +3,10 @@ against the particle mass matrix on Gauss points, an exact matrix, and where the
 
 import numpy as np
 import pytest
-from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine, asm
+import scipy.sparse as sp
+from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, ElementLinePp, MeshLine, asm
 
-from mpm_fem.bases import names
+from mpm_fem.bases import get, names
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.shape import make_shape
@@ -45,12 +46,19 @@ def rebuilt_fe_mass(grid, basis, fields, t):
     """The FE mass as scikit-fem assembles it from scratch: a ``Basis`` on the pieces split at the
     nodes, half cells and breakpoints, the form ``rho u v``, and ``M = E^T M_pieces E`` with
     ``E_ki = S_i(y_k)`` at the degrees of freedom (the grid functions are polynomials on a piece)."""
-    kernel = "bspline" if basis.startswith("bspline") else "mpm"
+    kernel, degree = get(basis).grid_functions, get(get(basis).grid_functions).degree
     edges = _pieces(grid, fields.breakpoints(t))
-    pieces = Basis(MeshLine(edges), ElementLineP2() if kernel == "bspline" else ElementLineP1(), intorder=9)
-    rho = fields.integrand(np.asarray(pieces.global_coordinates()[0]).ravel(), t)[0].reshape(pieces.nelems, -1)
+    element = {1: ElementLineP1, 2: ElementLineP2}.get(degree, lambda: ElementLinePp(degree))()
+    pieces = Basis(MeshLine(edges), element, intorder=9)
+    x = np.asarray(pieces.global_coordinates()[0]).ravel()
+    rho = fields.integrand(x, t)[0].reshape(pieces.nelems, -1)
     y = pieces.doflocs[0]
-    E = make_shape(grid, y, np.zeros_like(y), kernel).matrix()
+    if np.all(np.isfinite(y)):  # nodal: E_ki = S_i(y_k)
+        E = make_shape(grid, y, np.zeros_like(y), kernel).matrix()
+    else:  # ElementLinePp's hierarchical dofs: E from S_i(x_q) = sum_k E_ki phi_k(x_q), exact on the pieces
+        phi = pieces.probes(x[None, :]).toarray()
+        E = sp.csr_matrix(np.linalg.lstsq(phi, make_shape(grid, x, np.zeros_like(x), kernel).matrix().toarray(),
+                                          rcond=None)[0])
     return (E.T @ asm(_density_mass, pieces, rho=rho) @ E).tocsr()
 
 
@@ -66,8 +74,8 @@ def test_the_operator_built_once_equals_scikit_fem_assembling_from_scratch(basis
         want = rebuilt_fe_mass(grid, basis, fields, time)
         gap = np.abs((M - want).toarray()).max()
         assert gap < 1e-14 * np.abs(want.toarray()).max(), f"t = {time}: largest difference {gap:.2e}"
-    assert fe_mass_operator(grid, "bspline" if basis.startswith("bspline") else "mpm") is \
-        fe_mass_operator(grid, "bspline" if basis.startswith("bspline") else "mpm")  # built once
+    kernel = get(basis).grid_functions
+    assert fe_mass_operator(grid, kernel) is fe_mass_operator(grid, kernel)  # built once
 
 
 @pytest.mark.parametrize("basis", names())
@@ -79,7 +87,7 @@ def test_scikit_fem_mass_equals_the_particle_matrix_on_gauss_points(basis, case)
     grid = uniform_grid(0.0, 1.0, 0.05)
     M, m = fe_mass(grid, basis, fields, t)
     x, w = quadrature(grid, fields.breakpoints(t))
-    kernel = "bspline" if basis.startswith("bspline") else "mpm"
+    kernel = get(basis).grid_functions
     particles = particle_mass_matrix(make_shape(grid, x, w, kernel), w * fields.integrand(x, t)[0])
     gap = np.abs((M - particles).toarray()).max()
     assert gap < 1e-14 * np.abs(M).max(), f"largest difference {gap:.2e}"

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from mpm_fem.bases import names
+from mpm_fem.bases import get, names
 from mpm_fem.core.grid import grid_from_nodes, uniform_grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
@@ -61,7 +61,7 @@ def _burgers_inflow(x, t):
 
 def _case(model, boundary, steps=STEPS, basis="mpm"):
     """(problem, particles) of ``steps`` fixed steps for the model and boundary named."""
-    regular = boundary == "walls" and basis.startswith("bspline")
+    regular = boundary == "walls" and get(basis).uniform
     if model == "gas":
         problem = dict(model=IdealGas(), T=steps * 1e-3, cfl=1.0, dt=1e-3)
         particles = _gas_particles(regular)
@@ -202,10 +202,10 @@ def test_a_grid_not_uniform_to_round_off_keeps_the_node_arithmetic_bit_for_bit(b
     stretched = grid_from_nodes(np.linspace(0.0, 1.0, 11) ** 1.2)
     nearly = grid_from_nodes(np.linspace(0.0, 1.0, 11) * (1 + 1e-8 * np.sin(np.arange(11.0))))
     assert stretched.uniform_spacing is None and nearly.uniform_spacing is not None
-    grids = (_drifting_grid(),) if basis.startswith("bspline") else (stretched, nearly)
+    grids = (_drifting_grid(),) if get(basis).uniform else (stretched, nearly)
     for grid in grids:
         assert FusedStep(grid, IdealGas(), Walls()).inv_spacing == 0.0  # the node arithmetic
-        x, V = seed_positions(grid, 4, "regular" if basis.startswith("bspline") else "jittered", seed=3)
+        x, V = seed_positions(grid, 4, "regular" if get(basis).uniform else "jittered", seed=3)
         rho = 1.0 + 0.1 * np.sin(2 * np.pi * x)
         particles = make_particles(x, V, rho, 0.05 * np.sin(np.pi * x), rho**0.4 / 0.4, rho**1.4)
         problem = Problem(model=IdealGas(), boundary=Walls(), T=0.2, cfl=1.0, dt=1e-3)

@@ -26,7 +26,7 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from mpm_fem.bases import names
+from mpm_fem.bases import get, names
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force
@@ -103,6 +103,9 @@ class Stages(StageSwitches):
                                        or self.volume != "carried"):
             raise ValueError("the remedies flip, xpic, reconstruct and volume run with the MPM stages only "
                              "(the basis bspline_gimp also with the exact stages)")
+        if self.volume == "grid" and not get(get(self.basis).domain_twin).domain:
+            raise ValueError(f"the grid volume reset averages the grid functions over the particle domains: the "
+                             f"basis {self.basis} has no particle-domain twin")
         if self.uses_exact_fields and self.volume_rate != "point":
             raise ValueError("the volume rate over the particle domain runs with the MPM stages only")
 

@@ -3,7 +3,7 @@
     M_ij = int rho S_i S_j dx      (n_nodes, n_nodes), sparse, symmetric to round-off,
     m_i  = sum_j M_ij = int rho S_i dx      (the grid functions sum to 1),
 
-with ``S_i`` the grid functions (P1 hats, or the quadratic B-splines) and ``rho`` the density of the
+with ``S_i`` the grid functions (P1 hats, the quadratic or the cubic B-splines) and ``rho`` the density of the
 problem's :class:`~mpm_fem.exact_stages.fields.ExactFields` at time ``t``. The integrals are
 scikit-fem's, on the pieces of :mod:`mpm_fem.exact_stages.quadrature` (nodes, half cells and the
 breakpoints) with ``GAUSS_POINTS`` points each: exact to round-off for piecewise-polynomial
@@ -137,7 +137,10 @@ def fe_mass_operator(grid: Grid, functions: str) -> FEMass:
                           np.concatenate([np.repeat(d, GAUSS_POINTS) for d in pieces.element_dofs]))),
                         shape=(n, pieces.N))
     y = pieces.doflocs[0]
-    S = (phi @ make_shape(grid, y, np.zeros_like(y), functions).matrix()).tocsr()  # S_qi = S_i(x_q)
+    if np.all(np.isfinite(y)):  # a nodal element (P1, P2): S_qi = S_i(x_q) through its functions
+        S = (phi @ make_shape(grid, y, np.zeros_like(y), functions).matrix()).tocsr()
+    else:  # ElementLinePp (degree > 2): its interior dofs are not point values; S_qi = S_i(x_q) directly
+        S = make_shape(grid, points.ravel(), np.zeros(n), functions).matrix().tocsr()
     S.sort_indices()
     # the nonzeros of each row q padded to k columns (a repeated column with value 0)
     counts = np.diff(S.indptr)
