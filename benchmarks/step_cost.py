@@ -42,7 +42,7 @@ from mpm_fem.run.solve import Problem
 
 BASES = names()  # every registered basis
 # particle-steps/s of the fused loop at 1e6 particles, one thread (uniform-grid arithmetic in every basis)
-RATE_TARGETS = {"mpm": 3e7, "gimp": 2e7, "bspline": 2.5e7, "bspline_gimp": 1e7}
+RATE_TARGETS = {"mpm": 3e7, "gimp": 2e7, "bspline": 2.5e7, "bspline_gimp": 1e7, "cubic": 2e7}
 PPC = 4
 ANCHOR_BYTES = 6 * 8 + 5 * 8  # the anchor reads x, v, rho, eps, s, m and writes all but m
 STATE_FIELDS = ("x", "volume", "mass", "velocity", "density", "energy", "pressure")

@@ -240,4 +240,4 @@ def _e2(t: Tables) -> Finding:
 
 
 _BASIS_NAMES = {"mpm": "P1", "gimp": "GIMP", "bspline": "the C1 B-spline",
-                "bspline_gimp": "the particle-domain B-spline"}
+                "bspline_gimp": "the particle-domain B-spline", "cubic": "the C2 cubic B-spline"}
