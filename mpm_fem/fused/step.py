@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from mpm_fem.bases import get
+from mpm_fem.bases.contract import Cloud, RowStore
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
@@ -358,8 +359,8 @@ class FusedStep:
             rows_n = n if store else 0
             rows, S, G = (empty("rows", (rows_n, self.K), self._index), empty("S", (rows_n, self.K)),
                           empty("G", (rows_n, self.K)))
-            self.project(self.nodes, self.h, self.inv_spacing, x, V, m, v, p, gas_force, store, chunks,
-                         rows, S, G, cell, m_i, P_i, F_i, flags)
+            self.project(Geometry(self.nodes, self.h, self.inv_spacing), Cloud(x, V, m, v, p), gas_force, store,
+                         chunks, RowStore(rows, S, G, cell), m_i, P_i, F_i, flags)
             if (flags[:, :2] >= 0).any():
                 make_shape(grid, x, V, self.stages.basis)  # raises the numpy step's error
                 raise ValueError("a particle lies outside the grid or has no volume")  # not reached
