@@ -46,6 +46,7 @@ from mpm_fem.fused.codes import (
     USF,
     USL,
 )
+from mpm_fem.fused.remedies import Quadrature, Reset, State
 from mpm_fem.fused.sums import _divide_by_lumped
 
 # placeholders: each variant has its own (mpm_fem.fused.compiler)
@@ -221,6 +222,7 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     cell, rows, S, G, grid, flags, upd, values, speeds, reset, sums = scratch
     stored = RowStore(rows, S, G, cell)
     xpic, volume_width, integrals, points, G_q, weights, offsets = remedies
+    quadrature = Quadrature(points, G_q, weights, offsets)
     n = cell.size
     gas = MODEL == GAS
     eps = consts[IEPS]
@@ -263,9 +265,9 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
             _set_ends(ends, g_t, v_i)
         if VOLUME_ON:  # the volume reset, then the force of the reset state
             V_i = _nodal_rows(XPIC_ON, 0)  # its V_i and ratio follow XPIC's arrays
-            VOLUME(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks,
-                   WIDTH if store else volume_width, grid[V_i], grid[V_i + 1], reset[0, 0, :n], reset[0, 1, :n],
-                   reset[0, 2, :n], upd, values)
+            VOLUME(geometry, stored, State(x, V, m, rho, e, p), integrals, consts, chunks,
+                   WIDTH if store else volume_width,
+                   Reset(grid[V_i], grid[V_i + 1], reset[0, 0, :n], reset[0, 1, :n], reset[0, 2, :n]), upd, values)
             wide = 0
             for k in range(chunks):
                 wide = max(wide, upd[k, 1])
@@ -284,8 +286,7 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
         elif not gas and not exact and not TAYLOR_ON:
             VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, V, eps, chunks, F_i)
         if TAYLOR_ON and not exact:
-            TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if SCHEME == USF else p, v_i, eps, points, G_q,
-                   weights, offsets, chunks, sums, F_i)
+            TAYLOR(geometry, x, stored, p_n if SCHEME == USF else p, v_i, eps, quadrature, chunks, sums, F_i)
         if exact:
             row = _tabled(times, t) if accelerations.shape[0] else -1
             if row >= 0:
