@@ -148,7 +148,8 @@ def test_layer_two_packages_import_in_their_order():
     found = upward(graph())
     assert not found, "\n".join(found)
     order = sorted((p for p in FOLDERS if FOLDERS[p][0] == 2), key=FOLDERS.get)
-    assert order[:3] == ["mpm_fem.core.grid", "mpm_fem.bases", "mpm_fem.core"] and order[-3:] == ["mpm_fem.fused", "mpm_fem.run", "mpm_fem.problems"], order
+    assert order[:3] == ["mpm_fem.core.grid", "mpm_fem.bases", "mpm_fem.core"], order
+    assert order[-3:] == ["mpm_fem.fused", "mpm_fem.run", "mpm_fem.problems"], order
 
 
 def test_the_order_check_finds_the_time_loop_in_the_core():
