@@ -201,11 +201,14 @@ def _row(nodes, h, inv_spacing, x, V, row, S, G):
 
 
 @njit(cache=True, inline="always")
-def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi, rows, S, G, cell, buf):
+def _project(geometry, cloud, gas_force, store, lo, hi, stored, buf):
     """Pass 1 over particles ``lo .. hi-1`` on a uniform grid (:class:`~mpm_fem.bases.contract.Kernels`;
     the rows are stored whatever ``store``): each row from scalars (:func:`_scalars`, then
     :func:`_column`, or for five columns :func:`_five_columns`) stored and added at once to ``buf``
     (:func:`~mpm_fem.bases.cells.put`), in the loop that builds it."""
+    nodes, h, inv_spacing = geometry
+    x, V, m, v, p = cloud
+    rows, S, G, cell = stored
     n_nodes = nodes.size
     K = rows.shape[1]
     last = n_nodes - 1
@@ -229,15 +232,15 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi, row
         if K == 5:
             S0, S1, S2, S3, S4, G0, G1, G2, G3, G4 = _five_columns(inv_spacing, D)
             first = D[2] - 1  # the columns' nodes c_- - 1 + j, ghosts folded into the end nodes
-            put(q, 0, min(max(first, 0), last), S0, G0, mq, mv, Vp, gas_force, rows, S, G, buf)
-            put(q, 1, min(max(first + 1, 0), last), S1, G1, mq, mv, Vp, gas_force, rows, S, G, buf)
-            put(q, 2, min(first + 2, last), S2, G2, mq, mv, Vp, gas_force, rows, S, G, buf)
-            put(q, 3, min(first + 3, last), S3, G3, mq, mv, Vp, gas_force, rows, S, G, buf)
-            put(q, 4, min(first + 4, last), S4, G4, mq, mv, Vp, gas_force, rows, S, G, buf)
+            put(q, 0, min(max(first, 0), last), S0, G0, (mq, mv, Vp), gas_force, rows, S, G, buf)
+            put(q, 1, min(max(first + 1, 0), last), S1, G1, (mq, mv, Vp), gas_force, rows, S, G, buf)
+            put(q, 2, min(first + 2, last), S2, G2, (mq, mv, Vp), gas_force, rows, S, G, buf)
+            put(q, 3, min(first + 3, last), S3, G3, (mq, mv, Vp), gas_force, rows, S, G, buf)
+            put(q, 4, min(first + 4, last), S4, G4, (mq, mv, Vp), gas_force, rows, S, G, buf)
             continue
         for j in range(K):
             i, Sj, Gj = _column(j, inv_spacing, last, D)
-            put(q, j, i, Sj, Gj, mq, mv, Vp, gas_force, rows, S, G, buf)
+            put(q, j, i, Sj, Gj, (mq, mv, Vp), gas_force, rows, S, G, buf)
     return outside, empty, need
 
 

@@ -58,9 +58,11 @@ def stored_row(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl):
 
 
 @njit(cache=True, inline="always")
-def put(q, j, i, Sj, Gj, mq, mv, Vp, gas_force, rows, S, G, buf):
+def put(q, j, i, Sj, Gj, weights, gas_force, rows, S, G, buf):
     """Column ``j`` (node ``i``) of particle ``q``'s row stored, and its pass-1 terms added to the
-    chunk's ``buf``: ``m_p S_ij``, ``m_p v_p S_ij`` and, if ``gas_force``, ``V_p p_p G_ij``."""
+    chunk's ``buf``: ``m_p S_ij``, ``m_p v_p S_ij`` and, if ``gas_force``, ``V_p p_p G_ij``, with the
+    particle's ``weights = (m_p, m_p v_p, V_p p_p)``."""
+    mq, mv, Vp = weights
     rows[q, j], S[q, j], G[q, j] = i, Sj, Gj
     buf[0, i] += Sj * mq
     buf[1, i] += Sj * mv

@@ -27,6 +27,34 @@ if TYPE_CHECKING:
     from mpm_fem.core.grid import Grid
 
 
+class Geometry(NamedTuple):
+    """The grid as the compiled kernels and passes read it."""
+
+    nodes: np.ndarray  # x_i (n_nodes,)
+    h: np.ndarray  # (2, n_cells): the cell sizes h_c and 1 / h_c
+    inv_spacing: float  # 1/h on a grid uniform to round-off, else 0 (the node arithmetic)
+
+
+class Cloud(NamedTuple):
+    """The particle arrays pass 1 reads (n_p,): position, volume, mass, velocity, pressure."""
+
+    x: np.ndarray
+    V: np.ndarray
+    m: np.ndarray
+    v: np.ndarray
+    p: np.ndarray
+
+
+class RowStore(NamedTuple):
+    """Pass 1's store: the particles' rows (node indices, ``S_ip``, ``G_ip``; (n_p, K), or no rows
+    where they are not stored) and their cells (n_p,)."""
+
+    rows: np.ndarray
+    S: np.ndarray
+    G: np.ndarray
+    cell: np.ndarray
+
+
 class Kernels(NamedTuple):
     """A basis's compiled pieces: numba functions (``njit(inline="always")``) that the fused step's
     variants take as compile-time globals (:mod:`mpm_fem.fused.compiler`), so that a variant holds
@@ -42,13 +70,15 @@ class Kernels(NamedTuple):
               in the passes after pass 1: recomputed from ``x[q]`` (a point basis: the same
               numbers, and cheaper than reading them back) or read from pass 1's store ``rows``,
               ``S``, ``G``, ``cell`` (a particle-domain basis: :func:`mpm_fem.bases.cells.stored_row`).
-    project   ``(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi, rows, S, G, cell,
-              buf) -> (outside, empty, K_needed)``: pass 1 over particles ``lo .. hi-1`` into the
-              chunk's buffer ``buf`` (3, n_nodes): ``m_p S_ip``, ``m_p v_p S_ip`` and, if
-              ``gas_force``, ``V_p p_p G_ip``, each node's terms added in particle order, a row's
-              nodes left to right (the numpy step's ``np.bincount`` order); the cells into ``cell``,
-              the rows into ``rows``, ``S``, ``G`` if ``store``; returns the first particle outside
-              the grid, the first without volume (-1 if none) and the columns the rows need.
+    project   ``(geometry, cloud, gas_force, store, lo, hi, stored, buf) -> (outside, empty,
+              K_needed)``: pass 1 over particles ``lo .. hi-1`` (``geometry``: :class:`Geometry`,
+              the grid's ``nodes``, ``h``, ``inv_spacing``; ``cloud``: :class:`Cloud`, the
+              particles' ``x``, ``V``, ``m``, ``v``, ``p``) into the chunk's buffer ``buf`` (3,
+              n_nodes): ``m_p S_ip``, ``m_p v_p S_ip`` and, if ``gas_force``, ``V_p p_p G_ip``, each
+              node's terms added in particle order, a row's nodes left to right (the numpy step's
+              ``np.bincount`` order); into ``stored`` (:class:`RowStore`) the cells, and the rows
+              ``rows``, ``S``, ``G`` if ``store``; returns the first particle outside the grid, the
+              first without volume (-1 if none) and the columns the rows need.
     any_grid  whether ``project`` and ``move`` serve a grid that is not uniform too (else the fused
               step calls them only where ``inv_spacing > 0`` and takes ``row`` elsewhere).
     move      ``(nodes, h, inv_spacing, x, a_i, v_n) -> (c, sum_i S_ip a_i, sum_i S_ip v_n,i,

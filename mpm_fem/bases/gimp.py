@@ -160,10 +160,13 @@ def _row(nodes, h, inv_spacing, x, V, row, S, G):
 
 
 @njit(cache=True, inline="always")
-def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi, rows, S, G, cell, buf):
+def _project(geometry, cloud, gas_force, store, lo, hi, stored, buf):
     """Pass 1 over particles ``lo .. hi-1`` on a uniform grid (:class:`~mpm_fem.bases.contract.Kernels`;
     the rows are stored whatever ``store``): each row from scalars (:func:`_scalars`, :func:`_column`)
     stored and added at once to ``buf`` (:func:`~mpm_fem.bases.cells.put`), in the loop that builds it."""
+    nodes, h, inv_spacing = geometry
+    x, V, m, v, p = cloud
+    rows, S, G, cell = stored
     n_nodes = nodes.size
     K = rows.shape[1]
     last = n_nodes - 1
@@ -186,7 +189,7 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi, row
         Vp = V[q] * p[q]
         for j in range(K):
             i, Sj, Gj = _column(j, inv_spacing, last, D)
-            put(q, j, i, Sj, Gj, mq, mv, Vp, gas_force, rows, S, G, buf)
+            put(q, j, i, Sj, Gj, (mq, mv, Vp), gas_force, rows, S, G, buf)
     return outside, empty, need
 
 

@@ -67,11 +67,14 @@ def _pass_row(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl):
 
 
 @njit(cache=True, inline="always")
-def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi, rows, S, G, cell, buf):
+def _project(geometry, cloud, gas_force, store, lo, hi, stored, buf):
     """Pass 1 over particles ``lo .. hi-1`` (:class:`~mpm_fem.bases.contract.Kernels`): each node's
     terms added in particle order, but a cell's two node sums kept in registers while consecutive
     particles share the cell (sorted particles: ``ppc`` in a row) and written back to ``buf`` when
     the cell changes: one load and store per cell instead of one per term."""
+    nodes, h, inv_spacing = geometry
+    x, V, m, v, p = cloud
+    rows, S, G, cell = stored
     n_nodes = nodes.size
     a, b = nodes[0], nodes[n_nodes - 1]
     outside, held = -1, -1  # held: the cell whose node sums are in registers

@@ -154,25 +154,29 @@ def _spliced(fixed, sub, order):
 
 
 @njit(cache=True)
-def splice(x, w, nodes, S, G, cell, sub_x, sub_w, sub_nodes, sub_S, sub_G, sub_cell, cut, first):
+def splice(fixed, sub, cut, first):
     """The fixed pieces' points ``x``, weights ``w`` (n_pieces, n_gauss), rows ``nodes``, ``S``,
-    ``G`` (n_pieces, n_gauss, k) and ``cell`` with each cut piece replaced by its sub-pieces (the
-    ``sub_`` arrays; :func:`_order`), in order along the domain."""
+    ``G`` (n_pieces, n_gauss, k) and ``cell`` (the tuple ``fixed``, in that order) with each cut
+    piece replaced by its sub-pieces (the tuple ``sub`` of the same six; :func:`_order`), in order
+    along the domain."""
+    x, w, nodes, S, G, cell = fixed
+    sub_x, sub_w, sub_nodes, sub_S, sub_G, sub_cell = sub
     order = _order(x.shape[0], cut, first)
     return (_spliced(x, sub_x, order), _spliced(w, sub_w, order), _spliced(nodes, sub_nodes, order),
             _spliced(S, sub_S, order), _spliced(G, sub_G, order), _spliced(cell, sub_cell, order))
 
 
 @njit(cache=True)
-def fe_entries(indptr, indices, data, mirror, dx, rho, cut, keys, n_nodes, sub_nodes, sub_S, sub_w, sub_rho):
+def fe_entries(operator, mirror, dx, rho, cut, keys, n_nodes, sub_nodes, sub_S, sub_w, sub_rho):
     """The entries of the FE mass (module docstring) and whether a sub-piece product that is not 0
     falls outside the pattern ``keys`` (``i n_nodes + j`` of each stored entry, increasing).
 
-    ``indptr``, ``indices``, ``data``: the CSR operator ``A`` (entries x points); ``mirror``: an
+    ``operator = (indptr, indices, data)``: the CSR operator ``A`` (entries x points); ``mirror``: an
     earlier entry whose row of ``A`` is the same, stored and valued (the transposed entry of a
     symmetric ``M``), whose sum is then copied, else the entry itself; ``dx``, ``rho``:
     the fixed pieces' (n_pieces, n_gauss) weights and densities; ``cut``: the cut pieces; the sub-
     pieces' rows ``sub_nodes``, ``sub_S`` (n_sub, k), weights ``sub_w`` and densities ``sub_rho``."""
+    indptr, indices, data = operator
     g = dx.shape[1]
     q = np.empty(dx.size)
     for p in range(dx.shape[0]):

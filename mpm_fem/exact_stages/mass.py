@@ -84,7 +84,7 @@ class FEMass:
         k = cuts.rows.nodes.shape[-1]
         n = self.points.size
         data, outside = grid_kernels.fe_entries(
-            self.assemble.indptr, self.assemble.indices, self.assemble.data, self.mirror, self.dx,
+            (self.assemble.indptr, self.assemble.indices, self.assemble.data), self.mirror, self.dx,
             rho[:n].reshape(self.dx.shape), cuts.cut, self.keys, self.grid.n_nodes,
             cuts.rows.nodes.reshape(-1, k), cuts.rows.S.reshape(-1, k), cuts.w.ravel(), rho[n:])
         if outside:

@@ -136,7 +136,7 @@ class QuadratureRule:
         if cuts.cut.size == 0:
             return self._flat(fixed)
         sub = (cuts.x, cuts.w, cuts.rows.nodes, cuts.rows.S, cuts.rows.G, cuts.rows.cell)
-        return self._flat(grid_kernels.splice(*fixed, *sub, cuts.cut, cuts.first))
+        return self._flat(grid_kernels.splice(fixed, sub, cuts.cut, cuts.first))
 
     def splice_numpy(self, cuts: Cuts) -> tuple[np.ndarray, np.ndarray, Shape]:
         """The readable reference of :meth:`splice`: runs of fixed pieces and of sub-pieces, concatenated."""

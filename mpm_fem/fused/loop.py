@@ -8,7 +8,7 @@ The Dirichlet data come from a table the caller evaluates ahead, at the times th
 (:meth:`mpm_fem.core.step.Dirichlet.end_values_at`: the same floats as one call per time), and from the
 boundary object in object mode at a time the table misses; an exact acceleration likewise, from a
 table of the problem's own function evaluated ahead, or in object mode (the same floats). The loop's arguments
-travel in a few named structures (:class:`Geometry`, :class:`Conditions`, :class:`Clock`,
+travel in a few named structures (:class:`~mpm_fem.bases.contract.Geometry`, :class:`Conditions`, :class:`Clock`,
 :class:`Scratch`, :class:`Remedies`). The scheme, the remedies that run and the passes it calls are
 compile-time globals of each variant (:mod:`mpm_fem.fused.compiler`): the branches not taken are
 pruned and their passes never compile.
@@ -19,6 +19,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, objmode
 
+from mpm_fem.bases.contract import Cloud, RowStore
+from mpm_fem.bases.contract import Geometry as Geometry  # the grid as every pass reads it
 from mpm_fem.fused.codes import (
     GA,
     GAS,
@@ -44,19 +46,12 @@ from mpm_fem.fused.codes import (
     USF,
     USL,
 )
+from mpm_fem.fused.remedies import Quadrature, Reset, State
 from mpm_fem.fused.sums import _divide_by_lumped
 
 # placeholders: each variant has its own (mpm_fem.fused.compiler)
 STORED = MODEL = WIDTH = SCHEME = XPIC_ON = VOLUME_ON = TAYLOR_ON = None
 PROJECT = MOVE = UPDATE = FINISH = VISCOUS = GAS_FORCE = XPIC = VOLUME = TAYLOR = None
-
-class Geometry(NamedTuple):
-    """The grid as every pass reads it."""
-
-    nodes: np.ndarray  # x_i
-    h: np.ndarray  # rows: the cell sizes h_c and 1 / h_c
-    inv_spacing: float  # 1/h on a grid uniform to round-off, else 0 (the node arithmetic)
-
 
 class Conditions(NamedTuple):
     """The problem's conditions at the ends and on the particles."""
@@ -225,7 +220,9 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     ends, dirichlet, window, exact, times, table, accelerations = conditions
     t, T, speed, fixed_dt, cfl, h_min, refine, viscous_limit, steps, max_steps, budget = clock
     cell, rows, S, G, grid, flags, upd, values, speeds, reset, sums = scratch
+    stored = RowStore(rows, S, G, cell)
     xpic, volume_width, integrals, points, G_q, weights, offsets = remedies
+    quadrature = Quadrature(points, G_q, weights, offsets)
     n = cell.size
     gas = MODEL == GAS
     eps = consts[IEPS]
@@ -251,8 +248,8 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
         o = 1 - cur  # the other set: the new state
         x_n, v_new, V_n, m_n, rho_n, e_n, p_n = state[o, IX, :n], state[o, IV, :n], state[o, IVOL, :n], \
             state[o, IM, :n], state[o, IRHO, :n], state[o, IE, :n], state[o, IP, :n]
-        PROJECT(nodes, h, inv_spacing, x, V, m, v, p, gas and SCHEME != USF and not VOLUME_ON and not TAYLOR_ON,
-                store, chunks, rows, S, G, cell, m_i, P_i, F_i, flags)
+        PROJECT(geometry, Cloud(x, V, m, v, p), gas and SCHEME != USF and not VOLUME_ON and not TAYLOR_ON,
+                store, chunks, stored, m_i, P_i, F_i, flags)
         need = 2
         for k in range(chunks):
             need = max(need, flags[k, 2])
@@ -268,9 +265,9 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
             _set_ends(ends, g_t, v_i)
         if VOLUME_ON:  # the volume reset, then the force of the reset state
             V_i = _nodal_rows(XPIC_ON, 0)  # its V_i and ratio follow XPIC's arrays
-            VOLUME(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks,
-                   WIDTH if store else volume_width, grid[V_i], grid[V_i + 1], reset[0, 0, :n], reset[0, 1, :n],
-                   reset[0, 2, :n], upd, values)
+            VOLUME(geometry, stored, State(x, V, m, rho, e, p), integrals, consts, chunks,
+                   WIDTH if store else volume_width,
+                   Reset(grid[V_i], grid[V_i + 1], reset[0, 0, :n], reset[0, 1, :n], reset[0, 2, :n]), upd, values)
             wide = 0
             for k in range(chunks):
                 wide = max(wide, upd[k, 1])
@@ -289,8 +286,7 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
         elif not gas and not exact and not TAYLOR_ON:
             VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, V, eps, chunks, F_i)
         if TAYLOR_ON and not exact:
-            TAYLOR(nodes, h, inv_spacing, x, rows, S, G, cell, p_n if SCHEME == USF else p, v_i, eps, points, G_q,
-                   weights, offsets, chunks, sums, F_i)
+            TAYLOR(geometry, x, stored, p_n if SCHEME == USF else p, v_i, eps, quadrature, chunks, sums, F_i)
         if exact:
             row = _tabled(times, t) if accelerations.shape[0] else -1
             if row >= 0:

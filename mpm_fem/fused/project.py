@@ -25,12 +25,15 @@ from mpm_fem.fused.sums import _chunk, _one_row, _sum_chunks
 WIDTH = STORED = ANY_GRID = PROJECT_RUN = SHAPE_ROW = None
 
 
-def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
-             rows, S, G, cell, m_i, P_i, F_i, flags):
-    """Pass 1: the shape of every particle, ``m_i``, ``P_i`` and, if ``gas_force``, ``F_i = sum_p
-    V_p p_p G_ip``. The cells are stored; the rows ``rows``, ``S``, ``G`` only if ``store`` (the
-    consistent mass and the particle-domain bases need them). ``flags[k] = (first particle outside
-    the grid, first with V <= 0, the K it needs)`` of chunk k."""
+def _project(geometry, cloud, gas_force, store, chunks, stored, m_i, P_i, F_i, flags):
+    """Pass 1: the shape of every particle (``geometry``, ``cloud``, ``stored``: the grid, the
+    particles and the row store of :mod:`mpm_fem.bases.contract`), ``m_i``, ``P_i`` and, if
+    ``gas_force``, ``F_i = sum_p V_p p_p G_ip``. The cells are stored; the rows ``rows``, ``S``,
+    ``G`` only if ``store`` (the consistent mass and the particle-domain bases need them).
+    ``flags[k] = (first particle outside the grid, first with V <= 0, the K it needs)`` of chunk k."""
+    nodes, h, inv_spacing = geometry
+    x, V, m, v, p = cloud
+    rows, S, G, cell = stored
     n = x.size
     K = WIDTH  # nodes per particle
     n_nodes = nodes.size
@@ -41,8 +44,7 @@ def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, chunks,
         outside, empty, need = -1, -1, 0
         r, Sl, Gl = _one_row(K)
         if ANY_GRID == 1 or inv_spacing > 0.0:  # the basis's own loop (the loop below then skipped)
-            outside, empty, need = PROJECT_RUN(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi,
-                                               rows, S, G, cell, buf[k])
+            outside, empty, need = PROJECT_RUN(geometry, cloud, gas_force, store, lo, hi, stored, buf[k])
             lo = hi
         for q in range(lo, hi):
             if not (x[q] >= a and x[q] <= b):

@@ -14,6 +14,8 @@ averages over, the basis's ``domain_twin``) are compile-time globals of each var
 (:mod:`mpm_fem.fused.compiler`).
 """
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import prange
 
@@ -35,16 +37,51 @@ from mpm_fem.fused.sums import (
 MODEL = WIDTH = ROW = STORED = TWIN_ROW = TWIN_SCALARS = TWIN_COLUMN = None
 
 
-def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals, consts, chunks, width,
-                  V_i, ratio, V_r, rho_r, p_r, flags, values):
+class State(NamedTuple):
+    """The particles' state the grid volume reset reads (n_p,)."""
+
+    x: np.ndarray
+    V: np.ndarray
+    m: np.ndarray
+    rho: np.ndarray
+    e: np.ndarray  # the specific internal energy eps
+    p: np.ndarray
+
+
+class Reset(NamedTuple):
+    """The grid volume reset's nodal scratch (n_nodes,) and the reset state it writes (n_p,)."""
+
+    V_i: np.ndarray  # sum_p V_p Sbar_ip
+    ratio: np.ndarray  # int S_i / V_i
+    V: np.ndarray
+    rho: np.ndarray
+    p: np.ndarray
+
+
+class Quadrature(NamedTuple):
+    """The Taylor force's quadrature (:func:`~mpm_fem.core.reconstruction.force_quadrature`)."""
+
+    points: np.ndarray  # the points' nodes (n_points, k)
+    G_q: np.ndarray  # S_i' there (n_points, k)
+    weights: np.ndarray  # their weights w_g (n_points,)
+    offsets: np.ndarray  # xi_g - 1/2 of a cell's points
+
+
+def _volume_reset(geometry, stored, state, integrals, consts, chunks, width, out, flags, values):
     """The grid volume reset (:func:`mpm_fem.core.volume.grid_volume_factor`, then the model's
-    ``with_volume``): ``V_i = sum_p V_p Sbar_ip``, ``f_p = sum_i Sbar_ip (int S_i / V_i)`` (0 where
-    ``V_i = 0``; ``integrals`` holds ``int S_i``), ``V_p <- V_p f_p`` into ``V_r``; the gas at the same
-    mass and specific energy, ``rho_p = m_p / V_p``, ``p_p = (gamma - 1) rho_p eps_p + q_p rho_p /
-    rho_p^old`` (``q_p`` its viscosity) into ``rho_r``, ``p_r`` (Burgers: ``m_p = V_p``, which its
-    update sets anyway). The domain rows take ``width`` columns. ``flags[k] = (first particle of
-    chunk k whose new density (gas) or volume (Burgers) is not > 0, the width its rows need)``,
+    ``with_volume``) of the particles ``state`` (:class:`State`), with the grid ``geometry`` and pass
+    1's row store ``stored`` (:mod:`mpm_fem.bases.contract`): ``V_i = sum_p V_p Sbar_ip``, ``f_p =
+    sum_i Sbar_ip (int S_i / V_i)`` (0 where ``V_i = 0``; ``integrals`` holds ``int S_i``), ``V_p <-
+    V_p f_p``; the gas at the same mass and specific energy, ``rho_p = m_p / V_p``, ``p_p = (gamma -
+    1) rho_p eps_p + q_p rho_p / rho_p^old`` (``q_p`` its viscosity) (Burgers: ``m_p = V_p``, which
+    its update sets anyway): ``V_i``, the ratio and the reset ``V``, ``rho``, ``p`` into ``out``
+    (:class:`Reset`). The domain rows take ``width`` columns. ``flags[k] = (first particle of chunk
+    k whose new density (gas) or volume (Burgers) is not > 0, the width its rows need)``,
     ``values[k, 0]`` that density or volume."""
+    nodes, h, inv_spacing = geometry
+    rows, S = stored.rows, stored.S
+    x, V, m, rho, e, p = state
+    V_i, ratio, V_r, rho_r, p_r = out
     n = x.size
     gas = MODEL == GAS
     # Sbar_ip: the step's stored rows (a particle-domain basis), or the rows of its twin (a point
@@ -101,15 +138,18 @@ def _volume_reset(nodes, h, inv_spacing, x, rows, S, V, m, rho, e, p, integrals,
         flags[k, 0], values[k, 0] = int(bad), value
 
 
-def _taylor_force(nodes, h, inv_spacing, x, rows, S, G, cell, p, v_i, eps, points, G_q, weights, offsets, chunks,
-                  sums, F_i):
+def _taylor_force(geometry, x, stored, p, v_i, eps, quadrature, chunks, sums, F_i):
     """The reconstructed force (:func:`mpm_fem.core.reconstruction.reconstructed_force`, the same
     operations): the stress ``sigma_p`` (gas ``-p_p``; Burgers ``eps sum_i G_ip v_i``) fitted cell by
     cell by ``s0_c + s1_c (xi - 1/2)`` (:func:`~mpm_fem.core.reconstruction.taylor_fit`: the sums of 1,
     ``d``, ``d^2``, ``sigma``, ``sigma d`` over a cell's particles in index order, ``d = xi_p - 1/2``,
     into ``sums``), then ``F_i = - sum_g w_g sigma_h(x_g) S_i'(x_g)`` over the four points ``x_g`` of
-    every cell (:func:`~mpm_fem.core.reconstruction.force_quadrature`: their nodes ``points``, ``S_i'`` in
-    ``G_q``, ``w_g = h_c / 4``; ``offsets``: ``xi_g - 1/2``), point by point."""
+    every cell (:func:`~mpm_fem.core.reconstruction.force_quadrature`, ``quadrature``: their nodes
+    ``points``, ``S_i'`` in ``G_q``, ``w_g = h_c / 4``; ``offsets``: ``xi_g - 1/2``), point by point;
+    the grid ``geometry`` and pass 1's row store ``stored`` as :mod:`mpm_fem.bases.contract`'s."""
+    nodes, h, inv_spacing = geometry
+    rows, S, G, cell = stored
+    points, G_q, weights, offsets = quadrature
     n = x.size
     K = WIDTH  # nodes per particle
     gas = MODEL == GAS

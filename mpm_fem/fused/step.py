@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from mpm_fem.bases import get
+from mpm_fem.bases.contract import Cloud, RowStore
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
@@ -51,7 +52,7 @@ from mpm_fem.fused.compiler import PASSES
 from mpm_fem.fused.loop import _LOOP_CALLS, Clock, Conditions, Geometry, Remedies, Scratch, _advance, _nodal_rows
 from mpm_fem.fused.passes import _finish, _move, _move_exact, _scatter_pass, _update, _update_exact
 from mpm_fem.fused.project import _project
-from mpm_fem.fused.remedies import _taylor_force, _volume_reset
+from mpm_fem.fused.remedies import Quadrature, Reset, State, _taylor_force, _volume_reset
 from mpm_fem.fused.sums import _divide_by_lumped
 
 KERNELS = ("fused", "numpy")
@@ -304,7 +305,7 @@ class FusedStep:
         self._table = (times, table, accelerations)
         return self._table
 
-    def _grid_volume(self, geometry, x, rows, S, V, m, rho, e, p, chunks):
+    def _grid_volume(self, geometry, stored, x, V, m, rho, e, p, chunks):
         """The grid volume reset (:func:`~mpm_fem.fused.remedies._volume_reset`): ``(V, rho, p)`` of the
         reset state (Burgers: ``rho``, ``p`` as they are); raises :class:`PositivityError` as the model's
         ``with_volume``."""
@@ -315,8 +316,8 @@ class FusedStep:
         flags, values = np.empty((chunks, 2), np.int64), np.zeros((chunks, 2))
         while True:
             width = self.K if self.basis.domain else self.volume_width
-            reset(*geometry, x, rows, S, V, m, rho, e, p, self.integrals, self.consts, chunks, width,
-                  V_i, ratio, V_r, rho_r, p_r, flags, values)
+            reset(Geometry(*geometry), stored, State(x, V, m, rho, e, p),
+                  self.integrals, self.consts, chunks, width, Reset(V_i, ratio, V_r, rho_r, p_r), flags, values)
             need = int(flags[:, 1].max(initial=0))
             if need <= width:
                 break
@@ -358,8 +359,8 @@ class FusedStep:
             rows_n = n if store else 0
             rows, S, G = (empty("rows", (rows_n, self.K), self._index), empty("S", (rows_n, self.K)),
                           empty("G", (rows_n, self.K)))
-            self.project(self.nodes, self.h, self.inv_spacing, x, V, m, v, p, gas_force, store, chunks,
-                         rows, S, G, cell, m_i, P_i, F_i, flags)
+            self.project(Geometry(self.nodes, self.h, self.inv_spacing), Cloud(x, V, m, v, p), gas_force, store,
+                         chunks, RowStore(rows, S, G, cell), m_i, P_i, F_i, flags)
             if (flags[:, :2] >= 0).any():
                 make_shape(grid, x, V, self.stages.basis)  # raises the numpy step's error
                 raise ValueError("a particle lies outside the grid or has no volume")  # not reached
@@ -389,7 +390,7 @@ class FusedStep:
         v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
         shape_args = (*geometry, x, rows, S, G, cell)
         if grid_volume:  # the volume reset (mpm_fem.core.volume), then the force of the reset state
-            V, rho, p = self._grid_volume(geometry, x, rows, S, V, m, rho, e, p, chunks)
+            V, rho, p = self._grid_volume(geometry, RowStore(rows, S, G, cell), x, V, m, rho, e, p, chunks)
             if gas and scheme != "usf" and not exact and not taylor:
                 self._passes.get(_scatter_pass, BASIS=self.basis, WIDTH=self.K, WEIGHT=PRESSURE)(
                     *shape_args, v_i, V, p, 0.0, chunks, F_i)
@@ -408,8 +409,8 @@ class FusedStep:
             self.viscous_force(*shape_args, v_i, V, V, self.consts[IEPS], chunks, F_i)
         if taylor and not exact and not self.slides:  # the reconstructed force of the (updated) stress
             self._passes.get(_taylor_force, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)(
-                *shape_args, p_new if scheme == "usf" else p, v_i, self.consts[IEPS], *self.quadrature, chunks,
-                empty("sums", (5, grid.n_cells)), F_i)
+                Geometry(*geometry), x, RowStore(rows, S, G, cell), p_new if scheme == "usf" else p, v_i,
+                self.consts[IEPS], Quadrature(*self.quadrature), chunks, empty("sums", (5, grid.n_cells)), F_i)
         if exact:
             if self.exact_acceleration is None:
                 raise ValueError("this problem has no exact acceleration to use")
