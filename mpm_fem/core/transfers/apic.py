@@ -10,11 +10,11 @@ particles start without an affine part, whatever the initial velocity's gradient
 
 The G2P ``C_p`` is the gradient form (Jiang et al. 2015, sec. 5.3: ``B_p D_p^{-1}`` replaced by
 ``sum_i v_i (grad S_ip)^T``), exact for any basis that reproduces linears: an affine nodal field
-``v_i = a + b x_i`` gives ``v_p = a + b x_p`` and ``C_p = b``, and P2G of ``v_p + C_p (x - x_p)``
-then returns ``P_i = m_i (a + b x_i)`` whenever ``sum_p m_p S_ip (x_i - x_p) = 0``... in general the
-P2G of an affine particle field is exact on the lumped grid only to the nodal first moment;
-:mod:`tests.test_apic` measures it. Momentum: ``sum_i S_ip (x_i - x_p) = 0`` for a linear-reproducing
-basis, so ``sum_i P_i = sum_p m_p v_p``.
+``v_i = a + b x_i`` gives ``v_p = a + b x_p`` and ``C_p = b``; and P2G of ``v_p = a + b x_p``,
+``C_p = b`` gives ``v_i = a + b x_i`` for any basis, since ``v_p + C_p (x_i - x_p) = a + b x_i``
+(lumped mass). Momentum: ``sum_i S_ip (x_i - x_p) = 0`` for a linear-reproducing basis, so
+``sum_i P_i = sum_p m_p v_p`` (``tests/test_apic.py`` checks both on P1 and the quadratic B-spline
+away from the walls).
 
 The compiled step has no APIC kernels (``compiled = False``): a run with APIC takes the numpy step
 (:func:`mpm_fem.fused.step.supported` names the reason).
