@@ -56,11 +56,15 @@ class Particles:
     density: np.ndarray
     energy: np.ndarray
     pressure: np.ndarray
+    #: APIC's affine velocity coefficient ``C_p`` (:mod:`mpm_fem.core.transfers.apic`); ``None``: none carried
+    affine: np.ndarray | None = None
 
     def __post_init__(self):
         n = self.x.shape
         for f in fields(self):
             a = getattr(self, f.name)
+            if a is None and f.name == "affine":
+                continue
             if not isinstance(a, np.ndarray) or a.shape != n:
                 raise ValueError(f"particle field {f.name!r} must be an array of shape {n}")
 
@@ -73,12 +77,16 @@ class Particles:
 
     def take(self, index) -> "Particles":
         """The particles selected by ``index`` (a boolean mask or integer indices)."""
-        return Particles(**{f.name: getattr(self, f.name)[index] for f in fields(self)})
+        return Particles(**{f.name: getattr(self, f.name)[index] for f in fields(self)
+                            if getattr(self, f.name) is not None})
 
     def join(self, other: "Particles") -> "Particles":
         """These particles followed by ``other``."""
+        if (self.affine is None) != (other.affine is None):
+            raise ValueError("join particles that both carry the affine coefficient or neither")
         return Particles(
-            **{f.name: np.concatenate((getattr(self, f.name), getattr(other, f.name))) for f in fields(self)}
+            **{f.name: np.concatenate((getattr(self, f.name), getattr(other, f.name))) for f in fields(self)
+               if getattr(self, f.name) is not None}
         )
 
 

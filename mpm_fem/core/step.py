@@ -32,8 +32,10 @@ from mpm_fem.core.particles import Particles
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force
 from mpm_fem.core.shape import Shape, make_shape
 from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
+from mpm_fem.core.transfers import GridVelocities
+from mpm_fem.core.transfers import get as get_transfer
 from mpm_fem.core.volume import VOLUME_RATES, VOLUMES, domain_rate, grid_volume_factor
-from mpm_fem.core.xpic import boundary_change_rule, check_order, xpic_velocity
+from mpm_fem.core.xpic import boundary_change_rule, check_order
 
 SCHEMES = ("usl", "usf", "musl")
 ACCELERATIONS = ("calculated", "exact")
@@ -81,8 +83,17 @@ class Stages(StageSwitches):
 
     acceleration: str = "calculated"
     volume_rate: str = "point"
+    transfer: str = "flip"
 
     def __post_init__(self):
+        get_transfer(self.transfer)
+        if self.transfer == "xpic" and not self.xpic:
+            raise ValueError("the xpic transfer needs its order: Stages(xpic=m) with m >= 1")
+        if self.transfer == "apic" and (self.flip != 1 or self.xpic != 0):
+            raise ValueError(f"APIC replaces the PIC/FLIP blend and XPIC: use it with flip 1 and xpic 0, "
+                             f"got flip {self.flip!r}, xpic {self.xpic!r}")
+        if self.transfer != "flip" and self.uses_exact_fields:
+            raise ValueError(f"the transfer {self.transfer!r} runs with the MPM stages only")
         for name, allowed in (("basis", names()), ("mass", STAGE_MASS), ("acceleration", ACCELERATIONS),
                               ("scheme", SCHEMES), ("projection", PROJECTIONS), ("interpolation", INTERPOLATIONS),
                               ("reconstruct", RECONSTRUCTIONS), ("volume", VOLUMES), ("volume_rate", VOLUME_RATES)):
@@ -115,6 +126,17 @@ class Stages(StageSwitches):
         ``bspline_gimp``, the grid volume and ``reconstruct``)."""
         return (self.basis == "bspline_gimp" or self.flip != 1 or self.xpic != 0 or self.reconstruct != "none"
                 or self.volume != "carried")
+
+    @property
+    def transfer_name(self) -> str:
+        """The registered transfer this step takes (:mod:`mpm_fem.core.transfers`): ``transfer``,
+        with the old API mapped: ``xpic >= 1`` is ``"xpic"``."""
+        return "xpic" if self.xpic else self.transfer
+
+    @property
+    def transfer_setting(self):
+        """The parameter of :attr:`transfer_name`: the order for XPIC, the blend for the others."""
+        return self.xpic if self.xpic else self.flip
 
     @property
     def uses_exact_fields(self) -> bool:
@@ -292,7 +314,8 @@ def explicit_step(
     h_p = grid.h[shape.cell]
     m, V = particles.mass, particles.volume
     m_i = nodal_mass(shape, m)
-    P_i = nodal_momentum(shape, m, particles.velocity)
+    transfer = get_transfer(stages.transfer_name)
+    P_i = transfer.momentum(shape, grid.nodes, particles.x, m, particles.velocity, particles.affine)
     v_i = boundary.velocity(grid, grid_values(shape, m, m_i, P_i, stages.mass), t)
     if stages.volume == "grid":
         particles = _reset_volume(model, particles, grid_volume_factor(grid, particles.x, V, stages.basis, shape))
@@ -323,20 +346,17 @@ def explicit_step(
     v_new = v_i + dt * a_i
 
     moving = shape.gather(v_new)
-    if stages.xpic:
-        velocity = xpic_velocity(shape, m, m_i, v_i, a_i, dt, stages.xpic, stages.mass,
-                                 boundary_change_rule(boundary, grid, t))
-    else:
-        velocity = particles.velocity + dt * shape.gather(a_i)
-        if stages.flip != 1:
-            velocity = stages.flip * velocity + (1.0 - stages.flip) * moving
+    x_old = particles.x
+    velocity, affine = transfer.update(
+        GridVelocities(shape, m, m_i, v_i, a_i, v_new, moving, dt, stages.mass,
+                       boundary_change_rule(boundary, grid, t)),
+        particles.velocity, stages.transfer_setting)
     x = particles.x + dt * moving
-    particles = particles.replace(x=x, velocity=velocity)
+    particles = particles.replace(x=x, velocity=velocity, affine=affine)
 
     if stages.scheme == "musl":
-        v_new = boundary.velocity(
-            grid, grid_values(shape, m, m_i, nodal_momentum(shape, m, velocity), stages.mass), t + dt
-        )
+        P_new = transfer.momentum(shape, grid.nodes, x_old, m, velocity, affine)
+        v_new = boundary.velocity(grid, grid_values(shape, m, m_i, P_new, stages.mass), t + dt)
     if stages.scheme in ("usl", "musl"):
         particles = _update(model, grid, particles, shape, x_n, v_new, dt, h_p, stages)
     return particles, GridState(m_i, v_i, a_i, v_new)

@@ -30,6 +30,7 @@ from mpm_fem.core.reconstruction import OFFSETS, force_quadrature
 from mpm_fem.core.shape import Shape, basis_integrals, make_shape
 from mpm_fem.core.step import SCHEMES, Dirichlet, GridState, Stages, Walls, at_times
 from mpm_fem.core.transfer import solve_consistent
+from mpm_fem.core.transfers import get as get_transfer
 from mpm_fem.core.xpic import boundary_change_rule
 from mpm_fem.exact_stages import ExactFields, ExactGridStage, GridData
 from mpm_fem.fused.codes import (
@@ -66,6 +67,8 @@ def supported(model, stages: Stages) -> str | None:
     """``None`` if the fused step implements this model and these stages, else the reason."""
     if not isinstance(model, (IdealGas, ViscousBurgers)):
         return f"the fused step has no kernel for the model {type(model).__name__}"
+    if not get_transfer(stages.transfer_name).compiled:
+        return f"the fused step has no kernels for the transfer {stages.transfer_name!r}; it runs the numpy step"
     if stages.uses_exact_fields and not (isinstance(model, IdealGas) and stages.scheme == "usl"
                                          and stages.mass in ("lumped", "exact")
                                          and stages.acceleration == "calculated"):
