@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from mpm_fem.bases import get, names
+from mpm_fem.bases.contract import Cloud, Geometry, RowStore
 from mpm_fem.bases.cubic import _move, _project
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.shape import basis_integrals, make_shape
@@ -137,7 +138,8 @@ def test_the_compiled_kernels_are_the_numpy_rows():
     rows, S, G = np.zeros((n_p, 4), np.intp), np.zeros((n_p, 4)), np.zeros((n_p, 4))
     cell, buf = np.zeros(n_p, np.intp), np.zeros((3, GRID.n_nodes))
     h = np.ascontiguousarray([GRID.h, 1.0 / GRID.h])
-    outside, empty, K = _project(GRID.nodes, h, 1.0 / H, x, V, m, v, p, True, True, 0, n_p, rows, S, G, cell, buf)
+    outside, empty, K = _project(Geometry(GRID.nodes, h, 1.0 / H), Cloud(x, V, m, v, p), True, True, 0, n_p,
+                                 RowStore(rows, S, G, cell), buf)
     assert (outside, empty, K) == (-1, -1, 4)
     assert np.array_equal(rows, want.nodes) and np.array_equal(cell, want.cell)
     np.testing.assert_allclose(buf[0], want.scatter(m), rtol=1e-14, atol=1e-14)

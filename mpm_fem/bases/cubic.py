@@ -142,12 +142,15 @@ def _pass_row(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl):
 
 
 @njit(cache=True, inline="always")
-def _project(nodes, h, inv_spacing, x, V, m, v, p, gas_force, store, lo, hi, rows, S, G, cell, buf):
+def _project(geometry, cloud, gas_force, store, lo, hi, stored, buf):
     """Pass 1 over particles ``lo .. hi-1`` on a uniform grid (:class:`~mpm_fem.bases.contract.Kernels`):
     the row of :func:`_splines`, the four nodes' sums held in registers while consecutive particles
     share the cell (each node's terms still added in particle order). A particle in an end cell (a
     ghost folded into the end node: a node twice in its row) adds into ``buf`` directly, its
     columns left to right."""
+    nodes, h, inv_spacing = geometry
+    x, V, m, v, p = cloud
+    rows, S, G, cell = stored
     n_nodes = nodes.size
     top = n_nodes - 1
     a, b = nodes[0], nodes[top]
