@@ -30,17 +30,22 @@ from mpm_fem.core.grid import GridError
 from mpm_fem.core.particles import LAYOUTS
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS
 from mpm_fem.core.step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, SCHEMES, STAGE_MASS
+from mpm_fem.core.transfers import get as get_transfer
+from mpm_fem.core.transfers import names as transfer_names
 from mpm_fem.core.volume import VOLUMES
 
 CHOICES = {"mass": STAGE_MASS, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
            "projection": PROJECTIONS, "interpolation": INTERPOLATIONS}
 # --- remedies (E5): --flip ALPHA, --xpic M, --reconstruct none|taylor, --volume carried|grid, --basis bspline_gimp
-CHOICES.update({"reconstruct": RECONSTRUCTIONS, "volume": VOLUMES, "kernel": ("fused", "numpy")})
+CHOICES.update({"reconstruct": RECONSTRUCTIONS, "volume": VOLUMES, "kernel": ("fused", "numpy"),
+                "transfer": transfer_names()})
 REMEDY_HELP = {
     "flip": "PIC/FLIP blend alpha in [0, 1]: 1 FLIP (standard), 0 PIC",
     "xpic": "XPIC(M) particle velocity update of order M >= 1 in place of the blend (1: PIC); 0: off",
     "reconstruct": "stress before the force integral: none (particle sum) or taylor (per-cell least-squares line)",
     "volume": "particle volumes: carried by the flow, or grid (reset to tile the grid every step)",
+    "transfer": "grid-to-particle transfer (the registry of mpm_fem.core.transfers): flip (the blend of --flip), "
+                "xpic (the order of --xpic) or apic (affine particle-in-cell; the numpy step)",
 }
 HELP = {
     "h": "cell size (must divide the domain)",
@@ -208,7 +213,10 @@ def _prepare(args, problem: str, module, settings_cls):
         raise UsageError(str(err)) from None
     if not args.quiet:
         slower = (f" on the numpy step: the basis {settings.basis} has no compiled kernels"
-                  if cost.kernel == "numpy" and settings.kernel == "fused" and not compiled(settings.basis) else "")
+                  if cost.kernel == "numpy" and settings.kernel == "fused" and not compiled(settings.basis)
+                  else f" on the numpy step: the transfer {settings.transfer} has no compiled kernels"
+                  if cost.kernel == "numpy" and settings.kernel == "fused"
+                  and not get_transfer(settings.stages.transfer_name).compiled else "")
         print(f"{problem}: {guard.describe(cost)}{slower}", file=sys.stderr)
     return settings, cost, out
 

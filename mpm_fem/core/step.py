@@ -59,6 +59,7 @@ class StageSwitches:
     reconstruct: str = "none"
     volume: str = "carried"
     xpic: int = 0
+    transfer: str = "flip"
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,6 @@ class Stages(StageSwitches):
 
     acceleration: str = "calculated"
     volume_rate: str = "point"
-    transfer: str = "flip"
 
     def __post_init__(self):
         get_transfer(self.transfer)

@@ -14,6 +14,7 @@ from mpm_fem.bases import compiled
 from mpm_fem.core.grid import n_cells_for
 from mpm_fem.core.particles import LAYOUTS
 from mpm_fem.core.step import Stages, StageSwitches
+from mpm_fem.core.transfers import get as get_transfer
 
 # Bytes and seconds of one run, measured and then given a margin (stated, not tuned per run):
 # the particle state plus the peak of one step is 212-250 B per particle (benchmarks/step_cost.py,
@@ -99,7 +100,7 @@ def run_cost(settings, domain: tuple[float, float], max_speed: float, dt_cap: fl
     steps = math.ceil(ratio)
     stages = settings.stages
     fused = (settings.kernel == "fused" and not (stages.uses_exact_fields or stages.reconstruct != "none")
-             and compiled(stages.basis))  # a basis without compiled kernels: the numpy step
+             and compiled(stages.basis) and get_transfer(stages.transfer_name).compiled)  # else the numpy step
     return Cost(particles=n_cells * settings.ppc, nodes=n_cells + 1, steps=steps, kernel="fused" if fused else "numpy")
 
 

@@ -43,8 +43,8 @@ STATEMENTS = {
     "E2": "bases: point-mass P1 vs GIMP vs C1 B-spline",
     "E3": "on the same mesh MPM's error stays within a constant factor of the fixed-mesh FEM's",
     "E4": "one command regenerates every table from one code version, the current code's",
-    "E5": "a remedy (particle-domain B-spline, stress reconstruction, volume reset, PIC/FLIP, XPIC) removes the MPM "
-          "plateau",
+    "E5": "a remedy (particle-domain B-spline, stress reconstruction, volume reset, PIC/FLIP, XPIC, APIC, a cubic "
+          "B-spline) removes the MPM plateau",
     "E6a": "the growth of point-mass MPM's particle error under refinement comes from one stage: made exact, it turns "
            "the growth into convergence on every particle layout",
 }
