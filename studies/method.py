@@ -27,7 +27,6 @@ from __future__ import annotations
 import hashlib
 import importlib
 import inspect
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -165,12 +164,6 @@ def run(spec: str, options: StudyOptions) -> Path:
     page = folder / "METHOD.md"
     page.write_text(judge_method(basis, got, OURS))
     return page
-
-
-def main(argv=None) -> int:  # pragma: no cover - the command line's `mpm-fem method`
-    from mpm_fem.app.cli import main as cli
-
-    return cli(["method", *(sys.argv[1:] if argv is None else argv)])
 
 
 __all__ = ["METHOD_CLAIMS", "NAME", "OURS", "PLAN", "plan", "run", "run_case", "tables"]
