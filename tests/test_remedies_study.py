@@ -105,3 +105,14 @@ def test_the_error_rows_carry_the_particle_setting_and_orders_within_each_settin
     assert rows[1]["order_nodes_L1"] == pytest.approx(1.0) and rows[3]["order_nodes_L1"] == pytest.approx(1.0)
     summary = remedies._summary(rows)
     assert len(summary) == 1 and summary[0]["finest_nodes_L1"] == 0.01
+
+
+def test_a_particle_leaving_the_grid_is_a_failed_run_not_a_crash(monkeypatch):
+    from mpm_fem.bases import OutsideGridError
+
+    def leaves(settings, progress=None):
+        raise OutsideGridError("particle 0 at x=-1e-07 lies outside the grid [0.0, 1.0] (1 such particles)")
+
+    monkeypatch.setattr(remedies.sod, "simulate", leaves)
+    got = remedies.run_case({"solver": "sod", "h": 0.01, **remedies.SOD_MPM, **remedies.REMEDIES["cubic B-spline"]})
+    assert got == {"ok": False, "error": "particle 0 at x=-1e-07 lies outside the grid [0.0, 1.0] (1 such particles)"}
