@@ -80,3 +80,13 @@ def test_sod_with_apic_is_finite_and_close_to_pic():
     # the compiled kernel asked for: the run takes the numpy step (run/solve.py reads supported())
     fused = run(problem, grid, sod.initial_particles(settings, grid), Stages(transfer="apic"), kernel="fused")
     assert sod.errors(settings, fused)["density"]["particles"] == err["apic"]
+
+
+def test_particles_without_the_affine_coefficient_join_an_apic_set_with_it_zero():
+    from mpm_fem.core.particles import make_particles
+
+    old = make_particles([0.1, 0.2], 0.1, 1.0).replace(affine=np.array([2.0, -3.0]))
+    new = make_particles([0.3], 0.1, 1.0)  # a reservoir's particle
+    assert np.array_equal(old.join(new).affine, [2.0, -3.0, 0.0])
+    assert np.array_equal(new.join(old).affine, [0.0, 2.0, -3.0])
+    assert new.join(new).affine is None

@@ -81,9 +81,11 @@ class Particles:
                             if getattr(self, f.name) is not None})
 
     def join(self, other: "Particles") -> "Particles":
-        """These particles followed by ``other``."""
+        """These particles followed by ``other``. Where only one set carries the affine coefficient
+        (APIC's ``C_p``; e.g. particles a reservoir adds to an APIC run), the other joins with ``C_p =
+        0``, the coefficient APIC starts every particle with."""
         if (self.affine is None) != (other.affine is None):
-            raise ValueError("join particles that both carry the affine coefficient or neither")
+            self, other = (p if p.affine is not None else p.replace(affine=np.zeros(p.n)) for p in (self, other))
         return Particles(
             **{f.name: np.concatenate((getattr(self, f.name), getattr(other, f.name))) for f in fields(self)
                if getattr(self, f.name) is not None}
