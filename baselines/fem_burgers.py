@@ -217,8 +217,9 @@ def _compiled_steps(ops: _Operators, eps: float, dt: float, g: np.ndarray, g_t: 
     else:
         l = w = u = np.zeros(0)
         M_IB = np.zeros((0, ops.boundary.size))
-    fixed = (dt, np.ascontiguousarray(g), np.ascontiguousarray(g_t), ops.a, ops.b, ops.h, eps, ops.interior,
-             ops.boundary, ops.lumped, consistent, l, w, u, M_IB)
+    cells = fem_burgers_kernel.Cells(ops.a, ops.b, ops.h, ops.interior, ops.boundary)
+    mass = fem_burgers_kernel.Mass(ops.lumped, consistent, l, w, u, M_IB)
+    fixed = (dt, np.ascontiguousarray(g), np.ascontiguousarray(g_t), cells, eps, mass)
 
     def take(v, first, count):
         v = v.copy()

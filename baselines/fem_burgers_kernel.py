@@ -19,9 +19,34 @@ by the caller, with the numpy step's message).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
+
+
+class Cells(NamedTuple):
+    """The mesh as the loop reads it: cell e joins nodes ``a[e]`` and ``b[e]`` and has length
+    ``h[e]`` (n_cells,); ``interior`` and ``boundary`` the node indices (the Dirichlet nodes last)."""
+
+    a: np.ndarray
+    b: np.ndarray
+    h: np.ndarray
+    interior: np.ndarray
+    boundary: np.ndarray
+
+
+class Mass(NamedTuple):
+    """The mass the stage solves with: ``lumped`` (n_nodes,) where not ``consistent``; else the
+    factors ``l, w, u`` of :func:`tridiagonal_factors` and ``M_IB`` (n_interior, n_boundary)."""
+
+    lumped: np.ndarray
+    consistent: bool
+    l: np.ndarray
+    w: np.ndarray
+    u: np.ndarray
+    M_IB: np.ndarray
 
 
 def tridiagonal_factors(M_II: sp.spmatrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -52,8 +77,11 @@ def _factor(d, lower, upper):
 
 
 @njit(cache=True)
-def _derivative(v, k, g_t, a, b, h, eps, interior, boundary, lumped, consistent, l, w, u, M_IB, R1, R2, out):
-    """``dv/dt`` into ``out`` at the stage time ``k dt / 2`` (the module docstring's ``L``)."""
+def _derivative(v, k, g_t, cells, eps, mass, R1, R2, out):
+    """``dv/dt`` into ``out`` at the stage time ``k dt / 2`` (the module docstring's ``L``; ``R1``,
+    ``R2`` (n_nodes,) scratch)."""
+    a, b, h, interior, boundary = cells
+    lumped, consistent, l, w, u, M_IB = mass
     R1[:] = 0.0
     R2[:] = 0.0
     for e in range(a.size):
@@ -88,14 +116,16 @@ def _derivative(v, k, g_t, a, b, h, eps, interior, boundary, lumped, consistent,
 
 
 @njit(cache=True)
-def steps(v, first, count, dt, g, g_t, a, b, h, eps, interior, boundary, lumped, consistent, l, w, u, M_IB):
-    """Steps ``first ... first + count - 1`` of SSP-RK3 on ``v`` (in place; ``l, w, u``:
-    :func:`tridiagonal_factors`, ``w`` inverted). Returns ``(-1, -1)``, or the step (counted from
-    1) and the first node at which ``v`` stopped being finite."""
+def steps(v, first, count, dt, g, g_t, cells, eps, mass):
+    """Steps ``first ... first + count - 1`` of SSP-RK3 on ``v`` (in place; ``g``, ``g_t``: the
+    Dirichlet data and its time derivative at the half steps, (2 n_steps + 1, n_boundary); ``cells``
+    a :class:`Cells`, ``mass`` a :class:`Mass`). Returns ``(-1, -1)``, or the step (counted from 1)
+    and the first node at which ``v`` stopped being finite."""
     n_nodes = v.size
+    boundary = cells.boundary
     R1, R2 = np.empty(n_nodes), np.empty(n_nodes)
     L, v1, v2 = np.empty(n_nodes), np.empty(n_nodes), np.empty(n_nodes)
-    args = (a, b, h, eps, interior, boundary, lumped, consistent, l, w, u, M_IB, R1, R2)
+    args = (cells, eps, mass, R1, R2)
     for n in range(first, first + count):
         k = 2 * n
         _derivative(v, k, g_t, *args, L)

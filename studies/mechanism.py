@@ -180,6 +180,12 @@ COLORS = {"none": "k", "projection": "tab:blue", "mass": "tab:orange", "interpol
           "time": "tab:red", "all": "tab:gray"}
 
 
+def _panel_order(panel: tuple[str, int]) -> tuple[bool, int]:
+    """Sod's panels first, then by particles per cell."""
+    problem, ppc = panel
+    return problem != "sod", ppc
+
+
 def figure(folder, got: dict) -> None:
     """``growth.png``: per problem and particles per cell, v(S) against h (log-log) for each subset: the
     jittered layouts' mean as a solid line and their range as a band, the regular layout dotted; slope 1."""
@@ -189,7 +195,7 @@ def figure(folder, got: dict) -> None:
     for (p, n, lay, _, h, _), r in got.items():
         for made_exact, v in (r.get("errors") or {}).items():
             values.setdefault((p, n), {}).setdefault(made_exact, {}).setdefault(lay, {}).setdefault(h, []).append(v)
-    panels = sorted(values, key=lambda k: (k[0] != "sod", k[1]))
+    panels = sorted(values, key=_panel_order)
     nrows, ncols = grid_shape(len(panels), (4.2, 3.6))
     fig, axes = plt.subplots(nrows, ncols, figsize=(4.2 * ncols, 3.6 * nrows), squeeze=False)
     for ax in axes.ravel()[len(panels):]:

@@ -288,8 +288,8 @@ FLOAT = st.one_of(st.floats(-1.0, 3.0), st.sampled_from([math.nan, math.inf, -ma
        cfl=FLOAT, gamma=FLOAT, av=FLOAT, seed=st.integers(-3, 5), x0=FLOAT, eps=FLOAT,
        layout=st.sampled_from(["regular", "jittered", "random"]), scheme=st.sampled_from(["usl", "usf", "musl"]),
        mass=st.sampled_from(["lumped", "consistent"]), basis=st.sampled_from(["mpm", "gimp", "bspline"]))
-def test_random_options_finish_or_exit_2_on_one_line(tmp_path_factory, problem, h, ppc, T, cfl, gamma, av, seed, x0,
-                                                     eps, layout, scheme, mass, basis):
+def test_random_options_finish_or_exit_2_on_one_line(  # noqa: PLR0913 (one argument per hypothesis strategy)
+        tmp_path_factory, problem, h, ppc, T, cfl, gamma, av, seed, x0, eps, layout, scheme, mass, basis):
     import contextlib
     import io
 

@@ -133,7 +133,7 @@ def test_e6a_names_the_stage_that_turns_the_growth_into_convergence_on_every_run
     assert verdict == "confirmed", evidence
     assert "(projection on every one)" in evidence and "named: projection" in evidence
     found = growth_cases([r for r in tables[SUMMARY]])
-    assert set(found["growth"]) == {(4, (0.005, 0.0025)), (4, (0.0025, 0.00125))}
+    assert set(found["growth"]) == {(4, 0.005, 0.0025), (4, 0.0025, 0.00125)}
     assert all(found["named"][c] == ["projection"] for c in found["growth"])
 
 

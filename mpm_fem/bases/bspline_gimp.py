@@ -15,7 +15,7 @@ arithmetic, bit for bit.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -112,17 +112,46 @@ def _piece(d, left, a, b, c):
     return (left if d < 0 else 0.0) + (a if d == 0 else 0.0) + (b if d == 1 else 0.0) + (c if d == 2 else 0.0)
 
 
+class Domain(NamedTuple):
+    """A particle domain on a uniform grid, in scalars (:func:`_scalars`): its cell, the K its row
+    needs, the domain's ends ``c_-, c_+, s_-, s_+`` (:func:`~mpm_fem.bases.cells.domain_ends`),
+    ``inv_w = 1 / (s_+ - s_-)``, and at each end (``_lo``, ``_hi``) :func:`_pieces`: the first of the
+    three splines there ``d``, their antiderivatives ``M`` (left, centre, right) and values ``N``.
+    Scalars only, so that no array is handed to a helper per particle (reference counting)."""
+
+    cell: int
+    need: int
+    c_lo: int
+    c_hi: int
+    s_lo: float
+    s_hi: float
+    inv_w: float
+    d_lo: int
+    Ml_lo: float
+    M0_lo: float
+    Mr_lo: float
+    Nl_lo: float
+    N0_lo: float
+    Nr_lo: float
+    d_hi: int
+    Ml_hi: float
+    M0_hi: float
+    Mr_hi: float
+    Nl_hi: float
+    N0_hi: float
+    Nr_hi: float
+
+
 @njit(cache=True, inline="always")
 def _scalars(a, b, top_cell, inv_spacing, x, V):
-    """The row on a uniform grid in scalars, for :func:`_column`: the particle's cell ``c``, the K its
-    row needs (``c_+ - c_- + 4``), the domain's ends ``c_-, c_+, s_-, s_+``
-    (:func:`~mpm_fem.bases.cells.domain_ends`), ``inv_w = 1 / (s_+ - s_-)`` and the pieces at both
-    ends (:func:`_pieces`). A flat tuple, so that no array is handed to a helper per particle
-    (reference counting); a tuple of tuples failed to compile in numba's parallel variants."""
+    """The row on a uniform grid in scalars, for :func:`_column`: a :class:`Domain` with
+    ``K_needed = c_+ - c_- + 4`` (flat: a tuple of tuples failed to compile in numba's parallel variants)."""
     c, s_lo, c_lo, s_hi, c_hi = domain_ends(a, b, top_cell, inv_spacing, x, V)
     inv_w = 1.0 / (s_hi - s_lo)
-    return ((c, c_hi - c_lo + 4, c_lo, c_hi, s_lo, s_hi, inv_w)
-            + _pieces(s_lo, c_lo) + _pieces(s_hi, c_hi))
+    d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo = _pieces(s_lo, c_lo)
+    d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi = _pieces(s_hi, c_hi)
+    return Domain(c, c_hi - c_lo + 4, c_lo, c_hi, s_lo, s_hi, inv_w, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo,
+                  d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi)
 
 
 @njit(cache=True, inline="always")
@@ -183,7 +212,7 @@ def _row(nodes, h, inv_spacing, x, V, row, S, G):
         D = _scalars(a, b, n_nodes - 2, inv_spacing, x, V)
         for k in range(K):
             row[k], S[k], G[k] = _column(k, inv_spacing, n_nodes - 1, D)
-        return D[0], D[1]
+        return D.cell, D.need
     c, _ = _locate(nodes, inv_spacing, x)
     lo = max(x - 0.5 * V, a)
     hi = min(x + 0.5 * V, b)
@@ -224,14 +253,14 @@ def _project(geometry, cloud, gas_force, store, lo, hi, stored, buf):
                 empty = q
             continue
         D = _scalars(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
-        need = max(need, D[1])
-        cell[q] = D[0]
+        need = max(need, D.need)
+        cell[q] = D.cell
         mq = m[q]
         mv = mq * v[q]
         Vp = V[q] * p[q]
         if K == 5:
             S0, S1, S2, S3, S4, G0, G1, G2, G3, G4 = _five_columns(inv_spacing, D)
-            first = D[2] - 1  # the columns' nodes c_- - 1 + j, ghosts folded into the end nodes
+            first = D.c_lo - 1  # the columns' nodes c_- - 1 + j, ghosts folded into the end nodes
             put(q, 0, min(max(first, 0), last), S0, G0, (mq, mv, Vp), gas_force, rows, S, G, buf)
             put(q, 1, min(max(first + 1, 0), last), S1, G1, (mq, mv, Vp), gas_force, rows, S, G, buf)
             put(q, 2, min(first + 2, last), S2, G2, (mq, mv, Vp), gas_force, rows, S, G, buf)

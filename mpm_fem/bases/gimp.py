@@ -13,7 +13,7 @@ their arithmetic, bit for bit.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -93,14 +93,27 @@ def _hat_and_integral_at(nodes, i, y):
     return value, left + right
 
 
+class Domain(NamedTuple):
+    """A particle domain on a uniform grid, in scalars (:func:`_scalars`): its cell ``c``, the K its
+    row needs, the domain's ends ``c_-, c_+, s_-, s_+`` (:func:`~mpm_fem.bases.cells.domain_ends`) and
+    ``inv_w = 1 / (s_+ - s_-)``."""
+
+    cell: int
+    need: int
+    c_lo: int
+    c_hi: int
+    s_lo: float
+    s_hi: float
+    inv_w: float
+
+
 @njit(cache=True, inline="always")
 def _scalars(a, b, top_cell, inv_spacing, x, V):
-    """The row on a uniform grid in scalars, for :func:`_column`: ``(c, K_needed = c_+ - c_- + 2,
-    c_-, c_+, s_-, s_+, inv_w)`` (:func:`~mpm_fem.bases.cells.domain_ends`), ``inv_w = 1 / (s_+ -
-    s_-)``, 0 for a domain inside one cell (which needs no division)."""
+    """The row on a uniform grid in scalars, for :func:`_column`: a :class:`Domain` with
+    ``K_needed = c_+ - c_- + 2`` and ``inv_w`` 0 for a domain inside one cell (which needs no division)."""
     c, s_lo, c_lo, s_hi, c_hi = domain_ends(a, b, top_cell, inv_spacing, x, V)
     inv_w = 1.0 / (s_hi - s_lo) if c_hi != c_lo else 0.0
-    return c, c_hi - c_lo + 2, c_lo, c_hi, s_lo, s_hi, inv_w
+    return Domain(c, c_hi - c_lo + 2, c_lo, c_hi, s_lo, s_hi, inv_w)
 
 
 @njit(cache=True, inline="always")
@@ -109,7 +122,7 @@ def _column(k, inv_spacing, last, D):
     has the hats' values at its midpoint, ``S = (1 - xi_m, xi_m)``, ``G = (-1, 1)/h`` (no division);
     otherwise node ``i = min(c_- + k, last)``, ``S = (Psi(s_+ - i) - Psi(s_- - i)) inv_w``, ``G =
     (N(s_+ - i) - N(s_- - i)) inv_w / h`` (``N`` the unit hat), a node repeated at the last node zeroed."""
-    _, _, c_lo, c_hi, s_lo, s_hi, inv_w = D
+    c_lo, c_hi, s_lo, s_hi, inv_w = D.c_lo, D.c_hi, D.s_lo, D.s_hi, D.inv_w
     if c_hi == c_lo:
         xi = 0.5 * (s_lo + s_hi) - c_lo
         if k == 0:
@@ -136,7 +149,7 @@ def _row(nodes, h, inv_spacing, x, V, row, S, G):
         D = _scalars(a, b, n_nodes - 2, inv_spacing, x, V)
         for k in range(K):
             row[k], S[k], G[k] = _column(k, inv_spacing, n_nodes - 1, D)
-        return D[0], D[1]
+        return D.cell, D.need
     c, _ = _locate(nodes, inv_spacing, x)
     lo = max(x - 0.5 * V, a)
     hi = min(x + 0.5 * V, b)
@@ -182,8 +195,8 @@ def _project(geometry, cloud, gas_force, store, lo, hi, stored, buf):
                 empty = q
             continue
         D = _scalars(a, b, n_nodes - 2, inv_spacing, x[q], V[q])
-        need = max(need, D[1])
-        cell[q] = D[0]
+        need = max(need, D.need)
+        cell[q] = D.cell
         mq = m[q]
         mv = mq * v[q]
         Vp = V[q] * p[q]

@@ -42,10 +42,10 @@ from mpm_fem.fused.codes import (
     IV,
     IVOL,
     IX,
-    MUSL,
     USF,
     USL,
 )
+from mpm_fem.fused.models import Checks, ParticleState
 from mpm_fem.fused.remedies import Quadrature, Reset, State
 from mpm_fem.fused.sums import _divide_by_lumped
 
@@ -277,14 +277,14 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
             if gas:
                 rho, p = reset[0, 1, :n], reset[0, 2, :n]
                 if SCHEME != USF and not exact and not TAYLOR_ON:
-                    GAS_FORCE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, p, 0.0, chunks, F_i)
+                    GAS_FORCE(geometry, x, stored, v_i, V, p, 0.0, chunks, F_i)
         if SCHEME == USF:  # the state first, then its force
-            UPDATE(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts,
-                   not exact and not TAYLOR_ON, chunks, V_n, m_n, rho_n, e_n, p_n, F_i, upd, values)
+            UPDATE(geometry, stored, v_i, ParticleState(x, v, V, m, rho, e, p), dt, consts, not exact and not TAYLOR_ON,
+                   chunks, ParticleState(x_n, v_new, V_n, m_n, rho_n, e_n, p_n), F_i, Checks(upd, values, speeds[:0]))
             if (upd >= 0).any():
                 break
         elif not gas and not exact and not TAYLOR_ON:
-            VISCOUS(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, V, eps, chunks, F_i)
+            VISCOUS(geometry, x, stored, v_i, V, V, eps, chunks, F_i)
         if TAYLOR_ON and not exact:
             TAYLOR(geometry, x, stored, p_n if SCHEME == USF else p, v_i, eps, quadrature, chunks, sums, F_i)
         if exact:
@@ -310,7 +310,7 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
             term[:] = v_i
             v_star[:] = v_i
             for _ in range(xpic - 1):
-                XPIC(nodes, h, inv_spacing, x, rows, S, G, cell, term, m, m, 0.0, chunks, P_x)
+                XPIC(geometry, x, stored, term, m, m, 0.0, chunks, P_x)
                 _divide_by_lumped(P_x, m_i, P_x)
                 for i in range(term.size):
                     term[i] = term[i] - P_x[i]
@@ -320,21 +320,20 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
                     v_star[i] += term[i]
             for i in range(target.size):
                 target[i] = v_star[i] + dt * a_i[i]
-        usl, musl = SCHEME == USL, SCHEME == MUSL  # run-time flags: the per-step path's compiled MOVE
+        checks = Checks(flags, values, speeds)
+        old, new = ParticleState(x, v, V, m, rho, e, p), ParticleState(x_n, v_new, V_n, m_n, rho_n, e_n, p_n)
         if SCHEME == USL:
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl,
-                 chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
-        elif SCHEME == USF:
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V_n, m, v, rho_n, e_n, p_n, dt, consts, usl,
-                 musl, chunks, x_n, v_new, V_n, m_n, rho_n, e_n, p_n, P_musl, flags, values, speeds)
+            MOVE(geometry, stored, target, v_n, old, new, dt, consts, SCHEME, chunks, P_musl, checks)
+        elif SCHEME == USF:  # the state updated already: pass 2 moves the particles only
+            MOVE(geometry, stored, target, v_n, ParticleState(x, v, V_n, m, rho_n, e_n, p_n), new, dt, consts, SCHEME,
+                 chunks, P_musl, checks)
         else:  # MUSL: move, re-project the momentum, then the state
-            MOVE(nodes, h, inv_spacing, rows, S, G, cell, target, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl,
-                 chunks, x_n, v_new, V, m, rho, e, p, P_musl, flags, values, speeds)
+            MOVE(geometry, stored, target, v_n, old, ParticleState(x_n, v_new, V, m, rho, e, p), dt, consts, SCHEME,
+                 chunks, P_musl, checks)
             _lumped_walls(P_musl, m_i, ends, v_n)
             if dirichlet:
                 _set_ends(ends, g_next, v_n)
-            FINISH(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v_new, rho, e, p, dt, consts, chunks,
-                   V_n, m_n, rho_n, e_n, p_n, x_n, flags, values, speeds)
+            FINISH(geometry, stored, v_n, old, new, dt, consts, chunks, checks)
         if (flags >= 0).any():
             break
         speed = speeds.max()

@@ -7,7 +7,11 @@ operations in its order. A pass's checks (the first particle whose factor or ene
 positive, the first non-finite one, the largest signal speed) travel as a :class:`Tally` of seven
 floats through the particle loop, so that they stay in registers and numba's parallel analysis
 accepts them.
-Inlined into the passes, except :func:`all_finite`, the run's own check.
+Inlined into the passes, except :func:`all_finite`, the run's own check. The passes hand the particle
+state over as :class:`ParticleState` named tuples, which these helpers unpack before they index: inside
+a ``prange`` body numba 0.68 loses a write through a named tuple's attribute (``new.e[q] = ...``),
+while writes through the unpacked arrays land (``tests/test_fused_remedies.py``'s two-thread runs
+caught it; ``docs/performance.md``).
 """
 
 from typing import NamedTuple
@@ -16,6 +20,31 @@ import numpy as np
 from numba import njit
 
 from mpm_fem.fused.codes import IGGM1, IGM1, ILIN, IQUAD
+
+
+class ParticleState(NamedTuple):
+    """The particles' arrays a pass reads or writes (n_p,), in the columns' order ``IX .. IP``
+    (:mod:`mpm_fem.fused.codes`): position, velocity, volume, mass, density, specific internal energy
+    ``eps``, pressure. A pass takes the old state and the new one it writes (the same arrays where
+    the scheme updates a field in place or not at all)."""
+
+    x: np.ndarray
+    v: np.ndarray
+    V: np.ndarray
+    m: np.ndarray
+    rho: np.ndarray
+    e: np.ndarray
+    p: np.ndarray
+
+
+class Checks(NamedTuple):
+    """A pass's per-chunk outputs (a row per chunk k): ``flags[k]`` the first bad particles (factor,
+    energy and, with three columns, non-finite; -1: none), ``values[k]`` the factor and energy there,
+    ``speed[k]`` the largest signal speed."""
+
+    flags: np.ndarray
+    values: np.ndarray
+    speed: np.ndarray
 
 
 class Tally(NamedTuple):
@@ -69,11 +98,14 @@ def _first(bad, value_at_bad, q, value):
 
 
 @njit(cache=True, inline="always")
-def _new_state(gas, q, L, dt, l, V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts, tally):
+def _new_state(gas, q, L, dt, l, old, new, consts, tally):
     """The model's update of particle q from ``L_p`` (gas: :meth:`IdealGas.update`; Burgers:
-    ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``). Returns the :class:`Tally` updated, with this
+    ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``), from the :class:`ParticleState` ``old`` into ``new``
+    (``l`` the cell size of the artificial viscosity). Returns the :class:`Tally` updated, with this
     particle's sound speed."""
     bad_f, bad_e, bad_n, val_f, val_e, top, _ = tally
+    _, _, V, m, rho, e, p = old
+    _, _, V_new, m_new, rho_new, e_new, p_new = new  # unpacked: see the module docstring
     if gas:
         factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
             rho[q], e[q], p[q], m[q], L, dt, l, consts[IGM1], consts[IGGM1], consts[ILIN], consts[IQUAD])
@@ -87,30 +119,34 @@ def _new_state(gas, q, L, dt, l, V, m, rho, e, p, V_new, m_new, rho_new, e_new, 
 
 
 @njit(cache=True, inline="always")
-def _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, tally):
-    """The tally with ``max(top, c_p + |v_p|)`` (gas) or ``max(top, |v_p|)``, and the first
-    non-finite particle."""
+def _checked(gas, q, c, new, tally):
+    """The tally with ``max(top, c_p + |v_p|)`` (gas) or ``max(top, |v_p|)`` of particle q of the
+    :class:`ParticleState` ``new``, and the first non-finite particle."""
     bad_f, bad_e, bad_n, val_f, val_e, top, _ = tally
+    x, v, V, _, rho, e, p = new
     if gas:
-        top = max(top, c + abs(v_new[q]))
-        ok = _finite(x_new[q], v_new[q], rho_new[q], e_new[q], p_new[q], V_new[q])
+        top = max(top, c + abs(v[q]))
+        ok = _finite(x[q], v[q], rho[q], e[q], p[q], V[q])
     else:
-        top = max(top, abs(v_new[q]))
-        ok = _finite(x_new[q], v_new[q], V_new[q], 0.0, 0.0, 0.0)
+        top = max(top, abs(v[q]))
+        ok = _finite(x[q], v[q], V[q], 0.0, 0.0, 0.0)
     if bad_n < 0 and not ok:
         bad_n = float(q)
     return Tally(bad_f, bad_e, bad_n, val_f, val_e, top, c)
 
 
 @njit(cache=True, inline="always")
-def _flags(k, tally, flags, values):
-    """Chunk k's tally into the pass's outputs: ``flags[k]`` (the first bad particles: factor,
-    energy and, if it has three columns, non-finite), ``values[k]`` (the two values); returns the speed."""
+def _flags(k, tally, checks):
+    """Chunk k's tally into the pass's :class:`Checks`: ``flags[k]`` (the first bad particles: factor,
+    energy and, if it has three columns, non-finite), ``values[k]`` (the two values), ``speed[k]``
+    (where the pass has one per chunk)."""
+    flags, values, speed = checks  # unpacked: see the module docstring
     flags[k, 0], flags[k, 1] = int(tally.bad_factor), int(tally.bad_energy)
     if flags.shape[1] > 2:
         flags[k, 2] = int(tally.bad_finite)
     values[k, 0], values[k, 1] = tally.factor, tally.energy
-    return tally.speed
+    if speed.size > k:
+        speed[k] = tally.speed
 
 
 _NO_TALLY = Tally(-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0)  # no bad particle yet, speed 0

@@ -17,12 +17,17 @@ basis's pieces are compile-time globals of each variant (:mod:`mpm_fem.fused.com
 (1: the basis's rows are pass 1's stored ones, read in place), ``REGISTERS`` (1: the basis gives
 pass 2's sums with its row in registers, ``MOVE_RUN``) and ``ANY_GRID`` (that function serves any
 grid, else a grid uniform to round-off).
+
+The arguments travel as named tuples: ``g`` the grid (:class:`~mpm_fem.bases.contract.Geometry`),
+``store`` pass 1's rows and cells (:class:`~mpm_fem.bases.contract.RowStore`), ``old`` and ``new``
+the particles' state read and written (:class:`~mpm_fem.fused.models.ParticleState`), ``checks``
+the per-chunk flags, values and speeds (:class:`~mpm_fem.fused.models.Checks`).
 """
 
 import numpy as np
 from numba import prange
 
-from mpm_fem.fused.codes import GAS, IEPS, IFLIP, IGGM1, IXPIC, PRESSURE, VISCOUS_STRESS
+from mpm_fem.fused.codes import GAS, IEPS, IFLIP, IGGM1, IXPIC, MUSL, PRESSURE, USL, VISCOUS_STRESS
 from mpm_fem.fused.models import _NO_TALLY, _checked, _flags, _new_state
 from mpm_fem.fused.sums import _chunk, _gather, _gather_stored, _one_row, _scatter, _scatter_stored, _sum_chunks
 
@@ -30,9 +35,9 @@ from mpm_fem.fused.sums import _chunk, _gather, _gather_stored, _one_row, _scatt
 MODEL = WIDTH = WEIGHT = ROW = STORED = REGISTERS = ANY_GRID = MOVE_RUN = None
 
 
-def _scatter_pass(nodes, h, inv_spacing, x, rows, S, G, cell, f_i, a, b, coef, chunks, out):
-    """One scatter over the particles, ``out_i = sum_p w_p W_ip`` (each particle's row recomputed or
-    read as in pass 2), with the weight the compile-time ``WEIGHT`` picks:
+def _scatter_pass(g, x, store, f_i, a, b, coef, chunks, out):
+    """One scatter over the particles at ``x``, ``out_i = sum_p w_p W_ip`` (each particle's row
+    recomputed or read as in pass 2), with the weight the compile-time ``WEIGHT`` picks:
 
         PRESSURE         W = G_ip, w_p = a_p b_p:                  the gas force ``F_i = sum_p V_p p_p G_ip``
                                                                    (after the volume reset)
@@ -42,6 +47,8 @@ def _scatter_pass(nodes, h, inv_spacing, x, rows, S, G, cell, f_i, a, b, coef, c
                          (:func:`mpm_fem.core.transfer.nodal_momentum` of ``shape.gather(u)``)
 
     (``b``, ``coef``, ``f_i``: unused where the weight does not name them)."""
+    nodes, h, inv_spacing = g
+    rows, S, G, cell = store
     n = x.size
     K = WIDTH  # nodes per particle
     buf = np.zeros((chunks, 1, out.size))
@@ -67,14 +74,18 @@ def _scatter_pass(nodes, h, inv_spacing, x, rows, S, G, cell, f_i, a, b, coef, c
     _sum_chunks(buf, 0, out, -1.0 if WEIGHT == VISCOUS_STRESS else 1.0)
 
 
-def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt, consts, force, chunks,
-            V_new, m_new, rho_new, e_new, p_new, F_i, flags, values):
-    """USF: the model's state update from ``L_p = sum_i G_ip v_i`` before the force, and the force
-    of the updated state into ``F_i`` (if ``force``). ``flags[k] = (first particle with factor <= 0,
-    first with energy <= 0)``, ``values[k]`` their values."""
+def _update(g, store, v_i, old, dt, consts, force, chunks, new, F_i, checks):
+    """USF: the model's state update from ``L_p = sum_i G_ip v_i`` before the force (rows at
+    ``old.x``; ``new``'s V, m, rho, eps, p written), and the force of the updated state into ``F_i``
+    (if ``force``). ``checks.flags[k] = (first particle with factor <= 0, first with energy <= 0)``,
+    ``checks.values[k]`` their values."""
+    nodes, h, inv_spacing = g
+    rows, S, G, cell = store
+    x = old.x
     n = x.size
     K = WIDTH  # nodes per particle
     gas, eps = MODEL == GAS, consts[IEPS]
+    V_new, p_new = new.V, new.p
     buf = np.zeros((chunks, 1, F_i.size))
     for k in prange(chunks):
         tally = _NO_TALLY
@@ -82,25 +93,29 @@ def _update(nodes, h, inv_spacing, x, rows, S, G, cell, v_i, V, m, rho, e, p, dt
         for q in range(*_chunk(n, chunks, k)):
             c = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             L = _gather(Gl, v_i, r, K)
-            tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new, consts,
-                               tally)
+            tally = _new_state(gas, q, L, dt, h[0, c], old, new, consts, tally)
             if force:
                 _scatter(buf, k, r, Gl, V_new[q] * p_new[q] if gas else -(V_new[q] * (eps * L)), K)
-        _flags(k, tally, flags, values)
+        _flags(k, tally, checks)
     if force:
         _sum_chunks(buf, 0, F_i, 1.0)
 
 
-def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e, p, dt, consts, usl, musl, chunks,
-          x_new, v_new, V_new, m_new, rho_new, e_new, p_new, P_i, flags, values, speed):
-    """Pass 2: ``v_p += dt sum S a``, ``x_p += dt sum S v^{n+1}``; USL: the state update from
-    ``L_p = sum G v^{n+1}``; MUSL: ``P_i = sum_p m_p v_p^{n+1} S_ip``. The blend ``consts[IFLIP]``
-    (FLIP 1) mixes in ``sum S v^{n+1}``; with ``consts[IXPIC] > 0`` (XPIC) ``a_i`` holds ``v* + dt a``
-    and ``v_p = sum S a_i``. ``speed[k]``: max of
-    ``c_p + |v_p|`` (gas) or ``|v_p|`` (Burgers) over chunk k; ``flags[k] = (first bad factor,
-    first bad energy, first non-finite particle)``."""
+def _move(g, store, a_i, v_n, old, new, dt, consts, scheme, chunks, P_i, checks):
+    """Pass 2 from the rows at ``old.x``: ``new.v = old.v + dt sum S a``, ``new.x = old.x + dt sum S
+    v^{n+1}``; USL (``scheme``, :mod:`mpm_fem.fused.codes`): the state update from
+    ``L_p = sum G v^{n+1}``, ``old`` into ``new``; MUSL: ``P_i = sum_p m_p v_p^{n+1} S_ip``. The blend
+    ``consts[IFLIP]`` (FLIP 1) mixes in ``sum S v^{n+1}``; with ``consts[IXPIC] > 0`` (XPIC) ``a_i``
+    holds ``v* + dt a`` and ``v_p = sum S a_i``. ``checks.speed[k]``: max of ``c_p + |v_p|`` (gas) or
+    ``|v_p|`` (Burgers) over chunk k; ``checks.flags[k] = (first bad factor, first bad energy, first
+    non-finite particle)``."""
+    nodes, h, inv_spacing = g
+    rows, S, G, cell = store
+    x, v, m = old.x, old.v, old.m
+    x_new, v_new, e_new = new.x, new.v, new.e
     n = x.size
     K = WIDTH  # nodes per particle
+    usl, musl = scheme == USL, scheme == MUSL
     gas, g_gm1 = MODEL == GAS, consts[IGGM1]
     flip = consts[IFLIP] if consts.size > IFLIP else 1.0  # the PIC/FLIP blend (a shorter consts: FLIP)
     pic = consts.size > IXPIC and consts[IXPIC] > 0  # XPIC: a_i holds v* + dt a
@@ -115,9 +130,8 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
                     c, acc, vel, L = MOVE_RUN(nodes, h, inv_spacing, x[q], a_i, v_n)
                     v_new[q] = v[q] + dt * acc
                     x_new[q] = x[q] + dt * vel
-                    tally = _new_state(gas, q, L, dt, h[0, c], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new,
-                                       consts, tally)
-                    tally = _checked(gas, q, tally.sound_speed, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+                    tally = _new_state(gas, q, L, dt, h[0, c], old, new, consts, tally)
+                    tally = _checked(gas, q, tally.sound_speed, new, tally)
                 lo = hi
         for q in range(lo, hi):
             # stored rows: pass 1's row read in place, and USL's L_p (_gather's sum) in the same loop
@@ -153,21 +167,23 @@ def _move(nodes, h, inv_spacing, rows, S, G, cell, a_i, v_n, x, V, m, v, rho, e,
             if usl:
                 if STORED == 0:
                     L = _gather(Gl, v_n, r, K)
-                tally = _new_state(gas, q, L, dt, h[0, cq], V, m, rho, e, p,
-                                   V_new, m_new, rho_new, e_new, p_new, consts, tally)
+                tally = _new_state(gas, q, L, dt, h[0, cq], old, new, consts, tally)
                 c = tally.sound_speed
             else:
                 c = np.sqrt(g_gm1 * max(e_new[q], 0.0)) if gas else 0.0
-            tally = _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
-        speed[k] = _flags(k, tally, flags, values)
+            tally = _checked(gas, q, c, new, tally)
+        _flags(k, tally, checks)
     if musl:
         _sum_chunks(buf, 0, P_i, 1.0)
 
 
-def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p, dt, consts, chunks,
-            V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed):
+def _finish(g, store, v_n, old, new, dt, consts, chunks, checks):
     """MUSL's last pass: the state update from ``L_p = sum_i G_ip v_i^{n+1}`` (re-projected; the
-    shape at ``x_p^n``), the speed and the checks, as in :func:`_move`."""
+    shape at ``old.x``, ``x_p^n``), ``old`` into ``new`` (whose x and v pass 2 wrote), the speed and
+    the checks, as in :func:`_move`."""
+    nodes, h, inv_spacing = g
+    rows, S, G, cell = store
+    x = old.x
     n = x.size
     K = WIDTH  # nodes per particle
     gas = MODEL == GAS
@@ -176,13 +192,12 @@ def _finish(nodes, h, inv_spacing, x, rows, S, G, cell, v_n, V, m, v, rho, e, p,
         tally = _NO_TALLY
         for q in range(*_chunk(n, chunks, k)):
             cq = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[0, cq], V, m, rho, e, p,
-                               V_new, m_new, rho_new, e_new, p_new, consts, tally)
-            tally = _checked(gas, q, tally.sound_speed, x_new, v, rho_new, e_new, p_new, V_new, tally)
-        speed[k] = _flags(k, tally, flags, values)
+            tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[0, cq], old, new, consts, tally)
+            tally = _checked(gas, q, tally.sound_speed, new, tally)
+        _flags(k, tally, checks)
 
 
-def _move_exact(nodes, h, inv_spacing, rows, S, G, cell, a_c, v_c, p_v, p_a, x, v, dt, chunks, x_new, v_new, L_c):
+def _move_exact(g, store, a_c, v_c, p_v, p_a, old, new, dt, chunks, L_c):
     """Pass 2 of a step with the exact interpolation (:func:`mpm_fem.core.step.explicit_step`), before its
     state update: with ``a_c = a_i - a*_i`` and ``v_c = v_i^{n+1} - v*_i^{n+1}`` (the nodal values
     less the exact ones, the boundary rule applied to both) and ``p_v = v*(x_p^n)``, ``p_a = a*(x_p^n)``,
@@ -190,7 +205,11 @@ def _move_exact(nodes, h, inv_spacing, rows, S, G, cell, a_c, v_c, p_v, p_a, x, 
         v_p <- v_p + dt (p_a + sum_i S_ip a_c,i),
         x_p <- x_p + dt ((p_v + dt p_a) + sum_i S_ip v_c,i),       L_c,p = sum_i G_ip v_c,i,
 
-    the numpy step's operations in its order (``L_p = v*_x(x_p^{n+1}, t + dt) + L_c,p`` follows)."""
+    ``old``'s x and v into ``new``'s, the numpy step's operations in its order
+    (``L_p = v*_x(x_p^{n+1}, t + dt) + L_c,p`` follows)."""
+    nodes, h, inv_spacing = g
+    rows, S, G, cell = store
+    x, v, x_new, v_new = old.x, old.v, new.x, new.v
     n = x.size
     K = WIDTH  # nodes per particle
     for k in prange(chunks):
@@ -204,17 +223,14 @@ def _move_exact(nodes, h, inv_spacing, rows, S, G, cell, a_c, v_c, p_v, p_a, x, 
             L_c[q] = _gather(Gl, v_c, r, K)
 
 
-def _update_exact(h, cell, L, x_new, v_new, V, m, rho, e, p, dt, consts, chunks, V_new, m_new, rho_new, e_new,
-                  p_new, flags, values, speed):
+def _update_exact(h, cell, L, old, new, dt, consts, chunks, checks):
     """The state update of :func:`_move_exact`'s particles from their ``L_p`` (USL, the cell of
-    ``x_p^n``), with pass 2's checks: ``speed[k]``, ``flags[k]``, ``values[k]`` as :func:`_move`'s."""
-    n = x_new.size
+    ``x_p^n``), ``old`` into ``new``, with pass 2's checks (``checks`` as :func:`_move`'s)."""
+    n = L.size
     gas = MODEL == GAS
     for k in prange(chunks):
         tally = _NO_TALLY
         for q in range(*_chunk(n, chunks, k)):
-            tally = _new_state(gas, q, L[q], dt, h[0, cell[q]], V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new,
-                               consts, tally)
-            tally = _checked(gas, q, tally.sound_speed, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
-        speed[k] = _flags(k, tally, flags, values)
-
+            tally = _new_state(gas, q, L[q], dt, h[0, cell[q]], old, new, consts, tally)
+            tally = _checked(gas, q, tally.sound_speed, new, tally)
+        _flags(k, tally, checks)

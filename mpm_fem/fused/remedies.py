@@ -101,7 +101,7 @@ def _volume_reset(geometry, stored, state, integrals, consts, chunks, width, out
                 _scatter_stored(buf, k, rows, q, S, V[q], width)
             elif inv_spacing > 0.0:
                 D = TWIN_SCALARS(a, b, last - 1, inv_spacing, x[q], V[q])
-                need = max(need, D[1])
+                need = max(need, D.need)
                 for j in range(width):
                     i, s, _ = TWIN_COLUMN(j, inv_spacing, last, D)
                     buf[k, 0, i] += s * V[q]

@@ -51,6 +51,7 @@ from mpm_fem.fused.codes import (
 )
 from mpm_fem.fused.compiler import PASSES
 from mpm_fem.fused.loop import _LOOP_CALLS, Clock, Conditions, Geometry, Remedies, Scratch, _advance, _nodal_rows
+from mpm_fem.fused.models import Checks, ParticleState
 from mpm_fem.fused.passes import _finish, _move, _move_exact, _scatter_pass, _update, _update_exact
 from mpm_fem.fused.project import _project
 from mpm_fem.fused.remedies import Quadrature, Reset, State, _taylor_force, _volume_reset
@@ -319,7 +320,7 @@ class FusedStep:
         flags, values = np.empty((chunks, 2), np.int64), np.zeros((chunks, 2))
         while True:
             width = self.K if self.basis.domain else self.volume_width
-            reset(Geometry(*geometry), stored, State(x, V, m, rho, e, p),
+            reset(geometry, stored, State(x, V, m, rho, e, p),
                   self.integrals, self.consts, chunks, width, Reset(V_i, ratio, V_r, rho_r, p_r), flags, values)
             need = int(flags[:, 1].max(initial=0))
             if need <= width:
@@ -384,14 +385,14 @@ class FusedStep:
         scheme, exact = self.stages.scheme, self.stages.acceleration == "exact"
         grid_volume, taylor = self.stages.volume == "grid", self.stages.reconstruct == "taylor"
         gas_force = gas and scheme != "usf" and not exact and not grid_volume and not taylor
-        geometry = (self.nodes, self.h, self.inv_spacing)
+        geometry = Geometry(self.nodes, self.h, self.inv_spacing)
         n_nodes = grid.n_nodes
         self._turn = 1 - self._turn
         empty = self._empty
         shape, m_i, P_i, F_i, flags = self._pass1(particles, gas_force, self.stages.mass == "consistent", chunks)
         rows, S, G, cell = shape.nodes, shape.S, shape.G, shape.cell
         v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
-        shape_args = (*geometry, x, rows, S, G, cell)
+        shape_args = (geometry, x, RowStore(rows, S, G, cell))
         if grid_volume:  # the volume reset (mpm_fem.core.volume), then the force of the reset state
             V, rho, p = self._grid_volume(geometry, RowStore(rows, S, G, cell), x, V, m, rho, e, p, chunks)
             if gas and scheme != "usf" and not exact and not taylor:
@@ -401,18 +402,19 @@ class FusedStep:
         V_new, m_new = empty("V", n), (empty("m", n) if not gas else m)
         rho_new, e_new, p_new = (empty("rho", n), empty("e", n), empty("p", n)) if gas else (rho, e, p)
         values = np.zeros((chunks, 2))
+        old = ParticleState(x, v, V, m, rho, e, p)
         if scheme == "usf":
             upd = np.empty((chunks, 2), np.int64)
-            self.update(*shape_args, v_i, V, m, rho, e, p, dt, self.consts,
-                        not exact and not self.slides and not taylor, chunks, V_new, m_new, rho_new, e_new, p_new, F_i,
-                        upd, values)
+            force = not exact and not self.slides and not taylor
+            self.update(geometry, shape_args[2], v_i, old, dt, self.consts, force, chunks,
+                        ParticleState(x, v, V_new, m_new, rho_new, e_new, p_new), F_i, Checks(upd, values, np.empty(0)))
             if (upd >= 0).any():
                 self._positivity(upd, values, x)
         elif not gas and not exact and not self.slides and not taylor:
             self.viscous_force(*shape_args, v_i, V, V, self.consts[IEPS], chunks, F_i)
         if taylor and not exact and not self.slides:  # the reconstructed force of the (updated) stress
             self._passes.get(_taylor_force, BASIS=self.basis, MODEL=self.kind, WIDTH=self.K)(
-                Geometry(*geometry), x, RowStore(rows, S, G, cell), p_new if scheme == "usf" else p, v_i,
+                geometry, x, RowStore(rows, S, G, cell), p_new if scheme == "usf" else p, v_i,
                 self.consts[IEPS], Quadrature(*self.quadrature), chunks, empty("sums", (5, grid.n_cells)), F_i)
         if exact:
             if self.exact_acceleration is None:
@@ -428,19 +430,22 @@ class FusedStep:
         x_new, vel_new = empty("x", n), empty("v", n)
         speed = np.empty(chunks)
         usl, musl = scheme == "usl", scheme == "musl"
+        new = ParticleState(x_new, vel_new, V_new, m_new, rho_new, e_new, p_new)
         if usl:  # the move writes the new state
-            state = (V, m, rho, e, p, V_new, m_new, rho_new, e_new, p_new)
-        else:  # USF: updated already; MUSL: updated after the re-projection
-            V_m, m_m, rho_m, e_m, p_m = (V_new, m_new, rho_new, e_new, p_new) if scheme == "usf" else (V, m, rho, e, p)
-            state = (V_m, m, rho_m, e_m, p_m, V_m, m_m, rho_m, e_m, p_m)
+            moving, moved = old, new
+        elif scheme == "usf":  # updated already: the move reads and keeps the updated state
+            moving = ParticleState(x, v, V_new, m, rho_new, e_new, p_new)
+            moved = new
+        else:  # MUSL: the state updated after the re-projection
+            moving, moved = old, ParticleState(x_new, vel_new, V, m, rho, e, p)
         P_musl = empty("P_musl", n_nodes)
         target = self._xpic_target(shape, shape_args, m, m_i, v_i, a_i, t, dt, chunks) if self.stages.xpic else a_i
-        self.move(*geometry, rows, S, G, cell, target, v_n, x, state[0], state[1], v, state[2], state[3], state[4],
-                  dt, self.consts, usl, musl, chunks, x_new, vel_new, *state[5:], P_musl, flags, values, speed)
+        checks = Checks(flags, values, speed)
+        self.move(geometry, shape_args[2], target, v_n, moving, moved, dt, self.consts, SCHEME_CODE[scheme], chunks,
+                  P_musl, checks)
         if musl:
             v_n = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_musl, "v_musl"), t + dt)
-            self.finish(*shape_args, v_n, V, m, vel_new, rho, e, p, dt, self.consts, chunks,
-                        V_new, m_new, rho_new, e_new, p_new, x_new, flags, values, speed)
+            self.finish(geometry, shape_args[2], v_n, old, new, dt, self.consts, chunks, checks)
         if usl or musl:
             if (flags[:, :2] >= 0).any():
                 self._positivity(flags[:, :2], values, x_new)
@@ -473,21 +478,23 @@ class FusedStep:
         x_new, vel_new = empty("x", n), empty("v", n)
         V_new, rho_new, e_new, p_new = (empty(name, n) for name in ("V", "rho", "e", "p"))
         values, speed = np.zeros((chunks, 2)), np.empty(chunks)
-        geometry = (self.nodes, self.h, self.inv_spacing, shape.nodes, shape.S, shape.G, shape.cell)
+        geometry = Geometry(self.nodes, self.h, self.inv_spacing)
+        store = RowStore(shape.nodes, shape.S, shape.G, shape.cell)
+        old = ParticleState(x, v, V, m, rho, e, p)
+        new = ParticleState(x_new, vel_new, V_new, m, rho_new, e_new, p_new)
+        checks = Checks(flags, values, speed)
         if interpolate:
             p_v, _, p_a = self.exact.reference(x, t)
             star_new = stage.star_new
             L = empty("L", n)
             self._passes.get(_move_exact, BASIS=self.basis, WIDTH=self.K)(
-                *geometry, a_i - stage.star_a, v_n - star_new, p_v, p_a, x, v, dt, chunks, x_new, vel_new, L)
+                geometry, store, a_i - stage.star_a, v_n - star_new, p_v, p_a, old, new, dt, chunks, L)
             L = self.exact.velocity_gradient(x_new, t + dt) + L
-            self._passes.get(_update_exact, MODEL=self.kind)(
-                self.h, shape.cell, L, x_new, vel_new, V, m, rho, e, p, dt, self.consts, chunks,
-                V_new, m, rho_new, e_new, p_new, flags, values, speed)
+            self._passes.get(_update_exact, MODEL=self.kind)(self.h, shape.cell, L, old, new, dt, self.consts, chunks,
+                                                             checks)
         else:
-            state = (V, m, rho, e, p, V_new, m, rho_new, e_new, p_new)
-            self.move(*geometry, a_i, v_n, x, *state[:2], v, *state[2:5], dt, self.consts, True, False,
-                      chunks, x_new, vel_new, *state[5:], empty("P_musl", self.grid.n_nodes), flags, values, speed)
+            self.move(geometry, store, a_i, v_n, old, new, dt, self.consts, SCHEME_CODE["usl"], chunks,
+                      empty("P_musl", self.grid.n_nodes), checks)
         if (flags[:, :2] >= 0).any():
             self._positivity(flags[:, :2], values, x_new)
         return self._new_particles(x_new, vel_new, V_new, m, rho_new, e_new, p_new, flags, speed), \

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
+from typing import NamedTuple
 
 from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, GROWTH_ORDER, num, select, span
@@ -46,6 +47,14 @@ MECHANISM_MESHES = int(rule("MECHANISM_MESHES"))
 _RUN = ("ppc", "layout", "seed")
 
 SUMMARY = MECHANISM_SUMMARY.name
+
+
+class GrowthCase(NamedTuple):
+    """A particles-per-cell value and a pair of successive meshes, on which a growth is judged."""
+
+    ppc: int
+    h_coarse: float
+    h_fine: float
 
 
 def _run_key(row: dict) -> tuple:
@@ -85,7 +94,7 @@ def _pairs(rows: list[dict]) -> list[tuple[float, float]]:
 
 
 def growth_cases(rows: list[dict]) -> dict:
-    """From one problem's summary rows: ``{"judged": [(ppc, (h_c, h_f)), ...], "growth": {case: mpm row},
+    """From one problem's summary rows: ``{"judged": [GrowthCase, ...], "growth": {case: mpm row},
     "named": {case: [stages]}, "stops": {case: [stages]}}``; a particles-per-cell value is judged when
     all MPM has MIN_RUNS runs on every one of at least MECHANISM_MESHES - 1 mesh pairs."""
     judged, growth, named, stops = [], {}, {}, {}
@@ -94,11 +103,11 @@ def growth_cases(rows: list[dict]) -> dict:
         if len(_pairs(mpm)) < MECHANISM_MESHES - 1 or any(num(r, "runs") < MIN_RUNS for r in mpm):
             continue
         for r in sorted(mpm, key=lambda r: -num(r, "h_coarse")):
-            case = (ppc, (num(r, "h_coarse"), num(r, "h_fine")))
+            case = GrowthCase(ppc, num(r, "h_coarse"), num(r, "h_fine"))
             judged.append(case)
             if num(r, "mpm_growing") > 0:
                 growth[case] = r
-                alone = {s: select(rows, ppc=ppc, made_exact=s, h_coarse=case[1][0], h_fine=case[1][1])
+                alone = {s: select(rows, ppc=ppc, made_exact=s, h_coarse=case.h_coarse, h_fine=case.h_fine)
                          for s in STAGES}
                 g = num(r, "mpm_growing")
                 named[case] = [s for s, x in alone.items() if x and num(x[0], "converging_where_mpm_grows") >= g]
@@ -106,13 +115,13 @@ def growth_cases(rows: list[dict]) -> dict:
     return {"judged": judged, "growth": growth, "named": named, "stops": stops}
 
 
-def _case_text(case: tuple) -> str:
-    ppc, (hc, hf) = case
+def _case_text(case: GrowthCase) -> str:
+    ppc, hc, hf = case
     return f"{ppc} ppc, h = {hc:g} -> {hf:g}"
 
 
-def _orders(rows: list[dict], case: tuple, made_exact: str) -> str:
-    ppc, (hc, hf) = case
+def _orders(rows: list[dict], case: GrowthCase, made_exact: str) -> str:
+    ppc, hc, hf = case
     found = select(rows, ppc=ppc, made_exact=made_exact, h_coarse=hc, h_fine=hf)
     return span([num(found[0], "order_min"), num(found[0], "order_max")]) if found else "-"
 
