@@ -17,7 +17,7 @@ from studies import method
 @pytest.fixture(autouse=True)
 def own_registry(monkeypatch):
     monkeypatch.setattr(registry, "_BASES", dict(registry._BASES))
-    monkeypatch.setattr(plugins, "_LOADED", {})
+    monkeypatch.setattr(plugins.LOADER, "loaded", {})
 
 
 def _projection(mean, lo, hi):
