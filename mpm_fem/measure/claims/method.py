@@ -90,7 +90,7 @@ def budget_section(rows: list[dict], bases: tuple[str, ...]) -> list[str]:
     lines = ["## The error budget (E1's measurement, one mesh a problem)", "",
              "Each stage's Shapley share of v(all MPM) - v(all exact), the particle L1 error with every stage in "
              "MPM form and with every stage exact (`budget.csv`; the shares add up to 100 %; a share above 100 % or "
-             "below 0 is a stage that the others' interactions offset). No verdict: one mesh a problem.", ""]
+             "below 0 is a stage that the others' interactions offset). Reported without a verdict.", ""]
     for problem in dict.fromkeys(r["problem"] for r in rows):
         lines += [f"### {problem}", "", "| basis | h | v(all MPM) | v(all exact) | "
                   + " | ".join(stages) + " |", "|---" * (4 + len(stages)) + "|"]
