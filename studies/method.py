@@ -11,15 +11,24 @@
   per cell, CFL 0.05; Burgers the rarefaction with the calculated acceleration, 4 per cell) on
   :data:`PLAN`'s meshes, the regular layout and jittered seeds, and the orders between successive
   meshes with their range over the runs.
+- the error budget (E1's measurement, ``studies/budget.py``'s :func:`~studies.budget.budget_case`):
+  the sixteen subsets of the four stages {projection, mass, interpolation, time} in MPM or exact
+  form at the budget study's settings, the regular layout, on one mesh a problem (:data:`PLAN`'s
+  ``budget``), and each stage's Shapley share of ``v(all MPM) - v(all exact)`` (particle L1). The
+  exact stages run the basis's compiled row, so a basis without compiled kernels has no budget (its
+  rows say so).
 
 Tables, in ``<out>/method/<basis>/``: ``projection.csv`` (basis, layout, quantity, mean, lo, hi,
 runs), ``runs.csv`` (basis, problem, h, seed, ok, particles_L1, nodes_L1), ``orders.csv`` (basis,
-problem, h_coarse, h_fine, mean, lo, hi, runs); ``METHOD.md`` their verdicts, judged by
+problem, h_coarse, h_fine, mean, lo, hi, runs), ``budget.csv`` (the budget study's ``shapley.csv``
+columns, particle norm, and ``ok``/``error``: basis, problem, h, stage, shapley, share, alone,
+removed, mpm_error, exact_error); ``METHOD.md`` their verdicts, judged by
 :mod:`mpm_fem.measure.claims.method` with the rule book's thresholds, every number formatted from
-the tables of the same run. A basis from outside the package runs in each worker after being
-resolved there; its cases' cache keys hold a hash of its module's source, so a change to it reruns
-them. The quick plan runs in a few minutes on 2 cores (the numpy step of a basis without kernels
-costs about ten times the compiled one); ``--full`` takes finer meshes and more seeds.
+the tables of the same run, and the budget as a table without a verdict. A basis from outside the
+package runs in each worker after being resolved there; its cases' cache keys hold a hash of its
+module's source, so a change to it reruns them. The quick plan runs in a few minutes on 2 cores
+(the numpy step of a basis without kernels costs about ten times the compiled one); ``--full``
+takes finer meshes and more seeds.
 """
 
 from __future__ import annotations
@@ -40,9 +49,10 @@ OURS = ("mpm", "gimp", "bspline", "bspline_gimp")
 PROBLEMS = {"sod": "density", "burgers": "velocity"}
 PLAN = {
     "quick": {"cells": (20, 40, 80), "seeds": (1, 2, 3), "h": {"sod": (0.02, 0.01), "burgers": (0.04, 0.02)},
-              "runs": (0, 1, 2)},
+              "runs": (0, 1, 2), "budget": {"sod": 0.02, "burgers": 0.04}},
     "full": {"cells": (20, 40, 80, 160, 320), "seeds": (1, 2, 3, 4, 5),
-             "h": {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}, "runs": (0, 1, 2, 3, 4, 5)},
+             "h": {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}, "runs": (0, 1, 2, 3, 4, 5),
+             "budget": {"sod": 0.01, "burgers": 0.04}},
 }
 LAYOUTS = ("regular", "jittered")
 PPC = 4  # the projection's particles per cell
@@ -68,6 +78,7 @@ def plan(basis: str, spec: str | None, tier: str) -> list[dict]:
                    "seeds": [0] if lay == "regular" else list(p["seeds"]), **extra} for lay in LAYOUTS]
         cases += [{"kind": "run", "problem": prob, "basis": b, "h": h, "seed": s, **extra}
                   for prob in PROBLEMS for h in p["h"][prob] for s in p["runs"]]
+        cases += [{"kind": "budget", "problem": prob, "basis": b, "h": h, **extra} for prob, h in p["budget"].items()]
     return cases
 
 
@@ -78,7 +89,7 @@ def describe_estimate(basis: str, spec: str, options: StudyOptions) -> str:
     from mpm_fem.bases import compiled
 
     cases = plan(basis, spec if ":" in spec else None, "quick" if options.quick else "full")
-    seconds = 0.0
+    seconds = sum(budget_seconds(c) for c in cases if c["kind"] == "budget")
     for c in cases:
         if c["kind"] == "run":
             s = checked_settings(c["problem"], "study", {"h": c["h"], "basis": c["basis"]}, "mpm-fem method",
@@ -88,12 +99,40 @@ def describe_estimate(basis: str, spec: str, options: StudyOptions) -> str:
     return f"{len(cases)} cases, estimated {seconds / 60:.1f} CPU-min, {basis} on {step}"
 
 
+def budget_seconds(case: dict) -> float:
+    """Estimated CPU seconds of a budget case: the budget study's cost model, P1's for a basis it has
+    none for (none for a basis without compiled kernels: it has no budget)."""
+    from mpm_fem.bases import compiled
+
+    budget = importlib.import_module("studies.budget")
+    if not compiled(case["basis"]):
+        return 0.0
+    known = (case["problem"], case["basis"]) in budget.BUDGET_STEP_MS
+    return budget.cost({**case, "basis": case["basis"] if known else "mpm"}) * budget.SECONDS_PER_COST
+
+
+def budget_case(case: dict) -> dict:
+    """The error budget of one (problem, h, basis) (``studies/budget.py``'s case at its settings): ``ok``
+    and the subsets' ``v(S)`` per norm, or why it has none."""
+    from mpm_fem.bases import compiled
+
+    if not compiled(case["basis"]):
+        return {"ok": False, "error": "the exact stages need the basis's compiled row (kernels = None)"}
+    budget = importlib.import_module("studies.budget")
+    got = budget.budget_case({"kind": "budget", "problem": case["problem"], "h": case["h"], "basis": case["basis"],
+                              "K": budget.K})
+    failed = [r.get("error", "") for r in got["runs"] if not r["ok"]]
+    return {"ok": got["ok"], "subsets": got.get("subsets", {}), "error": failed[0] if failed else ""}
+
+
 def run_case(case: dict) -> dict:
     """One case in a worker: the basis resolved there first (a basis from outside the package)."""
     from mpm_fem.bases import plugins
 
     if case.get("spec"):
         plugins.resolve(case["spec"])
+    if case["kind"] == "budget":
+        return budget_case(case)
     if case["kind"] == "projection":
         from mpm_fem.measure.method import projection_orders
 
@@ -116,9 +155,11 @@ def tables(cases: list[dict], results: list[dict]) -> dict[str, list[dict]]:
     """``projection``, ``runs`` and ``orders`` rows (module docstring)."""
     from mpm_fem.measure.spread import spread
 
-    projection, runs = [], []
+    projection, runs, budgets = [], [], []
     for c, r in zip(cases, results, strict=True):
-        if c["kind"] == "projection":
+        if c["kind"] == "budget":
+            budgets.append((c, r))
+        elif c["kind"] == "projection":
             projection += [{"basis": c["basis"], "layout": c["layout"], "quantity": q, **o}
                            for q, o in r["orders"].items()]
         else:
@@ -143,7 +184,25 @@ def tables(cases: list[dict], results: list[dict]) -> dict[str, list[dict]]:
                            "mean": s.mean if s else "", "lo": s.lo if s else "", "hi": s.hi if s else "",
                            "runs": len(got),
                            "failed": sum(1 for r in rows if not r["ok"] and r["h"] in (coarse, fine))})
-    return {"projection": projection, "runs": runs, "orders": orders}
+    return {"projection": projection, "runs": runs, "orders": orders, "budget": budget_rows(budgets)}
+
+
+def budget_rows(budgets: list[tuple[dict, dict]]) -> list[dict]:
+    """``budget.csv``: the budget study's Shapley rows (particle norm) of each budget that ran
+    (:func:`studies.budget.decomposition_rows`), ``ok`` True; one row ``ok`` False with its
+    ``error`` for each that did not."""
+    budget = importlib.import_module("studies.budget")
+    ran = {(c["problem"], c["h"], c["basis"]): r for c, r in budgets if r["ok"]}
+    shapley = budget.decomposition_rows([row for row in budget.subset_rows(ran) if row["norm"] == "particles"])[0]
+    rows = [{"basis": r["basis"], "problem": r["problem"], "h": r["h"], "ok": True, "error": "",
+             **{k: r[k] for k in BUDGET_COLUMNS}} for r in shapley]
+    rows += [{"basis": c["basis"], "problem": c["problem"], "h": c["h"], "ok": False, "error": r.get("error", ""),
+              **dict.fromkeys(BUDGET_COLUMNS, "")} for c, r in budgets if not r["ok"]]
+    return rows
+
+
+#: the columns ``budget.csv`` keeps of the budget study's ``shapley.csv``
+BUDGET_COLUMNS = ("stage", "shapley", "share", "alone", "removed", "mpm_error", "exact_error")
 
 
 def run(spec: str, options: StudyOptions) -> Path:

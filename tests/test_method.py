@@ -24,7 +24,7 @@ TESTS = Path(__file__).parent
 @pytest.fixture(autouse=True)
 def own_registry(monkeypatch):
     monkeypatch.setattr(registry, "_BASES", dict(registry._BASES))
-    monkeypatch.setattr(plugins, "_LOADED", {})
+    monkeypatch.setattr(plugins.LOADER, "loaded", {})
 
 
 def test_the_quadrature_gives_the_hats_exact_integrals_of_the_projection_study():

@@ -10,14 +10,14 @@ import pytest
 from mpm_fem.app.cli import main
 from mpm_fem.bases import plugins, registry
 from mpm_fem.measure.claims.base import CONFIRMED, NOT_MEASURED, PARTLY, REFUTED
-from mpm_fem.measure.claims.method import acceleration, convergence
+from mpm_fem.measure.claims.method import acceleration, budget_section, convergence
 from studies import method
 
 
 @pytest.fixture(autouse=True)
 def own_registry(monkeypatch):
     monkeypatch.setattr(registry, "_BASES", dict(registry._BASES))
-    monkeypatch.setattr(plugins, "_LOADED", {})
+    monkeypatch.setattr(plugins.LOADER, "loaded", {})
 
 
 def _projection(mean, lo, hi):
@@ -56,7 +56,8 @@ def test_the_tables_take_the_order_of_each_run_between_successive_meshes():
 def test_a_small_plan_measures_a_copy_of_the_hats_as_the_hats(monkeypatch, tmp_path):
     monkeypatch.setattr(method, "OURS", ("mpm",))
     monkeypatch.setitem(method.PLAN, "quick", {"cells": (20, 40), "seeds": (1, 2), "runs": (0, 1),
-                                               "h": {"sod": (0.05, 0.025), "burgers": (0.08, 0.04)}})
+                                               "h": {"sod": (0.05, 0.025), "burgers": (0.08, 0.04)},
+                                               "budget": {"burgers": 0.08}})
     assert main(["method", "plugin_bases:Hats", "--out", str(tmp_path), "--jobs", "1", "--quiet"]) == 0
     page = (tmp_path / "method" / "hats" / "METHOD.md").read_text()
     for claim in ("M1", "M2", "M3"):  # the same verdict and numbers for the copy and the hats, claim by claim
@@ -68,6 +69,32 @@ def test_a_small_plan_measures_a_copy_of_the_hats_as_the_hats(monkeypatch, tmp_p
     assert len(orders) == 1 + 2 * 2  # (hats, mpm) x (sod, burgers), one pair of meshes each
     assert json.loads((tmp_path / "method" / "hats" / "orders.json").read_text())["settings"]["spec"] == \
         "plugin_bases:Hats"
+    budget = page.split("## The error budget")[1]
+    assert "| **hats** | 0.08 | not measured: the exact stages need the basis's compiled row" in budget
+    (mpm,) = [line for line in budget.splitlines() if line.startswith("| mpm | 0.08 |")]
+    shares = [float(cell.strip(" %")) for cell in mpm.split("|")[5:9]]
+    assert abs(sum(shares) - 100) <= 2 and len(shares) == 4, mpm  # four stages' shares of the gap, rounded
+
+
+def _budget_case(basis, problem, subsets):
+    return ({"kind": "budget", "problem": problem, "h": 0.04, "basis": basis},
+            {"ok": True, "subsets": {"particles": subsets}})
+
+
+def test_the_budget_table_is_the_budget_studys_shapley_decomposition():
+    from studies.budget import STAGES, label, subsets
+
+    # v(S) = 1 + 3 [projection in S] + 1 [time in S]: projection holds 3/4 of the gap, time 1/4, no interaction
+    values = {label(S): 1.0 + 3.0 * ("projection" in S) + 1.0 * ("time" in S) for S in subsets(STAGES)}
+    rows = method.budget_rows([_budget_case("b", "burgers", values),
+                               ({"kind": "budget", "problem": "burgers", "h": 0.04, "basis": "c"},
+                                {"ok": False, "error": "a particle left the grid"})])
+    share = {r["stage"]: r["share"] for r in rows if r["ok"]}
+    assert share == pytest.approx({"projection": 0.75, "mass": 0.0, "interpolation": 0.0, "time": 0.25})
+    assert {r["mpm_error"] for r in rows if r["ok"]} == {5.0} and {r["exact_error"] for r in rows if r["ok"]} == {1.0}
+    page = "\n".join(budget_section(rows, ("b", "c")))
+    assert "| **b** | 0.04 | 5 | 1 | 75 % | 0 % | 0 % | 25 % |" in page, page
+    assert "| c | 0.04 | not measured: a particle left the grid |" in page
 
 
 def test_a_basis_that_breaks_its_contract_is_refused_before_any_case(tmp_path, capsys):

@@ -32,20 +32,21 @@ from mpm_fem.core.reconstruction import RECONSTRUCTIONS
 from mpm_fem.core.step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, SCHEMES, STAGE_MASS
 from mpm_fem.core.transfers import get as get_transfer
 from mpm_fem.core.transfers import names as transfer_names
+from mpm_fem.core.transfers import plugins as transfer_plugins
 from mpm_fem.core.volume import VOLUMES
 
 CHOICES = {"mass": STAGE_MASS, "scheme": SCHEMES, "layout": LAYOUTS, "acceleration": ACCELERATIONS,
            "projection": PROJECTIONS, "interpolation": INTERPOLATIONS}
 # --- remedies (E5): --flip ALPHA, --xpic M, --reconstruct none|taylor, --volume carried|grid, --basis bspline_gimp
-CHOICES.update({"reconstruct": RECONSTRUCTIONS, "volume": VOLUMES, "kernel": ("fused", "numpy"),
-                "transfer": transfer_names()})
+CHOICES.update({"reconstruct": RECONSTRUCTIONS, "volume": VOLUMES, "kernel": ("fused", "numpy")})
 REMEDY_HELP = {
     "flip": "PIC/FLIP blend alpha in [0, 1]: 1 FLIP (standard), 0 PIC",
     "xpic": "XPIC(M) particle velocity update of order M >= 1 in place of the blend (1: PIC); 0: off",
     "reconstruct": "stress before the force integral: none (particle sum) or taylor (per-cell least-squares line)",
     "volume": "particle volumes: carried by the flow, or grid (reset to tile the grid every step)",
-    "transfer": "grid-to-particle transfer (the registry of mpm_fem.core.transfers): flip (the blend of --flip), "
-                "xpic (the order of --xpic) or apic (affine particle-in-cell; the numpy step)",
+    "transfer": "grid-to-particle transfer (the registry of mpm_fem.core.transfers, or package.module:Name of one "
+                "outside it, run on the numpy step with the blend of --flip as its setting): flip (the blend of "
+                "--flip), xpic (the order of --xpic) or apic (affine particle-in-cell; the numpy step)",
 }
 HELP = {
     "h": "cell size (must divide the domain)",
@@ -86,10 +87,23 @@ HELP.update(REMEDY_HELP)
 def basis_option(spec: str) -> str:
     """The ``--basis`` value: a registered name, an installed entry point's or a ``package.module:Name``
     checked against the contract (:mod:`mpm_fem.bases.plugins`); a refusal is argparse's one-line error."""
+    return _extension(plugins.resolve, spec)
+
+
+def transfer_option(spec: str) -> str:
+    """The ``--transfer`` value, as :func:`basis_option` (:mod:`mpm_fem.core.transfers.plugins`)."""
+    return _extension(transfer_plugins.resolve, spec)
+
+
+def _extension(resolve, spec: str) -> str:
     try:
-        return plugins.resolve(spec)
+        return resolve(spec)
     except (ValueError, TypeError) as err:
         raise argparse.ArgumentTypeError(str(err)) from None
+
+
+#: the options whose value is a registered extension or one from outside: its parser and its registry's names
+EXTENSIONS = {"basis": (basis_option, names), "transfer": (transfer_option, transfer_names)}
 
 
 def basis_help() -> str:
@@ -104,14 +118,14 @@ def _add_settings_options(parser: argparse.ArgumentParser, settings_cls, extra_c
     for f in dataclasses.fields(settings_cls):
         if isinstance(f.default, tuple):
             continue  # initial states stay in the settings JSON, not on the command line
-        kind = basis_option if f.name == "basis" else type(f.default)
+        kind, registered = EXTENSIONS.get(f.name, (type(f.default), None))
         parser.add_argument(
             f"--{f.name.replace('_', '-')}",
             dest=f.name,
             type=kind,
             default=f.default,
             choices=choices.get(f.name),
-            metavar="|".join(names()) if f.name == "basis" else None if f.name in choices else f.name.upper(),
+            metavar="|".join(registered()) if registered else None if f.name in choices else f.name.upper(),
             help=f"{helps[f.name]} (default: %(default)s)",
         )
     parser.add_argument("--out", default=None,
@@ -132,7 +146,8 @@ def build_parser() -> argparse.ArgumentParser:
     from mpm_fem.problems.burgers import DT_RULES, FORCES, WEIGHTS, BurgersSettings
     from mpm_fem.problems.sod import SodSettings
 
-    plugins.discover()  # installed bases join the choices
+    plugins.discover()  # installed bases and transfers join the choices
+    transfer_plugins.discover()
     parser = guard.OneLineParser(
         prog="mpm-fem",
         description="Where does the error of the Material Point Method come from? "

@@ -22,20 +22,16 @@ basis without compiled kernels (``kernels = None``) runs on the numpy step only
 
 from __future__ import annotations
 
-import importlib
-from importlib.metadata import entry_points
-
 import numpy as np
 
 from mpm_fem.bases.contract import Basis, missing
+from mpm_fem.bases.loader import Loader
 from mpm_fem.bases.registry import IncompleteBasisError, names, register
 
 ENTRY_POINT_GROUP = "mpm_fem.bases"
 CHECK_CELLS = 8  # the check's grid on [0, 1]
 CHECK_PPC = 5  # particles per cell of the check, plus both ends of the grid
 TOLERANCE = 1e-10  # the partition of unity and the compiled row against the numpy rows, relative to 1 and 1/h
-_LOADED: dict[str, str] = {}  # a spec or entry point -> the registered name
-_FAILED: dict[str, str] = {}  # an entry point that failed -> why
 
 
 class ContractError(IncompleteBasisError):
@@ -43,57 +39,19 @@ class ContractError(IncompleteBasisError):
 
 
 def resolve(spec: str) -> str:
-    """The registered name of ``spec``: a registered name as it is, a ``module:Name`` imported,
-    checked (:func:`verify`) and registered on first use. Raises :class:`ContractError` naming what
-    failed (the import, the attribute, the failed check) and ``ValueError`` for a name that is
-    neither registered, nor an installed entry point, nor a spec."""
-    if spec in names():
-        return spec
-    if spec in _LOADED:
-        return _LOADED[spec]
-    if ":" not in spec:
-        discover()
-        if spec in names():
-            return spec
-        if spec in _FAILED:
-            raise ContractError(_FAILED[spec])
-        raise ValueError(f"unknown basis {spec!r}; choose one of {', '.join(names())} or give package.module:Name")
-    module, _, attribute = spec.partition(":")
-    try:
-        target = getattr(importlib.import_module(module), attribute)
-    except (ImportError, AttributeError) as err:
-        raise ContractError(f"the basis {spec} cannot be loaded: {err}") from None
-    _LOADED[spec] = _admit(target, spec)
-    return _LOADED[spec]
+    """The registered name of ``spec``: a registered name as it is, an installed entry point's name,
+    a ``module:Name`` imported, checked (:func:`verify`) and registered on first use. Raises
+    :class:`ContractError` naming what failed (the import, the attribute, the failed check) and
+    ``ValueError`` for a name that is neither registered, nor an installed entry point, nor a spec
+    (:meth:`mpm_fem.bases.loader.Loader.resolve`)."""
+    return LOADER.resolve(spec)
 
 
 def discover() -> tuple[str, ...]:
     """Load, check and register every installed entry point of :data:`ENTRY_POINT_GROUP` not loaded
     yet; returns the names registered now. One that fails is kept out and its reason kept for
     :func:`resolve`, so a broken plugin refuses only a run that asks for it."""
-    added = []
-    for point in entry_points(group=ENTRY_POINT_GROUP):
-        if point.value in _LOADED or point.name in _FAILED:
-            continue
-        try:
-            _LOADED[point.value] = _admit(point.load(), point.value)
-            added.append(_LOADED[point.value])
-        except Exception as err:  # noqa: BLE001 - any failure of a third-party import refuses that plugin only
-            _FAILED[point.name] = str(err) if isinstance(err, ContractError) else (
-                f"the basis {point.value} (entry point {point.name}) cannot be loaded: {err}")
-    return tuple(added)
-
-
-def _admit(target, spec: str) -> str:
-    """Instantiate ``target`` if it is a class, check it and register it; its name."""
-    basis = target() if isinstance(target, type) and issubclass(target, Basis) else target
-    failed = verify(basis)
-    if failed:
-        raise ContractError(f"the basis {spec} breaks its contract: {failed}")
-    if basis.name in names():
-        raise ContractError(f"the basis {spec} is named {basis.name!r}, a name registered already")
-    register(basis)
-    return basis.name
+    return LOADER.discover()
 
 
 def verify(basis) -> str | None:
@@ -150,3 +108,7 @@ def _compare_row(basis: Basis, grid, x: np.ndarray, volume: np.ndarray, shape) -
             if gap > TOLERANCE:
                 return f"its compiled row differs from its numpy rows by {gap:.3g} at x = {x[p]:.6g}"
     return None
+
+
+#: the bases from outside the package: their entry points, specs and refusals (:class:`~mpm_fem.bases.loader.Loader`)
+LOADER = Loader("basis", ENTRY_POINT_GROUP, Basis, names, register, verify, ContractError)

@@ -21,3 +21,17 @@ def test_burgers_converges_on_the_regular_and_a_jittered_layout(mpm_method):
 
 def test_the_basis_is_found_through_its_entry_point(mpm_method_for):
     assert mpm_method_for("quartic").basis == "quartic"
+
+
+def test_the_blend_is_found_through_its_entry_point_and_is_flip_at_0_99():
+    from mpm_fem.core.transfers import plugins
+    from mpm_fem.problems import burgers
+
+    assert plugins.resolve("flip99") == "flip99"
+    settings = dict(h=0.04, T=0.2)
+    ours = burgers.simulate(burgers.BurgersSettings(transfer="flip99", **settings), progress=False)
+    package = burgers.simulate(burgers.BurgersSettings(flip=0.99, kernel="numpy", **settings), progress=False)
+    flip = burgers.simulate(burgers.BurgersSettings(kernel="numpy", **settings), progress=False)
+    assert ours.kernel == "numpy" and ours.steps == package.steps > 20
+    assert np.abs(ours.particles.velocity - package.particles.velocity).max() <= 1e-12  # the package's blend at 0.99
+    assert np.abs(ours.particles.velocity - flip.particles.velocity).max() > 1e-4  # and not FLIP (7.9e-4 apart)

@@ -12,7 +12,8 @@ bases, asked of a researcher's basis, judged from its tables with the rule book'
     M3  Burgers' particle velocity L1 error converges: as M2.
 
 Each verdict reads ``projection`` and ``orders`` rows (``studies/method.py``'s tables), so a table with
-other numbers gives another verdict (``tests/test_method_study.py`` flips each).
+other numbers gives another verdict (``tests/test_method_study.py`` flips each). The error budget
+(``budget`` rows) is reported as a table without a verdict (:func:`budget_section`).
 """
 
 from __future__ import annotations
@@ -76,4 +77,35 @@ def judge_method(basis: str, tables: dict[str, list[dict]], ours: tuple[str, ...
             verdict, numbers = verdicts(tables, b)[claim]
             lines.append(f"| {'**' + b + '**' if b == basis else b} | {verdict} | {numbers} |")
         lines.append("")
-    return "\n".join(lines)
+    return "\n".join(lines + budget_section(tables.get("budget", []), bases))
+
+
+def budget_section(rows: list[dict], bases: tuple[str, ...]) -> list[str]:
+    """``METHOD.md``'s budget: per problem, each basis's particle L1 error with every stage in MPM form
+    and with every stage exact, and each stage's Shapley share of their gap, from ``budget.csv``'s
+    rows; a basis whose budget did not run is named with the reason."""
+    if not rows:
+        return []
+    stages = list(dict.fromkeys(r["stage"] for r in rows if r["ok"] in (True, "True")))
+    lines = ["## The error budget (E1's measurement, one mesh a problem)", "",
+             "Each stage's Shapley share of v(all MPM) - v(all exact), the particle L1 error with every stage in "
+             "MPM form and with every stage exact (`budget.csv`; the shares add up to 100 %; a share above 100 % or "
+             "below 0 is a stage that the others' interactions offset). Reported without a verdict.", ""]
+    for problem in dict.fromkeys(r["problem"] for r in rows):
+        lines += [f"### {problem}", "", "| basis | h | v(all MPM) | v(all exact) | "
+                  + " | ".join(stages) + " |", "|---" * (4 + len(stages)) + "|"]
+        for b in bases:
+            got = select(rows, basis=b, problem=problem)
+            if not got:
+                continue
+            name = f"**{b}**" if b == bases[0] else b
+            if got[0]["ok"] not in (True, "True"):
+                lines.append(f"| {name} | {num(got[0], 'h'):g} | not measured: {got[0]['error']} |"
+                             + " |" * (1 + len(stages)))
+                continue
+            share = {r["stage"]: num(r, "share") for r in got}
+            lines.append(f"| {name} | {num(got[0], 'h'):g} | {num(got[0], 'mpm_error'):.3g} | "
+                         f"{num(got[0], 'exact_error'):.3g} | "
+                         + " | ".join(f"{100 * share[s]:.0f} %" for s in stages) + " |")
+        lines.append("")
+    return lines
