@@ -218,7 +218,7 @@ MECHANISM_SUMMARY = Table("mechanism/summary", (
 #: defects; ``error`` when the run failed.
 DEFECT = Table("defect/defect", (
     "problem", "basis", "ppc", "layout", "seed", "h", "ok"), optional=(
-    "error", "steps", "wall_s", "measured_L1", "predicted_L1", "ratio", "at_particles_L1", "floor_L1",
+    "error", "steps", "wall_s", "measured_L1", "predicted_L1", "ratio", "at_particles_L1", "residual_L1", "floor_L1",
     "acceleration_L1", "velocity_L1", "rate_L1", "defect_a", "defect_v", "defect_L"))
 
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
