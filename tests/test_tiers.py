@@ -11,6 +11,7 @@ from mpm_fem.app.cli import build_parser
 from mpm_fem.app.study import STUDIES, TIER_FOLDERS, StudyOptions, study_options
 
 PLANS = {"sod": "_plan", "burgers": "_plan", "budget": "plan", "remedies": "_plan", "time": "plan", "drift": "_plan",
+         "defect": "plan",
          "mechanism": "plan"}
 
 

@@ -201,11 +201,12 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
 
 #: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
 #: layer and import it, never the other way round).
-STUDIES = ("projection", "sod", "burgers", "identification", "budget", "time", "remedies", "drift", "mechanism")
-#: The studies the quick reproduction leaves out: their questions (E5, the mechanism of C11 and E6a) are
+STUDIES = ("projection", "sod", "burgers", "identification", "budget", "time", "remedies", "drift", "mechanism",
+           "defect")
+#: The studies the quick reproduction leaves out: their questions (E5, the mechanism of C11, E6a and the defect) are
 #: about the plateau of Sod's particle error, which the quick tier's meshes reach at one setting only
 #: (C11's). ``mpm-fem study NAME --quick`` still runs them.
-QUICK_LEAVES_OUT = ("remedies", "drift", "budget", "mechanism")
+QUICK_LEAVES_OUT = ("remedies", "drift", "budget", "mechanism", "defect")
 _NO_BUDGET = ("the quick reproduction leaves out the error budget (its exact-stage kernels take about a minute to "
               "compile)")
 #: The verdicts a tier does not judge, ``{tier: {claim: (the tier that judges it, why)}}``: the report

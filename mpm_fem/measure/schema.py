@@ -213,6 +213,13 @@ MECHANISM_GROWTH = Table("mechanism/growth", (
 MECHANISM_SUMMARY = Table("mechanism/summary", (
     "problem", "basis", "ppc", "made_exact", "mpm_stages", "h_coarse", "h_fine", "runs", "order_min", "order_mean",
     "order_max", "order_regular", "mpm_growing", "stops_growth", "converging_where_mpm_grows", "turns_growth"))
+#: One row per run (issue 46, item 2; :mod:`mpm_fem.measure.defect`): the measured particle L1 error and
+#: the accumulated defect's (``predicted_L1``), their ratio, the components' norms and the mean per-step
+#: defects; ``error`` when the run failed.
+DEFECT = Table("defect/defect", (
+    "problem", "basis", "ppc", "layout", "seed", "h", "ok"), optional=(
+    "error", "steps", "wall_s", "measured_L1", "predicted_L1", "ratio", "at_particles_L1", "residual_L1", "floor_L1",
+    "acceleration_L1", "velocity_L1", "rate_L1", "defect_a", "defect_v", "defect_L"))
 
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
@@ -231,7 +238,7 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     REMEDIES_ERRORS,
     DRIFT,
     IDENTIFICATION_SOD, IDENTIFICATION_BURGERS,
-    MECHANISM_GROWTH, MECHANISM_SUMMARY)}
+    MECHANISM_GROWTH, MECHANISM_SUMMARY, DEFECT)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}
 

@@ -125,6 +125,12 @@ def _keeps_particles(observer: Observer | None) -> bool:
     return observer is not None and getattr(observer, "keeps_particles", True) is not False
 
 
+def _needs_numpy_step(observer: Observer | None) -> bool:
+    """Whether ``observer`` asks for the numpy step (``needs_numpy_step = True``): the fused step's grid
+    state is not the numpy step's arrays, and an instrumented run must take the steps it measures."""
+    return observer is not None and getattr(observer, "needs_numpy_step", False) is True
+
+
 def run(
     problem: Problem,
     grid: Grid,
@@ -144,11 +150,13 @@ def run(
     ``kernel="numpy"`` always steps with :func:`explicit_step`. Both take the same steps (bit for
     bit on one thread). ``observer(step, t, old, new, state)`` is called after every step, which
     then runs one at a time rather than in compiled loops; the particles it is handed stay valid
-    only for the call if it says it keeps none (:func:`_keeps_particles`)."""
+    only for the call if it says it keeps none (:func:`_keeps_particles`). An observer that reads the
+    numpy step's grid state (``needs_numpy_step = True``, as :class:`~mpm_fem.measure.defect.DefectObserver`)
+    routes the run to the numpy step whatever ``kernel`` says."""
     check_kernel(kernel, threads)
     fused = None
     if (kernel == "fused" and supported(problem.model, stages) is None and numpy_only(problem.model, stages) is None
-            and compiled(stages.basis)):
+            and compiled(stages.basis) and not _needs_numpy_step(observer)):
         fused = FusedStep(grid, problem.model, problem.boundary, stages, problem.exact_acceleration, threads,
                           reuse=not _keeps_particles(observer), exact=problem.exact)
     # walls or Dirichlet ends, lumped mass, no observer, and no particle boundary or one that says
