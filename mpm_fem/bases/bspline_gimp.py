@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit
 
 from mpm_fem.bases.bspline import quadratic_bspline, require_uniform, spline_integrals
-from mpm_fem.bases.cells import domain_ends, put, stored_row
+from mpm_fem.bases.cells import DOMAIN_FIELDS, domain_ends, put, stored_row
 from mpm_fem.bases.cells import locate as _locate
 from mpm_fem.bases.contract import Basis, Kernels
 from mpm_fem.bases.shape import Shape, particle_domains
@@ -112,34 +112,13 @@ def _piece(d, left, a, b, c):
     return (left if d < 0 else 0.0) + (a if d == 0 else 0.0) + (b if d == 1 else 0.0) + (c if d == 2 else 0.0)
 
 
-class Domain(NamedTuple):
-    """A particle domain on a uniform grid, in scalars (:func:`_scalars`): its cell, the K its row
-    needs, the domain's ends ``c_-, c_+, s_-, s_+`` (:func:`~mpm_fem.bases.cells.domain_ends`),
-    ``inv_w = 1 / (s_+ - s_-)``, and at each end (``_lo``, ``_hi``) :func:`_pieces`: the first of the
-    three splines there ``d``, their antiderivatives ``M`` (left, centre, right) and values ``N``.
-    Scalars only, so that no array is handed to a helper per particle (reference counting)."""
-
-    cell: int
-    need: int
-    c_lo: int
-    c_hi: int
-    s_lo: float
-    s_hi: float
-    inv_w: float
-    d_lo: int
-    Ml_lo: float
-    M0_lo: float
-    Mr_lo: float
-    Nl_lo: float
-    N0_lo: float
-    Nr_lo: float
-    d_hi: int
-    Ml_hi: float
-    M0_hi: float
-    Mr_hi: float
-    Nl_hi: float
-    N0_hi: float
-    Nr_hi: float
+#: A particle domain on a uniform grid in scalars (:func:`_scalars`): the fields of
+#: :data:`~mpm_fem.bases.cells.DOMAIN_FIELDS`, then at each end (``_lo``, ``_hi``) :func:`_pieces`: the
+#: first of the three splines there ``d``, their antiderivatives ``M`` (left, centre, right) and values
+#: ``N``. Scalars only, so that no array is handed to a helper per particle (reference counting).
+Domain = NamedTuple("Domain", DOMAIN_FIELDS + [
+    (f"{name}_{end}", int if name == "d" else float)
+    for end in ("lo", "hi") for name in ("d", "Ml", "M0", "Mr", "Nl", "N0", "Nr")])
 
 
 @njit(cache=True, inline="always")

@@ -35,6 +35,13 @@ def scaled(nodes, inv_spacing, y):
     return s, min(int(s), nodes.size - 2)
 
 
+#: The fields a particle-domain basis's per-particle scalars begin with (its ``Domain`` named tuple, made
+#: with ``typing.NamedTuple("Domain", DOMAIN_FIELDS + its own)``): the particle's cell, the K its row
+#: needs, the domain's ends ``c_-, c_+, s_-, s_+`` (:func:`domain_ends`) and ``inv_w = 1 / (s_+ - s_-)``.
+DOMAIN_FIELDS = [("cell", int), ("need", int), ("c_lo", int), ("c_hi", int), ("s_lo", float), ("s_hi", float),
+                 ("inv_w", float)]
+
+
 @njit(cache=True, inline="always")
 def domain_ends(x0, b, top_cell, inv_spacing, x, V):
     """The particle domain ``[x - V/2, x + V/2]`` cut at the grid's ends ``[x0, b]``, in uniform-grid

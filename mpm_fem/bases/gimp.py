@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 from numba import njit
 
-from mpm_fem.bases.cells import domain_ends, put, stored_row
+from mpm_fem.bases.cells import DOMAIN_FIELDS, domain_ends, put, stored_row
 from mpm_fem.bases.cells import locate as _locate
 from mpm_fem.bases.contract import Basis, Kernels
 from mpm_fem.bases.point import hat_integrals
@@ -93,18 +93,9 @@ def _hat_and_integral_at(nodes, i, y):
     return value, left + right
 
 
-class Domain(NamedTuple):
-    """A particle domain on a uniform grid, in scalars (:func:`_scalars`): its cell ``c``, the K its
-    row needs, the domain's ends ``c_-, c_+, s_-, s_+`` (:func:`~mpm_fem.bases.cells.domain_ends`) and
-    ``inv_w = 1 / (s_+ - s_-)``."""
-
-    cell: int
-    need: int
-    c_lo: int
-    c_hi: int
-    s_lo: float
-    s_hi: float
-    inv_w: float
+#: A particle domain on a uniform grid in scalars (:func:`_scalars`): the fields of
+#: :data:`~mpm_fem.bases.cells.DOMAIN_FIELDS`.
+Domain = NamedTuple("Domain", DOMAIN_FIELDS)
 
 
 @njit(cache=True, inline="always")
