@@ -151,8 +151,9 @@ def run(
     bit on one thread where the fused step does the numpy arithmetic, to round-off (measured at most
     6e-14 relative) where it takes a uniform grid's node arithmetic (``tests/test_fused.py``).
     ``observer(step, t, old, new, state)`` is called after every step, which then runs one at a time
-    rather than in compiled loops; the particles it is handed stay valid only for the call if it says it keeps none (:func:`_keeps_particles`). An observer that reads the
-    numpy step's grid state (``needs_numpy_step = True``, as :class:`~mpm_fem.measure.defect.DefectObserver`)
+    rather than in compiled loops; the particles it is handed stay valid only for the call if it says
+    it keeps none (:func:`_keeps_particles`). An observer that reads the numpy step's grid state
+    (``needs_numpy_step = True``, as :class:`~mpm_fem.measure.defect.DefectObserver`)
     routes the run to the numpy step whatever ``kernel`` says."""
     check_kernel(kernel, threads)
     fused = None
