@@ -11,7 +11,7 @@ Inlined into the passes, except :func:`all_finite`, the run's own check. The pas
 state over as :class:`ParticleState` named tuples, which these helpers unpack before they index: inside
 a ``prange`` body numba 0.68 loses a write through a named tuple's attribute (``new.e[q] = ...``),
 while writes through the unpacked arrays land (``tests/test_fused_remedies.py``'s two-thread runs
-caught it; ``docs/performance.md``).
+caught it; numba/numba#7135, ``docs/performance.md``).
 """
 
 from typing import NamedTuple
