@@ -26,6 +26,7 @@ from functools import cached_property, lru_cache
 import numpy as np
 
 import mpm_fem.exact_stages.grid_kernels as grid_kernels
+from mpm_fem.bases import get
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.shape import Shape, make_shape
 
@@ -98,7 +99,11 @@ class QuadratureRule:
 
     def cuts(self, breakpoints) -> Cuts:
         """The pieces cut by ``breakpoints`` (those inside the domain) and their sub-pieces: the
-        compiled :func:`~mpm_fem.exact_stages.grid_kernels.cut_pieces`, equal bit for bit to :meth:`cuts_numpy`."""
+        compiled :func:`~mpm_fem.exact_stages.grid_kernels.cut_pieces`, equal bit for bit to :meth:`cuts_numpy`;
+        :meth:`cuts_numpy` itself for grid functions without a compiled row (a basis from outside the
+        package with ``kernels = None``)."""
+        if get(self.functions).kernels is None:
+            return self.cuts_numpy(breakpoints)
         bp = np.ascontiguousarray(breakpoints, dtype=float).ravel()
         grid = self.grid
         cut, first, x, w, nodes, S, G, cell = grid_kernels.cut_pieces(self.functions)(
