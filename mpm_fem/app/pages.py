@@ -222,4 +222,16 @@ PAGES = (
                       "order_max", "order_regular", "mpm_growing", "stops_growth", "converging_where_mpm_grows",
                       "turns_growth"), {}, "growth.png"),
          )),
+    Page("defect", "The local defect, accumulated: a prediction of the particle error (E6)",
+         "The mechanism study's all-MPM runs once more on the numpy step with an observer: at every step the defect "
+         "of each quantity the particle update takes from the grid (the particle acceleration, the motion, the rate "
+         "L_p) against its exact value at that step, accumulated along each particle's path with the update's own "
+         "propagation. The norm of the accumulated defect is the run's predicted particle error, beside the measured "
+         "one (Sod: density; Burgers: velocity; the budget's norm).",
+         views=(
+             View("defect/defect", "Per run: measured and predicted particle L1 errors, their ratio, the part the "
+                  "prediction misses and each component", (
+                      "problem", "ppc", "layout", "seed", "h", "steps", "measured_L1", "predicted_L1", "ratio",
+                      "residual_L1", "acceleration_L1", "velocity_L1", "rate_L1"), {}, "defect.png"),
+         )),
 )
