@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 
+from mpm_fem.app.discussion import defect_section
 from mpm_fem.app.markdown import (
     anchor_of,
     bullets,
@@ -421,9 +422,11 @@ def discussion(tables: Tables, found: Found, captions: dict, deep_found: Found |
                stale: bool = False) -> list[str]:
     return ["## Discussion", "", *prose(
         "Each claim whose measured behaviour departs from the source's statement, with what the study measured "
-        "about why; then the drift study, which measures the mechanism of the growth of Sod's particle error, and "
-        "what the deep tier's finer meshes change."), *discrepancies(found),
-        *drift_section(tables, captions.get("drift", {})), *deep_changes(found, deep_found, stale)]
+        "about why; then the drift study, which measures the mechanism of the growth of Sod's particle error, the "
+        "defect study, which predicts that error from the local defect of each step, and what the deep tier's "
+        "finer meshes change."), *discrepancies(found),
+        *drift_section(tables, captions.get("drift", {})), *defect_section(tables, captions.get("defect", {})),
+        *deep_changes(found, deep_found, stale)]
 
 
 def conclusions(found: Found, tables: Tables | None = None) -> list[str]:
