@@ -7,11 +7,11 @@ operations in its order. A pass's checks (the first particle whose factor or ene
 positive, the first non-finite one, the largest signal speed) travel as a :class:`Tally` of seven
 floats through the particle loop, so that they stay in registers and numba's parallel analysis
 accepts them.
-Inlined into the passes, except :func:`all_finite`, the run's own check. The passes hand the particle
-state over as :class:`ParticleState` named tuples, which these helpers unpack before they index: inside
-a ``prange`` body numba 0.68 loses a write through a named tuple's attribute (``new.e[q] = ...``),
-while writes through the unpacked arrays land (``tests/test_fused_remedies.py``'s two-thread runs
-caught it; numba/numba#7135, ``docs/performance.md``).
+Inlined into the passes, except :func:`all_finite`, the run's own check. These helpers run inside
+the passes' ``prange`` bodies, so they take arrays and scalars, never a named tuple of arrays: numba
+0.68 loses writes to an array reached through a tuple inside a ``prange`` body (numba/numba#5872,
+#7135, #10338; ``docs/performance.md``). The passes take :class:`ParticleState` and :class:`Checks`
+and unpack them before their ``prange``.
 """
 
 from typing import NamedTuple
@@ -48,9 +48,10 @@ class Checks(NamedTuple):
 
 
 class Tally(NamedTuple):
-    """A pass's checks so far, seven floats (particle indices < 2^53 are exact; -1: none yet). Floats,
-    not arrays: the tally stays in registers, and numba's parallel analysis takes it (it mistakes
-    integer tuples for shapes)."""
+    """A pass's checks so far and the state of the particle last updated, twelve floats (particle
+    indices < 2^53 are exact; -1: none yet). Floats, not arrays: the tally stays in registers, and
+    numba's parallel analysis takes it (it mistakes integer tuples, and a tuple of a tally and a
+    tuple, for shapes)."""
 
     bad_factor: float  # the first particle whose factor (1 - L dt, Burgers 1 + L dt) is not > 0
     bad_energy: float  # the first particle whose energy is not > 0 (gas)
@@ -59,6 +60,11 @@ class Tally(NamedTuple):
     energy: float  # the energy of ``bad_energy``
     speed: float  # the largest signal speed, ``max c_p + |v_p|`` (gas) or ``max |v_p|``
     sound_speed: float  # the sound speed of the particle last updated (what :func:`_checked` reads)
+    V: float  # the particle last updated: its new volume,
+    m: float  # mass,
+    rho: float  # density,
+    e: float  # specific internal energy
+    p: float  # and pressure (what :func:`_store` writes)
 
 
 @njit(cache=True, inline="always")
@@ -98,49 +104,58 @@ def _first(bad, value_at_bad, q, value):
 
 
 @njit(cache=True, inline="always")
-def _new_state(gas, q, L, dt, l, old, new, consts, tally):
-    """The model's update of particle q from ``L_p`` (gas: :meth:`IdealGas.update`; Burgers:
-    ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``), from the :class:`ParticleState` ``old`` into ``new``
-    (``l`` the cell size of the artificial viscosity). Returns the :class:`Tally` updated, with this
-    particle's sound speed."""
-    bad_f, bad_e, bad_n, val_f, val_e, top, _ = tally
-    _, _, V, m, rho, e, p = old
-    _, _, V_new, m_new, rho_new, e_new, p_new = new  # unpacked: see the module docstring
+def _new_state(gas, q, L, dt, l, rho, e, p, m, V, consts, tally):
+    """The model's update of particle q from ``L_p`` and its state ``rho, e, p, m, V`` (scalars; gas:
+    :meth:`IdealGas.update`; Burgers: ``V_p <- V_p (1 + L_p dt)``, ``m_p = V_p``; ``l`` the cell size of
+    the artificial viscosity). Returns the :class:`Tally` updated with this particle's sound speed and
+    new ``V, m, rho, eps, p`` (:func:`_store` writes those the model changes)."""
+    bad_f, bad_e, bad_n, val_f, val_e, top = (tally.bad_factor, tally.bad_energy, tally.bad_finite, tally.factor,
+                                               tally.energy, tally.speed)
     if gas:
-        factor, rho_new[q], e_new[q], p_new[q], V_new[q], c = _gas_update(
-            rho[q], e[q], p[q], m[q], L, dt, l, consts[IGM1], consts[IGGM1], consts[ILIN], consts[IQUAD])
-        bad_e, val_e = _first(bad_e, val_e, q, e_new[q])
+        factor, rho_n, e_n, p_n, V_n, c = _gas_update(
+            rho, e, p, m, L, dt, l, consts[IGM1], consts[IGGM1], consts[ILIN], consts[IQUAD])
+        m_n = m
+        bad_e, val_e = _first(bad_e, val_e, q, e_n)
     else:
         factor, c = 1.0 + L * dt, 0.0
-        V_new[q] = V[q] * factor
-        m_new[q] = V_new[q]
+        V_n = V * factor
+        m_n, rho_n, e_n, p_n = V_n, rho, e, p
     bad_f, val_f = _first(bad_f, val_f, q, factor)
-    return Tally(bad_f, bad_e, bad_n, val_f, val_e, top, c)
+    return Tally(bad_f, bad_e, bad_n, val_f, val_e, top, c, V_n, m_n, rho_n, e_n, p_n)
 
 
 @njit(cache=True, inline="always")
-def _checked(gas, q, c, new, tally):
-    """The tally with ``max(top, c_p + |v_p|)`` (gas) or ``max(top, |v_p|)`` of particle q of the
-    :class:`ParticleState` ``new``, and the first non-finite particle."""
-    bad_f, bad_e, bad_n, val_f, val_e, top, _ = tally
-    x, v, V, _, rho, e, p = new
+def _store(gas, q, tally, V_new, m_new, rho_new, e_new, p_new):
+    """Particle q's new state from the :class:`Tally` :func:`_new_state` returned into the arrays the
+    model changes: the gas's V, rho, eps, p; Burgers' V and m."""
     if gas:
-        top = max(top, c + abs(v[q]))
-        ok = _finite(x[q], v[q], rho[q], e[q], p[q], V[q])
+        V_new[q], rho_new[q], e_new[q], p_new[q] = tally.V, tally.rho, tally.e, tally.p
     else:
-        top = max(top, abs(v[q]))
-        ok = _finite(x[q], v[q], V[q], 0.0, 0.0, 0.0)
+        V_new[q], m_new[q] = tally.V, tally.m
+
+
+@njit(cache=True, inline="always")
+def _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, tally):
+    """The tally with ``max(top, c_p + |v_p|)`` (gas) or ``max(top, |v_p|)``, and the first
+    non-finite particle."""
+    bad_f, bad_e, bad_n, val_f, val_e, top = (tally.bad_factor, tally.bad_energy, tally.bad_finite, tally.factor,
+                                               tally.energy, tally.speed)
+    if gas:
+        top = max(top, c + abs(v_new[q]))
+        ok = _finite(x_new[q], v_new[q], rho_new[q], e_new[q], p_new[q], V_new[q])
+    else:
+        top = max(top, abs(v_new[q]))
+        ok = _finite(x_new[q], v_new[q], V_new[q], 0.0, 0.0, 0.0)
     if bad_n < 0 and not ok:
         bad_n = float(q)
-    return Tally(bad_f, bad_e, bad_n, val_f, val_e, top, c)
+    return Tally(bad_f, bad_e, bad_n, val_f, val_e, top, c, tally.V, tally.m, tally.rho, tally.e, tally.p)
 
 
 @njit(cache=True, inline="always")
-def _flags(k, tally, checks):
-    """Chunk k's tally into the pass's :class:`Checks`: ``flags[k]`` (the first bad particles: factor,
-    energy and, if it has three columns, non-finite), ``values[k]`` (the two values), ``speed[k]``
-    (where the pass has one per chunk)."""
-    flags, values, speed = checks  # unpacked: see the module docstring
+def _flags(k, tally, flags, values, speed):
+    """Chunk k's tally into a pass's outputs (:class:`Checks`' arrays): ``flags[k]`` (the first bad
+    particles: factor, energy and, if it has three columns, non-finite), ``values[k]`` (the two
+    values), ``speed[k]`` (where the pass has one per chunk)."""
     flags[k, 0], flags[k, 1] = int(tally.bad_factor), int(tally.bad_energy)
     if flags.shape[1] > 2:
         flags[k, 2] = int(tally.bad_finite)
@@ -149,4 +164,4 @@ def _flags(k, tally, checks):
         speed[k] = tally.speed
 
 
-_NO_TALLY = Tally(-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0)  # no bad particle yet, speed 0
+_NO_TALLY = Tally(-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # no bad particle yet, speed 0

@@ -21,14 +21,19 @@ grid, else a grid uniform to round-off).
 The arguments travel as named tuples: ``g`` the grid (:class:`~mpm_fem.bases.contract.Geometry`),
 ``store`` pass 1's rows and cells (:class:`~mpm_fem.bases.contract.RowStore`), ``old`` and ``new``
 the particles' state read and written (:class:`~mpm_fem.fused.models.ParticleState`), ``checks``
-the per-chunk flags, values and speeds (:class:`~mpm_fem.fused.models.Checks`).
+the per-chunk flags, values and speeds (:class:`~mpm_fem.fused.models.Checks`). Each pass takes
+their arrays out by attribute before its ``prange``, whose body never reaches an array through a
+tuple: numba 0.68's parallel variants lose writes to an array reached through a tuple inside the
+``prange`` body, and to some arrays taken out of a tuple by unpacking (``flags, values, speed =
+checks`` lost the writes to ``speed``) where the attribute works (numba/numba#5872, #7135, #10338;
+``docs/performance.md``; the two-thread tests compare every pass with one thread).
 """
 
 import numpy as np
 from numba import prange
 
 from mpm_fem.fused.codes import GAS, IEPS, IFLIP, IGGM1, IXPIC, MUSL, PRESSURE, USL, VISCOUS_STRESS
-from mpm_fem.fused.models import _NO_TALLY, _checked, _flags, _new_state
+from mpm_fem.fused.models import _NO_TALLY, _checked, _flags, _new_state, _store
 from mpm_fem.fused.sums import _chunk, _gather, _gather_stored, _one_row, _scatter, _scatter_stored, _sum_chunks
 
 # placeholders: each variant has its own (mpm_fem.fused.compiler)
@@ -47,8 +52,13 @@ def _scatter_pass(g, x, store, f_i, a, b, coef, chunks, out):
                          (:func:`mpm_fem.core.transfer.nodal_momentum` of ``shape.gather(u)``)
 
     (``b``, ``coef``, ``f_i``: unused where the weight does not name them)."""
-    nodes, h, inv_spacing = g
-    rows, S, G, cell = store
+    nodes = g.nodes
+    h = g.h
+    inv_spacing = g.inv_spacing
+    rows = store.rows
+    S = store.S
+    G = store.G
+    cell = store.cell
     n = x.size
     K = WIDTH  # nodes per particle
     buf = np.zeros((chunks, 1, out.size))
@@ -79,13 +89,31 @@ def _update(g, store, v_i, old, dt, consts, force, chunks, new, F_i, checks):
     ``old.x``; ``new``'s V, m, rho, eps, p written), and the force of the updated state into ``F_i``
     (if ``force``). ``checks.flags[k] = (first particle with factor <= 0, first with energy <= 0)``,
     ``checks.values[k]`` their values."""
-    nodes, h, inv_spacing = g
-    rows, S, G, cell = store
+    nodes = g.nodes
+    h = g.h
+    inv_spacing = g.inv_spacing
+    rows = store.rows
+    S = store.S
+    G = store.G
+    cell = store.cell
+    # one array a statement: a tuple's arrays unpacked together lose their writes in the prange (docstring)
     x = old.x
+    V = old.V
+    m = old.m
+    rho = old.rho
+    e = old.e
+    p = old.p
+    V_new = new.V
+    m_new = new.m
+    rho_new = new.rho
+    e_new = new.e
+    p_new = new.p
+    flags = checks.flags
+    values = checks.values
+    speed = checks.speed
     n = x.size
     K = WIDTH  # nodes per particle
     gas, eps = MODEL == GAS, consts[IEPS]
-    V_new, p_new = new.V, new.p
     buf = np.zeros((chunks, 1, F_i.size))
     for k in prange(chunks):
         tally = _NO_TALLY
@@ -93,10 +121,11 @@ def _update(g, store, v_i, old, dt, consts, force, chunks, new, F_i, checks):
         for q in range(*_chunk(n, chunks, k)):
             c = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
             L = _gather(Gl, v_i, r, K)
-            tally = _new_state(gas, q, L, dt, h[0, c], old, new, consts, tally)
+            tally = _new_state(gas, q, L, dt, h[0, c], rho[q], e[q], p[q], m[q], V[q], consts, tally)
+            _store(gas, q, tally, V_new, m_new, rho_new, e_new, p_new)
             if force:
                 _scatter(buf, k, r, Gl, V_new[q] * p_new[q] if gas else -(V_new[q] * (eps * L)), K)
-        _flags(k, tally, checks)
+        _flags(k, tally, flags, values, speed)
     if force:
         _sum_chunks(buf, 0, F_i, 1.0)
 
@@ -109,10 +138,31 @@ def _move(g, store, a_i, v_n, old, new, dt, consts, scheme, chunks, P_i, checks)
     holds ``v* + dt a`` and ``v_p = sum S a_i``. ``checks.speed[k]``: max of ``c_p + |v_p|`` (gas) or
     ``|v_p|`` (Burgers) over chunk k; ``checks.flags[k] = (first bad factor, first bad energy, first
     non-finite particle)``."""
-    nodes, h, inv_spacing = g
-    rows, S, G, cell = store
-    x, v, m = old.x, old.v, old.m
-    x_new, v_new, e_new = new.x, new.v, new.e
+    nodes = g.nodes
+    h = g.h
+    inv_spacing = g.inv_spacing
+    rows = store.rows
+    S = store.S
+    G = store.G
+    cell = store.cell
+    # one array a statement: a tuple's arrays unpacked together lose their writes in the prange (docstring)
+    x = old.x
+    v = old.v
+    V = old.V
+    m = old.m
+    rho = old.rho
+    e = old.e
+    p = old.p
+    x_new = new.x
+    v_new = new.v
+    V_new = new.V
+    m_new = new.m
+    rho_new = new.rho
+    e_new = new.e
+    p_new = new.p
+    flags = checks.flags
+    values = checks.values
+    speed = checks.speed
     n = x.size
     K = WIDTH  # nodes per particle
     usl, musl = scheme == USL, scheme == MUSL
@@ -130,8 +180,9 @@ def _move(g, store, a_i, v_n, old, new, dt, consts, scheme, chunks, P_i, checks)
                     c, acc, vel, L = MOVE_RUN(nodes, h, inv_spacing, x[q], a_i, v_n)
                     v_new[q] = v[q] + dt * acc
                     x_new[q] = x[q] + dt * vel
-                    tally = _new_state(gas, q, L, dt, h[0, c], old, new, consts, tally)
-                    tally = _checked(gas, q, tally.sound_speed, new, tally)
+                    tally = _new_state(gas, q, L, dt, h[0, c], rho[q], e[q], p[q], m[q], V[q], consts, tally)
+                    _store(gas, q, tally, V_new, m_new, rho_new, e_new, p_new)
+                    tally = _checked(gas, q, tally.sound_speed, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
                 lo = hi
         for q in range(lo, hi):
             # stored rows: pass 1's row read in place, and USL's L_p (_gather's sum) in the same loop
@@ -167,12 +218,13 @@ def _move(g, store, a_i, v_n, old, new, dt, consts, scheme, chunks, P_i, checks)
             if usl:
                 if STORED == 0:
                     L = _gather(Gl, v_n, r, K)
-                tally = _new_state(gas, q, L, dt, h[0, cq], old, new, consts, tally)
+                tally = _new_state(gas, q, L, dt, h[0, cq], rho[q], e[q], p[q], m[q], V[q], consts, tally)
+                _store(gas, q, tally, V_new, m_new, rho_new, e_new, p_new)
                 c = tally.sound_speed
             else:
                 c = np.sqrt(g_gm1 * max(e_new[q], 0.0)) if gas else 0.0
-            tally = _checked(gas, q, c, new, tally)
-        _flags(k, tally, checks)
+            tally = _checked(gas, q, c, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+        _flags(k, tally, flags, values, speed)
     if musl:
         _sum_chunks(buf, 0, P_i, 1.0)
 
@@ -181,9 +233,30 @@ def _finish(g, store, v_n, old, new, dt, consts, chunks, checks):
     """MUSL's last pass: the state update from ``L_p = sum_i G_ip v_i^{n+1}`` (re-projected; the
     shape at ``old.x``, ``x_p^n``), ``old`` into ``new`` (whose x and v pass 2 wrote), the speed and
     the checks, as in :func:`_move`."""
-    nodes, h, inv_spacing = g
-    rows, S, G, cell = store
+    nodes = g.nodes
+    h = g.h
+    inv_spacing = g.inv_spacing
+    rows = store.rows
+    S = store.S
+    G = store.G
+    cell = store.cell
+    # one array a statement: a tuple's arrays unpacked together lose their writes in the prange (docstring)
     x = old.x
+    V = old.V
+    m = old.m
+    rho = old.rho
+    e = old.e
+    p = old.p
+    x_new = new.x
+    v_new = new.v
+    V_new = new.V
+    m_new = new.m
+    rho_new = new.rho
+    e_new = new.e
+    p_new = new.p
+    flags = checks.flags
+    values = checks.values
+    speed = checks.speed
     n = x.size
     K = WIDTH  # nodes per particle
     gas = MODEL == GAS
@@ -192,9 +265,11 @@ def _finish(g, store, v_n, old, new, dt, consts, chunks, checks):
         tally = _NO_TALLY
         for q in range(*_chunk(n, chunks, k)):
             cq = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-            tally = _new_state(gas, q, _gather(Gl, v_n, r, K), dt, h[0, cq], old, new, consts, tally)
-            tally = _checked(gas, q, tally.sound_speed, new, tally)
-        _flags(k, tally, checks)
+            L = _gather(Gl, v_n, r, K)
+            tally = _new_state(gas, q, L, dt, h[0, cq], rho[q], e[q], p[q], m[q], V[q], consts, tally)
+            _store(gas, q, tally, V_new, m_new, rho_new, e_new, p_new)
+            tally = _checked(gas, q, tally.sound_speed, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+        _flags(k, tally, flags, values, speed)
 
 
 def _move_exact(g, store, a_c, v_c, p_v, p_a, old, new, dt, chunks, L_c):
@@ -207,9 +282,18 @@ def _move_exact(g, store, a_c, v_c, p_v, p_a, old, new, dt, chunks, L_c):
 
     ``old``'s x and v into ``new``'s, the numpy step's operations in its order
     (``L_p = v*_x(x_p^{n+1}, t + dt) + L_c,p`` follows)."""
-    nodes, h, inv_spacing = g
-    rows, S, G, cell = store
-    x, v, x_new, v_new = old.x, old.v, new.x, new.v
+    nodes = g.nodes
+    h = g.h
+    inv_spacing = g.inv_spacing
+    rows = store.rows
+    S = store.S
+    G = store.G
+    cell = store.cell
+    # one array a statement: a tuple's arrays unpacked together lose their writes in the prange (docstring)
+    x = old.x
+    v = old.v
+    x_new = new.x
+    v_new = new.v
     n = x.size
     K = WIDTH  # nodes per particle
     for k in prange(chunks):
@@ -226,11 +310,28 @@ def _move_exact(g, store, a_c, v_c, p_v, p_a, old, new, dt, chunks, L_c):
 def _update_exact(h, cell, L, old, new, dt, consts, chunks, checks):
     """The state update of :func:`_move_exact`'s particles from their ``L_p`` (USL, the cell of
     ``x_p^n``), ``old`` into ``new``, with pass 2's checks (``checks`` as :func:`_move`'s)."""
+    # one array a statement: a tuple's arrays unpacked together lose their writes in the prange (docstring)
+    V = old.V
+    m = old.m
+    rho = old.rho
+    e = old.e
+    p = old.p
+    x_new = new.x
+    v_new = new.v
+    V_new = new.V
+    m_new = new.m
+    rho_new = new.rho
+    e_new = new.e
+    p_new = new.p
+    flags = checks.flags
+    values = checks.values
+    speed = checks.speed
     n = L.size
     gas = MODEL == GAS
     for k in prange(chunks):
         tally = _NO_TALLY
         for q in range(*_chunk(n, chunks, k)):
-            tally = _new_state(gas, q, L[q], dt, h[0, cell[q]], old, new, consts, tally)
-            tally = _checked(gas, q, tally.sound_speed, new, tally)
-        _flags(k, tally, checks)
+            tally = _new_state(gas, q, L[q], dt, h[0, cell[q]], rho[q], e[q], p[q], m[q], V[q], consts, tally)
+            _store(gas, q, tally, V_new, m_new, rho_new, e_new, p_new)
+            tally = _checked(gas, q, tally.sound_speed, x_new, v_new, rho_new, e_new, p_new, V_new, tally)
+        _flags(k, tally, flags, values, speed)
