@@ -222,7 +222,7 @@ PAGES = (
                       "order_max", "order_regular", "mpm_growing", "stops_growth", "converging_where_mpm_grows",
                       "turns_growth"), {}, "growth.png"),
          )),
-    Page("defect", "The local defect, accumulated: a prediction of the particle error (E6)",
+    Page("defect", "The local defect, accumulated: a prediction of the particle error",
          "The mechanism study's all-MPM runs once more on the numpy step with an observer: at every step the defect "
          "of each quantity the particle update takes from the grid (the particle acceleration, the motion, the rate "
          "L_p) against its exact value at that step, accumulated along each particle's path with the update's own "
