@@ -205,8 +205,8 @@ def figure(folder, rows: list[dict]) -> None:
         ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set(xlabel="h", ylabel=f"particle {QUANTITY[p]} error (L1)", title=f"{p}, {n} per cell")
     axes[0][0].legend(fontsize=7)
-    save(fig, folder / "defect.png", caption="Issue 46 (2): the measured particle L1 error and the accumulated "
-                                             "defect's prediction against h, jittered layouts' mean and regular")
+    save(fig, folder / "defect.png", caption="The measured particle L1 error and the accumulated defect's "
+                                             "prediction against h, jittered layouts' mean and regular")
 
 
 #: The cost model of :mod:`mpm_fem.app.estimate`: :func:`cost` is in CPU milliseconds (:data:`STEP_MS`).

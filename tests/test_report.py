@@ -196,7 +196,8 @@ def test_a_folder_with_some_studies_has_a_section_for_every_claim():
 
 SECTIONS = ("## Abstract", "## 1 Introduction", "## 2 Method", "### 2.1 Problems and settings",
             "### 2.3 Verdicts and the rule book", "### 2.4 Seeds", "## 3 Results", "## 4 Discussion",
-            "### 4.2 What makes Sod's particle error grow: the drift study", "### 4.3 What the deep tier changes",
+            "### 4.2 What makes Sod's particle error grow: the drift study",
+            "### 4.3 Why the particle error grows: the local defect, accumulated", "### 4.4 What the deep tier changes",
             "## 5 Conclusions", "## Appendix A: the verdict rule of each claim")
 
 

@@ -92,8 +92,8 @@ def budget_section(rows: list[dict], bases: tuple[str, ...]) -> list[str]:
              "MPM form and with every stage exact (`budget.csv`; the shares add up to 100 %; a share above 100 % or "
              "below 0 is a stage that the others' interactions offset). Reported without a verdict.", ""]
     for problem in dict.fromkeys(r["problem"] for r in rows):
-        lines += [f"### {problem}", "", "| basis | h | v(all MPM) | v(all exact) | "
-                  + " | ".join(stages) + " |", "|---" * (4 + len(stages)) + "|"]
+        header = ["basis", "h", "v(all MPM)", "v(all exact)", *stages]
+        lines += [f"### {problem}", "", "| " + " | ".join(header) + " |", "|---" * len(header) + "|"]
         for b in bases:
             got = select(rows, basis=b, problem=problem)
             if not got:
@@ -106,6 +106,6 @@ def budget_section(rows: list[dict], bases: tuple[str, ...]) -> list[str]:
             share = {r["stage"]: num(r, "share") for r in got}
             lines.append(f"| {name} | {num(got[0], 'h'):g} | {num(got[0], 'mpm_error'):.3g} | "
                          f"{num(got[0], 'exact_error'):.3g} | "
-                         + " | ".join(f"{100 * share[s]:.0f} %" for s in stages) + " |")
+                         + " | ".join(f"{share[s]:.0%}".replace("%", " %") for s in stages) + " |")
         lines.append("")
     return lines
