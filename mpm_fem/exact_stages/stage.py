@@ -29,17 +29,14 @@ scheme). Every stage exact leaves semi-implicit Euler on the exact fields:
 
 so the remainder is the time error of the (refined) step alone.
 
-A problem supplies its exact fields through :class:`~mpm_fem.exact_stages.fields.ExactFields`:
-point values for the projection integrals, and the *reference* fields ``v*``, ``v*_x``, ``a* =
-Dv*/Dt`` that grid and particle values approximate (point values for Burgers, averages over a
-particle domain across Sod's shock: :mod:`mpm_fem.problems.burgers`, :mod:`mpm_fem.problems.sod`).
+A problem supplies its exact fields (:class:`~mpm_fem.exact_stages.fields.ExactFields`): point values
+for the projection integrals and the reference fields ``v*``, ``v*_x``, ``a* = Dv*/Dt`` that grid and
+particle values approximate (averages over a particle domain across Sod's shock).
 
 :class:`ExactGridStage` is the grid stage of a step with any of these exact forms; :class:`FieldStages`
 hands it, with the fields at the particles, to the numpy step (which reaches it through the
 protocol :class:`mpm_fem.core.step.ExactStages`, never by importing this package). The exact forms
-themselves: the quadrature (:mod:`mpm_fem.exact_stages.quadrature`), the projection
-(:mod:`mpm_fem.exact_stages.projection`), the FE mass (:mod:`mpm_fem.exact_stages.mass`), the nodal
-data and their solves (:mod:`mpm_fem.exact_stages.grid_data`).
+themselves: ``quadrature``, ``projection``, ``mass``, ``grid_data`` of this package.
 """
 
 from __future__ import annotations

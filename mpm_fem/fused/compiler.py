@@ -1,9 +1,8 @@
 """The variant compiler: each pass and the loop compiled once per basis, model, width, ... .
 
-A pass is written once, reading a few module globals in capitals; a variant is the same code with
-those globals replaced by constants (:func:`_compile`), so that numba prunes the branches of the
-other models, schemes and remedies before it compiles, and a variant holds one basis's kernels and
-no other's. Every replacement is named here:
+A pass reads a few module globals in capitals; a variant is its code with them replaced by constants
+(:func:`_compile`), so numba prunes the other models', schemes' and remedies' branches and a variant
+holds one basis's kernels only. The replacements:
 
     global        replaced with                                             in the variants of
     BASIS         a registered basis (:func:`mpm_fem.bases.get`), which     every pass but _update_exact; the loop
@@ -35,14 +34,10 @@ no other's. Every replacement is named here:
                   WIDTH (:meth:`_Passes._loop_passes`), ``None`` where its
                   run takes none (the branch calling it is pruned)
 
-A basis reaches a variant only as a registered :class:`~mpm_fem.bases.contract.Basis` (checked
-complete when registered): :func:`_basis_globals` refuses anything else, so an unknown basis is
-never compiled into another basis's arithmetic. ``CONSTANTS`` lists the constants each function's
-variants take, and :func:`_compile` refuses a variant that would leave a global it reads unreplaced:
-the modules define these names only as ``None`` placeholders. Each variant is named by its constants
-and a digest of the package's sources (:data:`SOURCES`: this package and the bases'), which keeps
-numba's on-disk caches apart: numba checks only the stamp of the variant's own file, not of the
-files whose helpers it inlines.
+Only a registered, complete :class:`~mpm_fem.bases.contract.Basis` reaches a variant
+(:func:`_basis_globals`); :func:`_compile` refuses a variant that would leave a global of ``CONSTANTS``
+unreplaced (the modules define them as ``None`` placeholders). A variant's name holds its constants and
+a digest of :data:`SOURCES`, which keeps numba's on-disk caches apart (numba stamps only its own file).
 """
 
 import hashlib

@@ -11,9 +11,8 @@ The exact stages of the error budget (the gas, USL, the lumped mass, the calcula
 
     v_p += dt (a*_p + sum_i S_ip (a_i - a*_i)),  x_p += dt ((v*_p + dt a*_p) + sum_i S_ip (v_i^{n+1} - v*_i^{n+1})),
     L_p = v*_x(x_p^{n+1}, t + dt) + sum_i G_ip (v_i^{n+1} - v*_i^{n+1}),  then the state update,
-
-with the numpy step's operations in its order. The other exact stages run the numpy step
-(:func:`supported`), as does any ``kernel="numpy"`` run.
+with the numpy step's operations in its order; the other exact stages, and ``kernel="numpy"``, run the
+numpy step (:func:`supported`).
 """
 
 from __future__ import annotations

@@ -25,21 +25,13 @@ Accumulated along each particle's path with the update's own propagation: the pa
     velocity   e^{n+1} = e^n + dt (d_A - v*_x d_W)
     density    e^{n+1} = (1 - dt L_p) e^n - dt (rho_p d_L + rho*_x d_W)
 
-(the particle moves with ``W``, not ``W*``, through a field of slope ``q*_x`` at ``(x_p^n, t^n)``; the
-density update multiplies the error it carries by ``1 - dt L_p``). The three components, each
-accumulated with the propagation of the quantity it enters, so that they add up to the accumulated
-defect of that quantity:
-
-    acceleration   dt d_A              velocity (the nodal acceleration as the particle takes it)
-    velocity       -dt q*_x d_W        the measured quantity q (the nodal velocity v_i^{n+1} the particle
-                                       moves with)
-    rate           -dt rho_p d_L       density (for a unit-density model, Burgers, the drift of the
-                                       volume in density units: ``-rho_p`` times its relative defect)
-
-The predicted error of the density is rate + velocity, of the velocity acceleration + velocity. What the
-sum leaves out: the particles' initial error (zero for the studies' problems: they start on the exact
-solution), the time error of semi-implicit Euler on the exact fields, and terms of second order in the
-errors. A particle fed in (Burgers' reservoir) starts with zero defect.
+(the particle moves with ``W``, not ``W*``, through a field of slope ``q*_x``; the density update
+multiplies the error it carries by ``1 - dt L_p``). The components, each accumulated with the
+propagation of the quantity it enters, add up to the accumulated defect: acceleration ``dt d_A``
+(velocity), velocity ``-dt q*_x d_W`` (the measured quantity), rate ``-dt rho_p d_L`` (density; for
+Burgers the volume's drift in density units). The predicted error of the density is rate + velocity,
+of the velocity acceleration + velocity. Left out: the initial error (zero: the problems start on the
+exact solution), the time error on the exact fields, second-order terms. A particle fed in starts at zero.
 
 :class:`DefectObserver` is an observer of :func:`mpm_fem.run.solve.run`, which routes a run it
 instruments to the numpy step (``needs_numpy_step``); it changes no number of the run. The step's
