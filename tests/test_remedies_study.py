@@ -21,14 +21,13 @@ def test_plan_runs_every_remedy_on_the_stated_meshes(tier):
     assert {n for n, _ in plan["burgers"]} == set(remedies.REMEDIES)
     sod_meshes = {n: {h for m, h in plan["sod"] if m == n} for n in remedies.REMEDIES}
     finest = {"MPM", "B-spline domain", "B-spline domain + Taylor + volume", "B-spline domain + XPIC(5)"}
-    # full: every remedy to h = 0.000625 but APIC (the numpy step) to 0.00125; deep: the four to 0.00015625,
-    # the others to 0.0003125; every remedy but APIC on the compiled step
+    # full: every remedy to h = 0.000625; deep: the four to 0.00015625, the others to 0.0003125; every
+    # remedy on the compiled step (APIC too: its kernels)
     for name in remedies.REMEDIES:
-        n = (7 if name in finest else 6) if tier == "deep" else 4 if name == "APIC" else 5
+        n = (7 if name in finest else 6) if tier == "deep" else 5
         expected = set(remedies.SOD_H[:n])
         assert sod_meshes[name] == expected, name
-        compiled = supported(IdealGas(), Stages(**remedies.REMEDIES[name])) is None
-        assert compiled == (name != "APIC"), name
+        assert supported(IdealGas(), Stages(**remedies.REMEDIES[name])) is None, name
     assert plan["sod"][("B-spline domain + XPIC(5)", 0.000625)]["xpic"] == 5
     assert all(case["ppc"] == 16 and case["cfl"] == 0.05 for case in plan["sod"].values())
     assert all(case["ppc"] == 4 and case["acceleration"] == "calculated" for case in plan["burgers"].values())

@@ -46,7 +46,7 @@ REMEDY_HELP = {
     "volume": "particle volumes: carried by the flow, or grid (reset to tile the grid every step)",
     "transfer": "grid-to-particle transfer (the registry of mpm_fem.core.transfers, or package.module:Name of one "
                 "outside it, run on the numpy step with the blend of --flip as its setting): flip (the blend of "
-                "--flip), xpic (the order of --xpic) or apic (affine particle-in-cell; the numpy step)",
+                "--flip), xpic (the order of --xpic) or apic (affine particle-in-cell)",
 }
 HELP = {
     "h": "cell size (must divide the domain)",

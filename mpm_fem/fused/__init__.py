@@ -19,15 +19,17 @@ order: deterministic, equal to the one-thread step to round-off. The compiled lo
 Supported: every registered basis (:mod:`mpm_fem.bases`: each gives its rows as compiled kernels,
 which the variants take as globals), USL, USF, MUSL, lumped and consistent mass, calculated or exact
 acceleration, the ideal gas and viscous Burgers, and every remedy (the PIC/FLIP blend, XPIC(m), the
-grid volume, the Taylor reconstruction); the exact stages for the gas with USL, the lumped mass and
-the calculated acceleration (:func:`~mpm_fem.fused.step.supported` says which run the numpy step).
+grid volume, the Taylor reconstruction) and the transfers whose kernels it has (the blend, XPIC, APIC's
+affine kernels; APIC per step, not in the loop); the exact stages for the gas with USL, the lumped mass and
+the calculated acceleration (:func:`~mpm_fem.fused.support.supported` says which run the numpy step).
 
 Modules, in the order of the step: :mod:`~mpm_fem.fused.codes` (compile-time codes, named indices),
 :mod:`~mpm_fem.fused.sums` (gathers, scatters, chunk sums), :mod:`~mpm_fem.fused.models` (a
 particle's state update and the checks), :mod:`~mpm_fem.fused.project` (pass 1),
 :mod:`~mpm_fem.fused.passes` (pass 2 and the passes around it), :mod:`~mpm_fem.fused.remedies` (the
 volume reset, the Taylor force), :mod:`~mpm_fem.fused.loop` (many steps in one call),
-:mod:`~mpm_fem.fused.compiler` (the variants and what each replaces) and :mod:`~mpm_fem.fused.step`
+:mod:`~mpm_fem.fused.compiler` (the variants and what each replaces), :mod:`~mpm_fem.fused.support`
+(what it takes) and :mod:`~mpm_fem.fused.step`
 (:class:`~mpm_fem.fused.step.FusedStep`). How the passes were made fast: ``docs/performance.md``.
 """
 

@@ -22,7 +22,6 @@ import numpy as np
 from mpm_fem.bases import get
 from mpm_fem.bases.contract import Cloud, RowStore
 from mpm_fem.core.grid import Grid
-from mpm_fem.core.models.burgers import ViscousBurgers
 from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import Particles, PositivityError
 from mpm_fem.core.reconstruction import OFFSETS, force_quadrature
@@ -55,34 +54,12 @@ from mpm_fem.fused.passes import _finish, _move, _move_exact, _scatter_pass, _up
 from mpm_fem.fused.project import _project
 from mpm_fem.fused.remedies import Quadrature, Reset, State, _taylor_force, _volume_reset
 from mpm_fem.fused.sums import _divide_by_lumped
+from mpm_fem.fused.support import KERNELS, check_kernel, supported  # noqa: F401 (the package's names)
 
-KERNELS = ("fused", "numpy")
-_STATE = ("x", "v", "V", "m", "rho", "e", "p")  # the arrays of the particles a step returns
+_STATE = ("x", "v", "V", "m", "rho", "e", "p", "C")  # the arrays of the particles a step returns
 _PAD = 40  # doubles between advance's particle arrays: 5 cache lines, so that they do not share cache sets
 _TABLE_ROWS = 4096  # at most this many times of the tables ahead (FusedStep._tables)
 _TABLE_VALUES = 1 << 18  # at most this many exact nodal accelerations in a table (2 MiB)
-
-
-def supported(model, stages: Stages) -> str | None:
-    """``None`` if the fused step implements this model and these stages, else the reason."""
-    if not isinstance(model, (IdealGas, ViscousBurgers)):
-        return f"the fused step has no kernel for the model {type(model).__name__}"
-    if not get_transfer(stages.transfer_name).compiled:
-        return f"the fused step has no kernels for the transfer {stages.transfer_name!r}; it runs the numpy step"
-    if stages.uses_exact_fields and not (isinstance(model, IdealGas) and stages.scheme == "usl"
-                                         and stages.mass in ("lumped", "exact")
-                                         and stages.acceleration == "calculated"):
-        return ("the exact projection, mass and interpolation stages run compiled for the gas, USL, the lumped "
-                "mass and the calculated acceleration; the others run the numpy step")
-    return None
-
-
-def check_kernel(kernel: str, threads: int) -> None:
-    """Raise ``ValueError`` for an unknown kernel or a thread count that is not an integer >= 1."""
-    if kernel not in KERNELS:
-        raise ValueError(f"unknown kernel {kernel!r}; choose one of {', '.join(KERNELS)}")
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise ValueError(f"the number of threads must be an integer >= 1, got {threads!r}")
 
 
 def _uniform_to_round_off(grid: Grid) -> bool:
@@ -138,6 +115,10 @@ class FusedStep:
         else:
             self.consts[IEPS] = model.eps
         self.consts[IFLIP], self.consts[IXPIC] = float(stages.flip), float(stages.xpic)
+        self.transfer = get_transfer(stages.transfer_name)
+        self.move_consts = self.consts.copy()  # an affine transfer moves with PIC's velocity: XPIC(1)'s
+        if self.transfer.affine:
+            self.move_consts[IXPIC] = 1.0
         self.slides = self.kind == BURGERS and getattr(model, "force", "weak") == "slides"
         self._width(self.basis.width)
         self.speed, self.finite = np.nan, True
@@ -203,7 +184,7 @@ class FusedStep:
                                                    and problem.boundary is self.boundary)
         exact = (self.stages.acceleration == "exact" and self.exact_acceleration is not None
                  and problem.exact_acceleration is self.exact_acceleration)
-        return (ends and self.stages.mass == "lumped" and not self.stages.uses_exact_fields
+        return (ends and self.stages.mass == "lumped" and not self.stages.uses_exact_fields and not self.transfer.affine
                 and (self.stages.acceleration == "calculated" or exact)
                 and not self.slides and (problem.particle_boundary is None or self._window(problem) is not None))
 
@@ -388,8 +369,12 @@ class FusedStep:
         n_nodes = grid.n_nodes
         self._turn = 1 - self._turn
         empty = self._empty
-        shape, m_i, P_i, F_i, flags = self._pass1(particles, gas_force, self.stages.mass == "consistent", chunks)
+        affine = self.transfer.kernels if self.transfer.affine else None  # its rows stored: they serve its sums
+        shape, m_i, P_i, F_i, flags = self._pass1(particles, gas_force,
+                                                  self.stages.mass == "consistent" or affine is not None, chunks)
         rows, S, G, cell = shape.nodes, shape.S, shape.G, shape.cell
+        if affine is not None and particles.affine is not None:
+            affine.momentum(self.nodes, rows, S, x, m, particles.affine, P_i)
         v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
         shape_args = (geometry, x, RowStore(rows, S, G, cell))
         if grid_volume:  # the volume reset (mpm_fem.core.volume), then the force of the reset state
@@ -440,16 +425,24 @@ class FusedStep:
         P_musl = empty("P_musl", n_nodes)
         target = self._xpic_target(shape, shape_args, m, m_i, v_i, a_i, t, dt, chunks) if self.stages.xpic else a_i
         checks = Checks(flags, values, speed)
-        self.move(geometry, shape_args[2], target, v_n, moving, moved, dt, self.consts, SCHEME_CODE[scheme], chunks,
-                  P_musl, checks)
+        self.move(geometry, shape_args[2], v_n if affine is not None else target, v_n, moving, moved, dt,
+                  self.move_consts, SCHEME_CODE[scheme], chunks, P_musl, checks)
+        C_new = None
+        if affine is not None:  # G2P's coefficient from v_i^{n+1}; MUSL re-projects with it
+            C_new = empty("C", n)
+            affine.coefficient(rows, G, v_n, C_new)
         if musl:
+            if affine is not None:
+                affine.momentum(self.nodes, rows, S, x, m, C_new, P_musl)
             v_n = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_musl, "v_musl"), t + dt)
             self.finish(geometry, shape_args[2], v_n, old, new, dt, self.consts, chunks, checks)
         if usl or musl:
             if (flags[:, :2] >= 0).any():
                 self._positivity(flags[:, :2], values, x_new)
-        return self._new_particles(x_new, vel_new, V_new, m_new, rho_new, e_new, p_new, flags, speed), \
-            GridState(m_i, v_i, a_i, v_n)
+        new_particles = self._new_particles(x_new, vel_new, V_new, m_new, rho_new, e_new, p_new, flags, speed)
+        if C_new is not None:
+            new_particles = new_particles.replace(affine=C_new)
+        return new_particles, GridState(m_i, v_i, a_i, v_n)
 
     def _new_particles(self, x, v, V, m, rho, e, p, flags, speed) -> Particles:
         """The step's particles; :attr:`speed` and :attr:`finite` from pass 2's tallies."""

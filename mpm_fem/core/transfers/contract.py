@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -40,16 +40,35 @@ class GridVelocities:
     rule: Callable[[np.ndarray], np.ndarray]
 
 
+class AffineKernels(NamedTuple):
+    """An affine transfer's compiled pieces (numba functions over a step's stored rows: ``rows``
+    (n_p, K) node indices, ``S``, ``G`` (n_p, K) at ``x_p^n``), each the numpy form's operations in
+    its order, so that the fused step equals the numpy step bit for bit on one thread. The fused
+    step's particle velocity of an affine transfer is PIC's, ``v_p = sum_i S_ip v_i^{n+1}``.
+
+    momentum     ``(nodes, rows, S, x, m, C, P)``: the affine part of P2G added to ``P`` (n_nodes,)
+                 in place, ``P_i += sum_p S_ip (x_i - x_p) m_p C_p``, the sum accumulated on its
+                 own from zero in particle order, a row left to right (``np.bincount``'s), then added.
+    coefficient  ``(rows, G, v, C)``: G2P's new coefficient into ``C`` (n_p,), ``C_p = sum_i G_ip v_i``
+                 (``Shape.gather_gradient``'s order)."""
+
+    momentum: Callable
+    coefficient: Callable
+
+
 class Transfer(ABC):
     """A transfer: ``name`` (a run's ``Stages(transfer=...)``), ``title`` (a few words),
     ``affine`` (whether the particles carry an affine velocity coefficient ``C_p``,
-    :attr:`mpm_fem.core.particles.Particles.affine`) and ``compiled`` (whether the fused step has
-    its kernels)."""
+    :attr:`mpm_fem.core.particles.Particles.affine`), ``compiled`` (whether the fused step has
+    its kernels: the blend and XPIC are the passes' own, an affine transfer brings ``kernels``)."""
 
     name: str
     title: str
     affine: bool = False
     compiled: bool = True
+    #: an affine transfer's compiled pieces (:class:`AffineKernels`); the fused step refuses an affine
+    #: transfer without them
+    kernels: AffineKernels | None = None
 
     def momentum(self, shape: Shape, nodes: np.ndarray, x: np.ndarray, mass: np.ndarray, velocity: np.ndarray,
                  affine: np.ndarray | None) -> np.ndarray:
