@@ -54,8 +54,9 @@ from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import PositivityError
 from mpm_fem.core.step import Dirichlet, Walls
+from mpm_fem.measure.claims.model import model_rows
 from mpm_fem.measure.defect import DefectObserver
-from mpm_fem.measure.schema import DEFECT
+from mpm_fem.measure.schema import DEFECT, MODEL, MODEL_FIT
 from mpm_fem.measure.timing import field_on
 from mpm_fem.problems import burgers, sod
 from studies.budget import BURGERS, SOD, _layout_changes, _settings, _steps, norm_points, setting_of
@@ -172,15 +173,22 @@ def run(options: StudyOptions) -> None:
                 "ppc": list(t["ppc"]), "h": {p: list(hs) for p, hs in t["h"].items()},
                 "layouts": [f"{lay} {s}" for lay, s in t["layouts"]]}
     folder = options.folder(NAME)
-    publish(folder, {DEFECT: rows}, settings)
+    model, constants = model_rows(rows) if any(r["ok"] for r in rows) else ([], [])
+    publish(folder, {DEFECT: rows, MODEL: model, MODEL_FIT: constants}, settings)
     figure(folder, [r for r in rows if r["ok"]])
+    figure(folder, model, ("model_L1", "model"), "model.png",
+           "The measured particle L1 error and the closed-form defect model's (E6, fitted on the coarse meshes at "
+           "4 per cell) against h, jittered layouts' mean and regular")
 
 
 # ---------------------------------------------------------------- figure
 
-def figure(folder, rows: list[dict]) -> None:
-    """``defect.png``: per problem and particles per cell, the measured (solid) and predicted (dashed)
-    particle L1 error against h (log-log): the jittered layouts' mean and the regular layout (dotted)."""
+def figure(folder, rows: list[dict], predicted=("predicted_L1", "predicted"), name="defect.png",
+           caption="The measured particle L1 error and the accumulated defect's prediction against h, jittered "
+                   "layouts' mean and regular") -> None:
+    """``defect.png`` (or ``name``): per problem and particles per cell, the measured (solid) and predicted
+    (dashed; the column ``predicted[0]``, labelled ``predicted[1]``) particle L1 error against h (log-log): the
+    jittered layouts' mean and the regular layout (dotted)."""
     from matplotlib.ticker import NullFormatter
 
     panels = sorted({(r["problem"], r["ppc"]) for r in rows}, key=lambda k: (k[0] != "sod", k[1]))
@@ -193,20 +201,19 @@ def figure(folder, rows: list[dict]) -> None:
     for ax, (p, n) in zip(axes.ravel(), panels, strict=False):
         sub = [r for r in rows if (r["problem"], r["ppc"]) == (p, n)]
         hs = sorted({r["h"] for r in sub})
-        for column, color in (("measured_L1", "k"), ("predicted_L1", "tab:red")):
-            name = column.split("_")[0]
+        for column, color in (("measured_L1", "k"), (predicted[0], "tab:red")):
+            label = "measured" if column == "measured_L1" else predicted[1]
             for layout, style in (("jittered", "o-"), ("regular", "s:")):
                 values = [[r[column] for r in sub if r["h"] == h and r["layout"] == layout] for h in hs]
                 if all(values):
-                    ax.loglog(hs, [np.mean(v) for v in values], style if name == "measured" else style.replace(
-                        "-", "--"), ms=3, lw=1.1, color=color, label=f"{name}, {layout}")
+                    ax.loglog(hs, [np.mean(v) for v in values], style if label == "measured" else style.replace(
+                        "-", "--"), ms=3, lw=1.1, color=color, label=f"{label}, {layout}")
         slope_guides(ax, hs, min(r["measured_L1"] for r in sub), (1,))
         ax.set_xticks(hs, [f"{h:g}" for h in hs])
         ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set(xlabel="h", ylabel=f"particle {QUANTITY[p]} error (L1)", title=f"{p}, {n} per cell")
     axes[0][0].legend(fontsize=7)
-    save(fig, folder / "defect.png", caption="The measured particle L1 error and the accumulated defect's "
-                                             "prediction against h, jittered layouts' mean and regular")
+    save(fig, folder / name, caption=caption)
 
 
 #: The cost model of :mod:`mpm_fem.app.estimate`: :func:`cost` is in CPU milliseconds (:data:`STEP_MS`).

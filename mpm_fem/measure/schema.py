@@ -221,6 +221,14 @@ DEFECT = Table("defect/defect", (
     "error", "steps", "wall_s", "measured_L1", "predicted_L1", "ratio", "at_particles_L1", "residual_L1", "floor_L1",
     "acceleration_L1", "velocity_L1", "rate_L1", "defect_a", "defect_v", "defect_L"))
 
+#: One row per run of ``defect/defect`` (E6, :mod:`mpm_fem.measure.claims.model`): whether the error model
+#: was fitted on it (``role`` fitted or checked), its measured particle error, its driving defect, the
+#: defect law's value and the model's error, and model / measured.
+MODEL = Table("defect/model", ("problem", "ppc", "layout", "seed", "h", "role", "measured_L1", "defect",
+                               "defect_law", "model_L1", "ratio"))
+#: One row per problem and layout class: the defect law ``d = D h^q n^-r`` and the error model ``A h^p + B d``.
+MODEL_FIT = Table("defect/model_fit", ("problem", "layout", "driver", "D", "q", "r", "A", "p", "B"))
+
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
 #: One row per table: the code version that wrote it and its tier (:func:`mpm_fem.measure.tables.table_tier`;
@@ -238,7 +246,7 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     REMEDIES_ERRORS,
     DRIFT,
     IDENTIFICATION_SOD, IDENTIFICATION_BURGERS,
-    MECHANISM_GROWTH, MECHANISM_SUMMARY, DEFECT)}
+    MECHANISM_GROWTH, MECHANISM_SUMMARY, DEFECT, MODEL, MODEL_FIT)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}
 

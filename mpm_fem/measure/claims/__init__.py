@@ -10,7 +10,7 @@ report's summary. A claim whose tables are missing is ``not measured``; no verdi
 One module per study registers its claims with :func:`claim` (:mod:`.base`, with :data:`STATEMENTS`
 and :data:`CLAIMS`): :mod:`.projection` (C4-C10), :mod:`.sod` (C3, C11, C12, C14, C15, E3),
 :mod:`.reproduce` (E4), :mod:`.burgers` (C3, C13, C15), :mod:`.time` (C1, C2), :mod:`.budget` (E1,
-E2), :mod:`.remedies` (E5) and :mod:`.mechanism` (E6a); :mod:`.shared` holds the criteria of C3 and
+E2), :mod:`.remedies` (E5), :mod:`.mechanism` (E6a) and :mod:`.model` (E6); :mod:`.shared` holds the criteria of C3 and
 C15 that Sod and Burgers share, :mod:`.rows` the helpers that read rows. The tables' names and columns
 are declared once, in :mod:`mpm_fem.measure.schema` (the mechanism's in :mod:`.mechanism`, which adds
 them to the schema's index). Importing this package registers every claim, in the order above. The
@@ -48,6 +48,7 @@ from mpm_fem.measure.claims.remedies import (
     BURGERS_ORDER, FV_DRIFT, FV_FACTOR, ORDER_MARGIN, PLATEAU_CRITERION, REMEDY_ERRORS, REMEDY_MEASURES,
     remedy_assessment, remedy_budget)
 from mpm_fem.measure.claims.mechanism import MECHANISM_MESHES, growth_cases, summary_rows
+from mpm_fem.measure.claims.model import model_rows, ppc_needed
 # isort: on
 
 __all__ = [
@@ -63,5 +64,5 @@ __all__ = [
     "_roundoff_text",
     "REMEDY_ERRORS", "ORDER_MARGIN", "FV_DRIFT", "PLATEAU_CRITERION", "FV_FACTOR", "BURGERS_ORDER", "REMEDY_MEASURES",
     "remedy_assessment", "remedy_budget",
-    "MECHANISM_MESHES", "growth_cases", "summary_rows",
+    "MECHANISM_MESHES", "growth_cases", "summary_rows", "model_rows", "ppc_needed",
 ]

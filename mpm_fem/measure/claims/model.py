@@ -1,0 +1,210 @@
+"""E6: a closed-form model of point-mass MPM's particle error, built from the local defect (issue 46,
+items 3-4), fitted on some runs of ``defect/defect`` and checked on the others.
+
+The defect study (``studies/defect.py``) measures in every run the mean per-step L1 defect of the
+quantity that drives the measured error (:data:`DRIVER`: Sod's density through the rate ``L_p``,
+``defect_L``; Burgers' velocity through the particle acceleration, ``defect_a``) and shows that the
+accumulated defect is the particle error (its ``ratio``). The model replaces both by closed forms:
+
+    d(h, n, layout) = D h^q n^-r                  (the per-step defect, n particles per cell)
+    E(h, n, layout) = A h^p + B d(h, n, layout)   (the particle L1 error)
+
+``D, q, r`` per problem and layout class (regular, jittered) by least squares on ``log d`` over every
+run's defect (a defect, never a particle error); ``A, B >= 0`` per problem by non-negative least
+squares on the relative misfit ``E / E_measured - 1`` over the *fitted* rows only (``MODEL_FIT_PPC``
+particles per cell, ``h >= MODEL_FIT_H_*``), ``p`` the best of ``MODEL_P_STEPS`` orders from
+``MODEL_P_MIN`` to ``MODEL_P_MAX``. The *checked* rows (the finer meshes, the other particles per cell)
+are disjoint from the fitted ones: their measured error is read only by the verdict. ``A h^p`` is what
+converges; ``B d`` is the defect's accumulation, which grows under refinement where ``q < 0``.
+
+Particles per cell needed: the error keeps converging down to ``h`` (``dE/dh > 0``) while
+``A p h^(p-1) > B D |q| h^(q-1) n^-r``, i.e. ``n > (B D |q| h^(q-p) / (A p))^(1/r)`` (:func:`ppc_needed`).
+
+E6 per setting (problem, particles per cell, layout class), on the checked rows: it *holds* when
+``model / measured`` lies within ``PREDICTION_FACTOR`` on every checked row and the model's trend
+(error down or up between successive meshes whose finer one is checked) has the measured sign on
+every seed. Every judged setting holds -> confirmed; some -> partly; none -> refuted; no setting with
+``MODEL_MIN_CHECKED`` checked rows -> not measured.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from typing import NamedTuple
+
+import numpy as np
+from scipy.optimize import nnls
+
+from mpm_fem.measure.claims.base import CONFIRMED, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim
+from mpm_fem.measure.claims.rows import num, select, span
+from mpm_fem.measure.claims.rules import rule
+from mpm_fem.measure.schema import MODEL, MODEL_FIT
+
+#: the mean per-step defect that drives each problem's measured particle error (``defect/defect``'s column)
+DRIVER = {"sod": "defect_L", "burgers": "defect_a"}
+FACTOR = rule("PREDICTION_FACTOR")
+FIT_PPC = int(rule("MODEL_FIT_PPC"))
+FIT_H = {"sod": rule("MODEL_FIT_H_SOD"), "burgers": rule("MODEL_FIT_H_BURGERS")}
+ORDERS = np.linspace(rule("MODEL_P_MIN"), rule("MODEL_P_MAX"), int(rule("MODEL_P_STEPS")))
+MIN_CHECKED = int(rule("MODEL_MIN_CHECKED"))
+
+
+class Law(NamedTuple):
+    """The per-step defect's closed form ``d = D h^q n^-r`` of one problem and layout class."""
+
+    D: float
+    q: float
+    r: float
+
+    def __call__(self, h, n):
+        return self.D * np.asarray(h, float) ** self.q * np.asarray(n, float) ** -self.r
+
+
+class ErrorModel(NamedTuple):
+    """``E = A h^p + B d(h, n, layout)`` of one problem, ``laws`` by layout class."""
+
+    A: float
+    p: float
+    B: float
+    laws: dict
+
+    def __call__(self, h, n, layout: str):
+        return self.A * np.asarray(h, float) ** self.p + self.B * self.laws[layout](h, n)
+
+
+def fitted(row: dict) -> bool:
+    """Whether a ``defect/defect`` row is one the model is fitted on (module docstring)."""
+    return int(num(row, "ppc")) == FIT_PPC and num(row, "h") >= FIT_H[row["problem"]]
+
+
+def _ok(rows: Iterable[dict]) -> list[dict]:
+    return [r for r in rows if str(r.get("ok")) in ("True", "true", "1") and math.isfinite(num(r, "measured_L1"))]
+
+
+def fit_law(rows: list[dict], column: str) -> Law:
+    """``D, q, r`` by least squares on ``log d = log D + q log h - r log n`` (``r = 0`` with one n)."""
+    h, n, d = (np.array([num(r, c) for r in rows]) for c in ("h", "ppc", column))
+    one = np.unique(n).size == 1
+    columns = [np.ones_like(h), np.log(h)] + ([] if one else [-np.log(n)])
+    coef, *_ = np.linalg.lstsq(np.column_stack(columns), np.log(d), rcond=None)
+    return Law(float(np.exp(coef[0])), float(coef[1]), float(0) if one else float(coef[2]))
+
+
+def fit_model(rows: list[dict], problem: str) -> ErrorModel:
+    """One problem's :class:`ErrorModel` from its ``defect/defect`` rows (module docstring): the laws on
+    every row's defect, ``A, p, B`` on the fitted rows' measured errors only."""
+    rows = select(_ok(rows), problem=problem)
+    laws = {layout: fit_law(select(rows, layout=layout), DRIVER[problem])
+            for layout in sorted({r["layout"] for r in rows})}
+    train = [r for r in rows if fitted(r)]
+    y = np.array([num(r, "measured_L1") for r in train])
+    d = np.array([laws[r["layout"]](num(r, "h"), num(r, "ppc")) for r in train])
+    h = np.array([num(r, "h") for r in train])
+    best = None
+    for p in ORDERS:
+        (A, B), misfit = nnls(np.column_stack([h**p, d]) / y[:, None], np.ones_like(y))
+        if best is None or misfit < best[0]:
+            best = (misfit, float(p), float(A), float(B))
+    _, p, A, B = best
+    return ErrorModel(A, p, B, laws)
+
+
+def model_rows(rows: Iterable[dict]) -> tuple[list[dict], list[dict]]:
+    """``(defect/model, defect/model_fit)`` from ``defect/defect`` rows: per run its role, measured and
+    modelled error and their ratio; per problem and layout the fitted constants."""
+    rows = _ok(rows)
+    out, constants = [], []
+    for problem in sorted({r["problem"] for r in rows}):
+        model = fit_model(rows, problem)
+        for r in select(rows, problem=problem):
+            h, n, layout = num(r, "h"), num(r, "ppc"), r["layout"]
+            value = float(model(h, n, layout))
+            out.append({"problem": problem, "ppc": int(n), "layout": layout, "seed": int(num(r, "seed")), "h": h,
+                        "role": "fitted" if fitted(r) else "checked", "measured_L1": num(r, "measured_L1"),
+                        "defect": num(r, DRIVER[problem]), "defect_law": float(model.laws[layout](h, n)),
+                        "model_L1": value, "ratio": value / num(r, "measured_L1")})
+        for layout, law in model.laws.items():
+            constants.append({"problem": problem, "layout": layout, "driver": DRIVER[problem], "D": law.D,
+                              "q": law.q, "r": law.r, "A": model.A, "p": model.p, "B": model.B})
+    return out, constants
+
+
+def ppc_needed(constants: dict, h: float) -> float:
+    """The particles per cell above which the model's error still converges at ``h`` (module docstring),
+    from one ``defect/model_fit`` row; ``inf`` when the defect law does not fall with n, 0 when it does
+    not grow under refinement."""
+    A, p, B, D, q, r = (num(constants, c) for c in ("A", "p", "B", "D", "q", "r"))
+    if q >= 0 or B <= 0:
+        return float(0)
+    if A <= 0 or r <= 0:
+        return math.inf
+    return float((B * D * -q * h ** (q - p) / (A * p)) ** (1 / r))
+
+
+def _settings(rows: list[dict]) -> dict:
+    groups: dict[tuple, list[dict]] = {}
+    for r in rows:
+        groups.setdefault((r["problem"], int(num(r, "ppc")), r["layout"]), []).append(r)
+    return groups
+
+
+def setting_holds(rows: list[dict]) -> tuple[bool, float, float, int, int]:
+    """``(holds, ratio_lo, ratio_hi, trends_right, trends)`` of one setting's model rows (module
+    docstring): the checked rows' ratios and the trends between successive meshes of each seed whose
+    finer mesh is checked."""
+    checked = [r for r in rows if r["role"] == "checked"]
+    ratios = [num(r, "ratio") for r in checked]
+    right = total = 0
+    for seed in {int(num(r, "seed")) for r in rows}:
+        runs = sorted((r for r in rows if int(num(r, "seed")) == seed), key=lambda r: -num(r, "h"))
+        for coarse, fine in zip(runs, runs[1:], strict=False):
+            if fine["role"] != "checked":
+                continue
+            total += 1
+            measured = num(fine, "measured_L1") - num(coarse, "measured_L1")
+            modelled = num(fine, "model_L1") - num(coarse, "model_L1")
+            right += measured * modelled > 0
+    within = all(1 / FACTOR <= x <= FACTOR for x in ratios)
+    return within and right == total, min(ratios), max(ratios), right, total
+
+
+def _e6(t: Tables) -> Finding:
+    """A closed-form model built from the local defect (a converging term plus the per-step defect's
+    closed form in h, particles per cell and layout) is fitted on the coarser meshes at one number of
+    particles per cell and predicts the particle error of the finer meshes and the other number: within a
+    factor and with the right trend under refinement on every seed, per setting."""
+    rows = t[MODEL.name]
+    groups = {k: g for k, g in _settings(rows).items()
+              if sum(r["role"] == "checked" for r in g) >= MIN_CHECKED}
+    if not groups:
+        return Finding(NOT_MEASURED, f"no setting with {MIN_CHECKED} checked rows in `{MODEL.name}.csv`")
+    table, held = [], []
+    for (problem, ppc, layout), g in sorted(groups.items()):
+        holds, lo, hi, right, total = setting_holds(g)
+        held.append(holds)
+        table.append({"setting": f"{problem}, {ppc} ppc, {layout}", "checked rows": sum(r["role"] == "checked"
+                                                                                       for r in g),
+                      "model / measured": span([lo, hi]), "trend right": f"{right} of {total}",
+                      "holds": "yes" if holds else "no"})
+    verdict = CONFIRMED if all(held) else PARTLY if any(held) else REFUTED
+    good = [row["setting"] for row, h in zip(table, held, strict=True) if h]
+    bad = [f"{row['setting']} ({row['model / measured']}, trend {row['trend right']})"
+           for row, h in zip(table, held, strict=True) if not h]
+    evidence = (f"the model predicts the checked rows within {FACTOR:g}x with the measured trend on "
+                f"{sum(held)} of {len(held)} settings" + (f": {'; '.join(good)}" if good else "")
+                + (f"; not on {'; '.join(bad)}" if bad else ""))
+    sentence = (f"fitted on the coarse meshes at {FIT_PPC} per cell, the defect model predicts the particle error "
+                f"of the finer meshes and the other particle counts within {FACTOR:g}x, with the measured trend, on "
+                f"{sum(held)} of {len(held)} settings")
+    return Finding(verdict, evidence, sentence, tuple(table))
+
+
+_E6_RULE = (f"per setting (problem, particles per cell, layout class) with {MIN_CHECKED} checked rows: model / "
+            "measured "
+            f"within [1/{FACTOR:g}, {FACTOR:g}] on every checked row and the model's trend between successive meshes "
+            "(finer one checked) of the measured sign on every seed -> the setting holds; every setting -> confirmed; "
+            "some -> partly; none -> refuted. Fitted on h >= MODEL_FIT_H at MODEL_FIT_PPC per cell; read from "
+            "defect/model")
+claim("E6", source="issue 46: does the accumulated quadrature defect, in closed form, predict the particle error and "
+                   "its growth?", tables=(MODEL.name, MODEL_FIT.name), study="defect", thresholds=_E6_RULE)(_e6)
