@@ -161,7 +161,10 @@ def model_paragraph(tables: Tables, captions: dict) -> list[str]:
         "(`defect/model.csv`, E6). " + " ".join(parts) + " The defect falls slowly with the particles per cell "
         "(r below one) and grows under refinement (q below zero), so the particles needed to keep converging "
         "grow faster than 1/h: the model says point-mass MPM cannot be kept converging by adding particles at "
-        "any practical count on these layouts. This agrees with E5, where the remedy that keeps Sod converging "
+        "any practical count on these layouts. Those counts are extrapolations far beyond the 4 and 8 per cell "
+        "the model was fitted and checked on, and its converging term's order p is the fit's choice among the "
+        "orders tried (`MODEL_P_MIN` to `MODEL_P_MAX` in the rule book): read them as orders of magnitude. "
+        "This agrees with E5, where the remedy that keeps Sod converging "
         "changes the quadrature (the particle-domain B-spline), not the particle count; the model itself is not "
         "fitted to the remedies' runs.")
     if "model.png" in captions:
