@@ -35,14 +35,19 @@ from mpm_fem.measure.tables import Tables
 
 Found = dict[str, tuple[Claim, Finding]]
 #: The findings the abstract states, in this order (label, the subject when the finding has no sentence).
-ABSTRACT = ("C11", "C13", "E1 (sod)", "E5")
+ABSTRACT = ("C11", "C13", "E1 (sod)", "E5", "E6")
 #: The findings the conclusions state, in this order; the measured ones among them, at most eight.
 CONCLUSIONS = ("C11", "C13", "C12", "C15 (sod)", "E1 (sod)", "E3", "E5", "C10", "C3 (sod)")
 MAX_CONCLUSIONS = 8
 #: Verdicts that depart from the source's statement: the discussion takes each in turn.
 DEPARTS = (PARTLY, DIFFERS, REFUTED)
 #: Where the discussion measures a discrepancy's mechanism in a section of its own.
-MEASURED_ELSEWHERE = {"C11": "[The drift study](#drift) below measures what makes the particle error grow."}
+MEASURED_ELSEWHERE = {
+    "C11": "[The drift study](#drift) below measures what makes the particle error grow on the regular layout, and "
+           "[the local defect, accumulated](#defect) traces the growth on every layout to the defect of the rate L_p "
+           "at the particles, summed over the steps (E6).",
+    "C13": "[The local defect, accumulated](#defect) traces the Burgers stall to the defect of the particle "
+           "acceleration, summed over the steps (E6)."}
 #: The results' section of the claims on the record itself (E4): they read the tables' stamps.
 REPRODUCTION = Page("reproduce", "Reproduction", "Every table carries the version of the code that wrote it; one "
                     "command regenerates them all. Each table's stamp is in the appendix.")

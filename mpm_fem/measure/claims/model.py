@@ -196,7 +196,7 @@ def _e6(t: Tables) -> Finding:
                 + (f"; not on {'; '.join(bad)}" if bad else ""))
     sentence = (f"fitted on the coarse meshes at {FIT_PPC} per cell, the defect model predicts the particle error "
                 f"of the finer meshes and the other particle counts within {FACTOR:g}x, with the measured trend, on "
-                f"{sum(held)} of {len(held)} settings")
+                f"{sum(held)} of {len(held)} settings" + (f" ({'; '.join(good)})" if good and bad else ""))
     return Finding(verdict, evidence, sentence, tuple(table))
 
 
