@@ -119,3 +119,26 @@ def test_the_real_table_gives_a_verdict_from_its_numbers():
     finding = _verdict(rows)
     assert finding.verdict in ("confirmed", "partly", "refuted")
     assert all(np.isfinite(float(r["model_L1"])) for r in model_rows(rows)[0])
+
+
+def _remedies(order_of):
+    """``remedies/orders`` and its settings for three remedies: MPM, the particle-domain B-spline (a change of
+    the quadrature) and XPIC(5) (a transfer), each with the least particle order ``order_of[name]``."""
+    rows = [{"problem": "sod", "remedy": name, "min_order_particles_L1": order} for name, order in order_of.items()]
+    settings = [{"table": "remedies/orders", "key": "remedies.B-spline domain.basis", "value": "bspline_gimp"},
+                {"table": "remedies/orders", "key": "remedies.XPIC(5).xpic", "value": "5"}]
+    return {"remedies/orders": rows, "settings": settings}
+
+
+def test_e6_reads_which_remedies_stop_the_growth():
+    from mpm_fem.measure.claims.model import remedy_rows
+
+    model, constants = model_rows(_table())
+    e6 = next(c for c in CLAIMS if c.id == "E6")
+    agreeing = _remedies({"MPM": -0.3, "B-spline domain": 0.9, "XPIC(5)": -0.4})
+    rows = remedy_rows(agreeing)
+    assert [r["changes the quadrature"] for r in rows] == ["no", "yes", "no"] and all(r["agrees"] for r in rows)
+    tables = {"defect/model": model, "defect/model_fit": constants}
+    assert e6.criterion({**tables, **agreeing}).verdict == "confirmed"
+    wrong = e6.criterion({**tables, **_remedies({"MPM": -0.3, "B-spline domain": -0.2, "XPIC(5)": -0.4})})
+    assert wrong.verdict == "partly" and "not on sod B-spline domain (-0.20)" in wrong.evidence

@@ -23,8 +23,12 @@ Particles per cell needed: the error keeps converging down to ``h`` (``dE/dh > 0
 E6 per setting (problem, particles per cell, layout class), on the checked rows: it *holds* when
 ``model / measured`` lies within ``PREDICTION_FACTOR`` on every checked row and the model's trend
 (error down or up between successive meshes whose finer one is checked) has the measured sign on
-every seed. Every judged setting holds -> confirmed; some -> partly; none -> refuted; no setting with
-``MODEL_MIN_CHECKED`` checked rows -> not measured.
+every seed. The same model says which remedies help (:func:`remedy_rows`): the growth is the point-mass
+quadrature's defect, so a remedy that changes the quadrature (a particle-domain basis of the registry, or
+the reconstructed stress) stops it and one that does not (a transfer, the volume, a point basis) leaves it;
+checked against ``remedies/orders`` (the particle L1 order's minimum over the meshes at least
+``GROWTH_ORDER``: it stops). Every judged setting holds and every remedy agrees -> confirmed; some of
+either -> partly; none -> refuted; no setting with ``MODEL_MIN_CHECKED`` checked rows -> not measured.
 """
 
 from __future__ import annotations
@@ -36,8 +40,9 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import nnls
 
+from mpm_fem.bases import get as get_basis
 from mpm_fem.measure.claims.base import CONFIRMED, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim
-from mpm_fem.measure.claims.rows import num, select, span
+from mpm_fem.measure.claims.rows import GROWTH_ORDER, num, select, span
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import MODEL, MODEL_FIT
 
@@ -169,6 +174,29 @@ def setting_holds(rows: list[dict]) -> tuple[bool, float, float, int, int]:
     return within and right == total, min(ratios), max(ratios), right, total
 
 
+REMEDIES = "remedies/orders"
+
+
+def remedy_rows(t: Tables) -> list[dict]:
+    """Per remedy of ``remedies/orders`` with a finite particle order: whether the model says it helps (it
+    changes the quadrature: a particle-domain basis, or ``reconstruct`` other than ``none``, read from the
+    table's settings), whether it stops the growth (its least particle L1 order >= ``GROWTH_ORDER``), and
+    whether the two agree."""
+    settings = {r["key"]: r["value"] for r in t.get("settings", []) if r["table"] == REMEDIES}
+    out = []
+    for r in t.get(REMEDIES, []):
+        name, order = r["remedy"], num(r, "min_order_particles_L1")
+        if not math.isfinite(order):
+            continue
+        basis = settings.get(f"remedies.{name}.basis", "mpm")
+        helps = get_basis(basis).domain is True or settings.get(f"remedies.{name}.reconstruct", "none") != "none"
+        stops = order >= GROWTH_ORDER
+        out.append({"problem": r["problem"], "remedy": name, "changes the quadrature": "yes" if helps else "no",
+                    "least particle order": order, "stops the growth": "yes" if stops else "no",
+                    "agrees": helps == stops})
+    return out
+
+
 def _e6(t: Tables) -> Finding:
     """A closed-form model built from the local defect (a converging term plus the per-step defect's
     closed form in h, particles per cell and layout) is fitted on the coarser meshes at one number of
@@ -187,16 +215,24 @@ def _e6(t: Tables) -> Finding:
                                                                                        for r in g),
                       "model / measured": span([lo, hi]), "trend right": f"{right} of {total}",
                       "holds": "yes" if holds else "no"})
-    verdict = CONFIRMED if all(held) else PARTLY if any(held) else REFUTED
+    remedies = remedy_rows(t)
+    agree = [r for r in remedies if r["agrees"]]
+    wrong = [f"{r['problem']} {r['remedy']} ({r['least particle order']:.2f})" for r in remedies if not r["agrees"]]
+    verdict = (CONFIRMED if all(held) and len(agree) == len(remedies) else
+               PARTLY if any(held) or agree else REFUTED)
     good = [row["setting"] for row, h in zip(table, held, strict=True) if h]
     bad = [f"{row['setting']} ({row['model / measured']}, trend {row['trend right']})"
            for row, h in zip(table, held, strict=True) if not h]
     evidence = (f"the model predicts the checked rows within {FACTOR:g}x with the measured trend on "
                 f"{sum(held)} of {len(held)} settings" + (f": {'; '.join(good)}" if good else "")
-                + (f"; not on {'; '.join(bad)}" if bad else ""))
+                + (f"; not on {'; '.join(bad)}" if bad else "")
+                + (f"; which remedies stop the growth (they change the quadrature): right on {len(agree)} of "
+                   f"{len(remedies)} remedies" + (f", not on {', '.join(wrong)}" if wrong else "") if remedies else
+                   "; the remedies table is not here"))
     sentence = (f"fitted on the coarse meshes at {FIT_PPC} per cell, the defect model predicts the particle error "
                 f"of the finer meshes and the other particle counts within {FACTOR:g}x, with the measured trend, on "
-                f"{sum(held)} of {len(held)} settings" + (f" ({'; '.join(good)})" if good and bad else ""))
+                f"{sum(held)} of {len(held)} settings" + (f" ({'; '.join(good)})" if good and bad else "")
+                + (f"; it says which remedies stop the growth on {len(agree)} of {len(remedies)}" if remedies else ""))
     return Finding(verdict, evidence, sentence, tuple(table))
 
 
