@@ -54,7 +54,7 @@ from mpm_fem.app.study import StudyOptions, publish, script_main
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import PositivityError
 from mpm_fem.core.step import Dirichlet, Walls
-from mpm_fem.measure.claims.model import model_rows
+from mpm_fem.measure.claims.model import FIT_PPC, model_rows
 from mpm_fem.measure.defect import DefectObserver
 from mpm_fem.measure.schema import DEFECT, MODEL, MODEL_FIT
 from mpm_fem.measure.timing import field_on
@@ -178,7 +178,7 @@ def run(options: StudyOptions) -> None:
     figure(folder, [r for r in rows if r["ok"]])
     figure(folder, model, ("model_L1", "model"), "model.png",
            "The measured particle L1 error and the closed-form defect model's (E6, fitted on the coarse meshes at "
-           "4 per cell) against h, jittered layouts' mean and regular")
+           f"{FIT_PPC} per cell) against h, jittered layouts' mean and regular")
 
 
 # ---------------------------------------------------------------- figure

@@ -216,6 +216,7 @@ NOT_JUDGED = {"quick": {
     "E5": ("full", "the quick reproduction leaves out the remedies study"),
     **{c: ("full", "the quick reproduction leaves out the mechanism study (the exact-stage kernels)")
        for c in ("E6a (sod)", "E6a (burgers)")},
+    "E6": ("full", "the quick reproduction leaves out the defect study"),
 }}
 
 
