@@ -122,12 +122,15 @@ def test_the_real_table_gives_a_verdict_from_its_numbers():
 
 
 def _remedies(order_of):
-    """``remedies/orders`` and its settings for three remedies: MPM, the particle-domain B-spline (a change of
-    the quadrature) and XPIC(5) (a transfer), each with the least particle order ``order_of[name]``."""
-    rows = [{"problem": "sod", "remedy": name, "min_order_particles_L1": order} for name, order in order_of.items()]
-    settings = [{"table": "remedies/orders", "key": "remedies.B-spline domain.basis", "value": "bspline_gimp"},
-                {"table": "remedies/orders", "key": "remedies.XPIC(5).xpic", "value": "5"}]
-    return {"remedies/orders": rows, "settings": settings}
+    """``remedies/errors`` and its settings for three remedies: MPM, the particle-domain B-spline (a change of
+    the quadrature) and XPIC(5) (a transfer), each a series on two Sod meshes whose particle L1 order is
+    ``order_of[name]``."""
+    rows = [{"problem": "sod", "remedy": name, "h": h, "ok": True, "nodes_L1": 0.01 * (h / 0.01) ** order,
+             "particles_L1": 0.01 * (h / 0.01) ** order}
+            for name, order in order_of.items() for h in (0.01, 0.005)]
+    settings = [{"table": "remedies/errors", "key": "remedies.B-spline domain.basis", "value": "bspline_gimp"},
+                {"table": "remedies/errors", "key": "remedies.XPIC(5).xpic", "value": "5"}]
+    return {"remedies/errors": rows, "settings": settings}
 
 
 def test_e6_reads_which_remedies_stop_the_growth():

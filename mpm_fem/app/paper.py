@@ -35,7 +35,7 @@ from mpm_fem.measure.tables import Tables
 
 Found = dict[str, tuple[Claim, Finding]]
 #: The findings the abstract states, in this order (label, the subject when the finding has no sentence).
-ABSTRACT = ("C11", "C13", "E1 (sod)", "E5", "E6")
+ABSTRACT = ("C11", "C13", "E1 (sod)", "E5")
 #: The findings the conclusions state, in this order; the measured ones among them, at most eight.
 CONCLUSIONS = ("C11", "C13", "C12", "C15 (sod)", "E1 (sod)", "E3", "E5", "C10", "C3 (sod)")
 MAX_CONCLUSIONS = 8

@@ -26,9 +26,10 @@ E6 per setting (problem, particles per cell, layout class), on the checked rows:
 every seed. The same model says which remedies help (:func:`remedy_rows`): the growth is the point-mass
 quadrature's defect, so a remedy that changes the quadrature (a particle-domain basis of the registry, or
 the reconstructed stress) stops it and one that does not (a transfer, the volume, a point basis) leaves it;
-checked against ``remedies/orders`` (the particle L1 order's minimum over the meshes at least
-``GROWTH_ORDER``: it stops). Every judged setting holds and every remedy agrees -> confirmed; some of
-either -> partly; none -> refuted; no setting with ``MODEL_MIN_CHECKED`` checked rows -> not measured.
+checked against ``remedies/errors`` (each remedy's main series, as E5 reads it: its least successive
+particle L1 order at least ``GROWTH_ORDER``: it stops). Every judged setting holds and every remedy
+agrees -> confirmed; some of either -> partly; none -> refuted; no setting with ``MODEL_MIN_CHECKED``
+checked rows -> not measured.
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ from scipy.optimize import nnls
 
 from mpm_fem.bases import get as get_basis
 from mpm_fem.measure.claims.base import CONFIRMED, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim
+from mpm_fem.measure.claims.remedies import REMEDY_ERRORS, _series, remedy_assessment
 from mpm_fem.measure.claims.rows import GROWTH_ORDER, num, select, span
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import MODEL, MODEL_FIT
@@ -174,27 +176,28 @@ def setting_holds(rows: list[dict]) -> tuple[bool, float, float, int, int]:
     return within and right == total, min(ratios), max(ratios), right, total
 
 
-REMEDIES = "remedies/orders"
-
-
 def remedy_rows(t: Tables) -> list[dict]:
-    """Per remedy of ``remedies/orders`` with a finite particle order: whether the model says it helps (it
-    changes the quadrature: a particle-domain basis, or ``reconstruct`` other than ``none``, read from the
-    table's settings), whether it stops the growth (its least particle L1 order >= ``GROWTH_ORDER``), and
-    whether the two agree."""
-    settings = {r["key"]: r["value"] for r in t.get("settings", []) if r["table"] == REMEDIES}
-    out = []
-    for r in t.get(REMEDIES, []):
-        name, order = r["remedy"], num(r, "min_order_particles_L1")
-        if not math.isfinite(order):
-            continue
-        basis = settings.get(f"remedies.{name}.basis", "mpm")
-        helps = get_basis(basis).domain is True or settings.get(f"remedies.{name}.reconstruct", "none") != "none"
-        stops = order >= GROWTH_ORDER
-        out.append({"problem": r["problem"], "remedy": name, "changes the quadrature": "yes" if helps else "no",
-                    "least particle order": order, "stops the growth": "yes" if stops else "no",
-                    "agrees": helps == stops})
+    """Per problem and remedy of ``remedies/errors`` with a finite particle order (its main series, as E5
+    reads it): whether the model says it helps (it changes the quadrature: a particle-domain basis, or
+    ``reconstruct`` other than ``none``, read from the table's settings), whether it stops the growth (its
+    least successive particle L1 order >= ``GROWTH_ORDER``), and whether the two agree."""
+    settings = {r["key"]: r["value"] for r in t.get("settings", []) if r["table"] == REMEDY_ERRORS}
+    rows, out = t.get(REMEDY_ERRORS, []), []
+    for problem in ("sod", "burgers"):
+        for name, series in _series(rows, problem).items():
+            order = remedy_assessment(series)["min_order_particles_L1"]
+            if math.isfinite(order):
+                out.append(_remedy_row(problem, name, order, settings))
     return out
+
+
+def _remedy_row(problem: str, name: str, order: float, settings: dict) -> dict:
+    """One remedy's row of :func:`remedy_rows` (``settings``: the remedies table's, flattened)."""
+    basis = settings.get(f"remedies.{name}.basis", "mpm")
+    helps = get_basis(basis).domain is True or settings.get(f"remedies.{name}.reconstruct", "none") != "none"
+    stops = order >= GROWTH_ORDER
+    return {"problem": problem, "remedy": name, "changes the quadrature": "yes" if helps else "no",
+            "least particle order": order, "stops the growth": "yes" if stops else "no", "agrees": helps == stops}
 
 
 def _e6(t: Tables) -> Finding:
