@@ -240,10 +240,11 @@ def _e6(t: Tables) -> Finding:
 
 
 _E6_RULE = (f"per setting (problem, particles per cell, layout class) with {MIN_CHECKED} checked rows: model / "
-            "measured "
-            f"within [1/{FACTOR:g}, {FACTOR:g}] on every checked row and the model's trend between successive meshes "
-            "(finer one checked) of the measured sign on every seed -> the setting holds; every setting -> confirmed; "
-            "some -> partly; none -> refuted. Fitted on h >= MODEL_FIT_H at MODEL_FIT_PPC per cell; read from "
-            "defect/model")
+            f"measured within [1/{FACTOR:g}, {FACTOR:g}] on every checked row and the model's trend between successive "
+            "meshes (finer one checked) of the measured sign on every seed -> the setting holds; per remedy of "
+            "remedies/errors: it changes the quadrature (a particle-domain basis or the reconstructed stress) exactly "
+            f"when its least particle order is at least {GROWTH_ORDER:g} -> it agrees; every setting holds and every "
+            "remedy agrees -> confirmed; some of either -> partly; none -> refuted. Fitted on h >= MODEL_FIT_H_SOD "
+            "(MODEL_FIT_H_BURGERS) at MODEL_FIT_PPC per cell; read from defect/model and remedies/errors")
 claim("E6", source="issue 46: does the accumulated quadrature defect, in closed form, predict the particle error and "
                    "its growth?", tables=(MODEL.name, MODEL_FIT.name), study="defect", thresholds=_E6_RULE)(_e6)
