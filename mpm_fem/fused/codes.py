@@ -27,5 +27,5 @@ IGM1, IGGM1, ILIN, IQUAD, IEPS, IFLIP, IXPIC = range(7)
 
 # rows of the loop's nodal scratch (Scratch.grid): m_i, P_i, F_i, v_i, a_i, v_i^{n+1} and MUSL's P_i always;
 # XPIC's P, term, v* and target after them where it runs; the volume reset's V_i and ratio after those
-GM, GP, GF, GV, GA, GVN, GPMUSL = range(7)
+GM, GP, GF, GV, GA, GVN, GPMUSL = range(7)  # GM .. GF: pass 1's three sums, as a basis's project kernel writes them
 GPX, GTERM, GVSTAR, GTARGET = range(7, 11)

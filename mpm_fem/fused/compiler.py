@@ -54,8 +54,10 @@ from mpm_fem.fused.loop import _advance
 from mpm_fem.fused.passes import _finish, _move, _move_exact, _scatter_pass, _update, _update_exact
 from mpm_fem.fused.project import _project
 from mpm_fem.fused.remedies import _taylor_force, _volume_reset
+from mpm_fem.fused.sweep import _sweep
 
-LOOP_PASSES = ("PROJECT", "MOVE", "UPDATE", "FINISH", "VISCOUS", "GAS_FORCE", "XPIC", "VOLUME", "TAYLOR")
+LOOP_PASSES = ("PROJECT", "MOVE", "UPDATE", "FINISH", "VISCOUS", "GAS_FORCE", "XPIC", "VOLUME", "TAYLOR", "SWEEP",
+               "SWEEP_ON")
 BASIS_GLOBALS = ("ROW", "SHAPE_ROW", "PROJECT_RUN", "MOVE_RUN", "STORED", "REGISTERS", "ANY_GRID", "TWIN_ROW",
                  "TWIN_SCALARS", "TWIN_COLUMN")
 REPLACED = frozenset(("BASIS", "MODEL", "WIDTH", "WEIGHT", "SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON")
@@ -72,8 +74,11 @@ CONSTANTS = {  # the constants of each function's variants (the keywords of _Pas
     _volume_reset: ("BASIS", "MODEL"),
     _move_exact: _SHAPE,
     _update_exact: ("MODEL",),
+    _sweep: _SHAPE,
     _advance: _MODEL + ("SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON"),
 }
+# numba's error model where it is not Python's: the sweep's divisions unchecked, so that its update vectorises
+ERROR_MODEL = {_sweep: "numpy"}
 # the files whose code a variant compiles (inlined helpers included): this package and the bases
 SOURCES = sorted(Path(__file__).parent.glob("*.py")) + sorted(Path(inspect.getsourcefile(bases)).parent.glob("*.py"))
 DIGEST = hashlib.sha1(b"".join(path.read_bytes() for path in SOURCES)).hexdigest()[:8]
@@ -106,7 +111,7 @@ def _compile(fn, parallel, passes=None, **constants):
     variant = types.FunctionType(fn.__code__, dict(fn.__globals__, **replaced), f"{fn.__name__}{suffix}_{DIGEST}",
                                  fn.__defaults__)
     variant.__qualname__ = variant.__name__
-    return njit(cache=True, parallel=parallel)(variant)
+    return njit(cache=True, parallel=parallel, error_model=ERROR_MODEL.get(fn, "python"))(variant)
 
 
 class _Passes:
@@ -137,7 +142,9 @@ class _Passes:
         shape = dict(BASIS=BASIS, WIDTH=WIDTH)
         model = dict(shape, MODEL=MODEL)
         scatter = lambda weight: self.get(_scatter_pass, **shape, WEIGHT=weight)  # noqa: E731
+        sweep = MODEL == GAS and SCHEME not in (USF, MUSL) and not (XPIC_ON or VOLUME_ON or TAYLOR_ON or self.parallel)
         return dict(PROJECT=self.get(_project, **shape), MOVE=self.get(_move, **model),
+                    SWEEP=self.get(_sweep, **shape) if sweep else None, SWEEP_ON=int(sweep),
                     UPDATE=self.get(_update, **model) if SCHEME == USF else None,
                     FINISH=self.get(_finish, **model) if SCHEME == MUSL else None,
                     VISCOUS=scatter(VISCOUS_STRESS) if MODEL == BURGERS else None,

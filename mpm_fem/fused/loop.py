@@ -48,10 +48,11 @@ from mpm_fem.fused.codes import (
 from mpm_fem.fused.models import Checks, ParticleState
 from mpm_fem.fused.remedies import Quadrature, Reset, State
 from mpm_fem.fused.sums import _divide_by_lumped
+from mpm_fem.fused.sweep import BLOCK
 
 # placeholders: each variant has its own (mpm_fem.fused.compiler)
-STORED = MODEL = WIDTH = SCHEME = XPIC_ON = VOLUME_ON = TAYLOR_ON = None
-PROJECT = MOVE = UPDATE = FINISH = VISCOUS = GAS_FORCE = XPIC = VOLUME = TAYLOR = None
+STORED = ANY_GRID = MODEL = WIDTH = SCHEME = XPIC_ON = VOLUME_ON = TAYLOR_ON = SWEEP_ON = None
+PROJECT = MOVE = UPDATE = FINISH = VISCOUS = GAS_FORCE = XPIC = VOLUME = TAYLOR = SWEEP = None
 
 class Conditions(NamedTuple):
     """The problem's conditions at the ends and on the particles."""
@@ -230,6 +231,10 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[GM], grid[GP], grid[GF], grid[GV], grid[GA], grid[GVN], grid[GPMUSL]
     done, dt_min, dt_max = 0, np.inf, -np.inf
     g_t, g_next, known = np.empty(0), np.empty(0), False  # Dirichlet data at t and t + dt
+    # the sweep (USL gas, one thread, a grid the basis's own kernels serve): pass 2 and the next pass 1 together
+    sweeping = SWEEP_ON == 1 and chunks == 1 and (ANY_GRID == 1 or inv_spacing > 0.0)
+    block = np.empty((4, BLOCK if sweeping else 0))
+    projected = False  # m_i, P_i, F_i (and the cells, rows) hold pass 1 of state[cur]: the last sweep's
     while done < budget and t < T * (1 - 1e-12):
         if fixed_dt > 0:
             base = fixed_dt
@@ -248,13 +253,15 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
         o = 1 - cur  # the other set: the new state
         x_n, v_new, V_n, m_n, rho_n, e_n, p_n = state[o, IX, :n], state[o, IV, :n], state[o, IVOL, :n], \
             state[o, IM, :n], state[o, IRHO, :n], state[o, IE, :n], state[o, IP, :n]
-        PROJECT(geometry, Cloud(x, V, m, v, p), gas and SCHEME != USF and not VOLUME_ON and not TAYLOR_ON,
-                store, chunks, stored, m_i, P_i, F_i, flags)
-        need = 2
-        for k in range(chunks):
-            need = max(need, flags[k, 2])
-        if (flags[:, :2] >= 0).any() or (store and need != WIDTH and n > 0):
-            break
+        if not projected:
+            PROJECT(geometry, Cloud(x, V, m, v, p), gas and SCHEME != USF and not VOLUME_ON and not TAYLOR_ON,
+                    store, chunks, stored, m_i, P_i, F_i, flags)
+            need = 2
+            for k in range(chunks):
+                need = max(need, flags[k, 2])
+            if (flags[:, :2] >= 0).any() or (store and need != WIDTH and n > 0):
+                break
+        projected = False
         _lumped_walls(P_i, m_i, ends, v_i)
         if dirichlet:
             if not known:
@@ -323,7 +330,15 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
         checks = Checks(flags, values, speeds)
         old, new = ParticleState(x, v, V, m, rho, e, p), ParticleState(x_n, v_new, V_n, m_n, rho_n, e_n, p_n)
         if SCHEME == USL:
-            MOVE(geometry, stored, target, v_n, old, new, dt, consts, SCHEME, chunks, P_musl, checks)
+            if SWEEP_ON == 1 and sweeping:  # pass 2, and the next step's pass 1 into m_i, P_i, F_i (GM, GP, GF)
+                refused, top, outside, empty, need = SWEEP(geometry, stored, target, v_n, old, new, dt, consts, block,
+                                                           grid[GM:GM + 3])
+                if refused >= 0:
+                    break  # the per-step path retakes this step and raises
+                flags[0, 0], flags[0, 1], flags[0, 2], speeds[0] = -1, -1, -1, top
+                projected = outside < 0 and empty < 0 and (not store or need == WIDTH or n == 0)
+            else:
+                MOVE(geometry, stored, target, v_n, old, new, dt, consts, SCHEME, chunks, P_musl, checks)
         elif SCHEME == USF:  # the state updated already: pass 2 moves the particles only
             MOVE(geometry, stored, target, v_n, ParticleState(x, v, V_n, m, rho_n, e_n, p_n), new, dt, consts, SCHEME,
                  chunks, P_musl, checks)

@@ -1,0 +1,141 @@
+"""The sweep: pass 2 of one gas step and pass 1 of the next in one pass over the particles, by blocks.
+
+For USL with the gas (no remedy, one thread), step n's pass 2 and step n+1's pass 1 read the same
+particles one after the other, and pass 1 needs nothing of the grid stage between them. The compiled
+loop (:func:`mpm_fem.fused.loop._advance`) therefore takes them together, :func:`_sweep`, over
+blocks of ``BLOCK`` particles, each in three loops:
+
+    A  the gather: each particle's row at ``x_p^n`` (the basis's ``move`` kernel, pass 1's stored
+       row read in place, or ``pass_row`` and the gathers) and its sums
+       ``acc_p = sum_i S_ip a_i``, ``vel_p = sum_i S_ip v_i^{n+1}``, ``L_p = sum_i G_ip v_i^{n+1}``,
+       with ``h_c`` of its cell (the artificial viscosity's length), into the block's scratch;
+    B  the update over the block's contiguous slices, branch-free so that LLVM vectorises it:
+       ``v_p^{n+1} = v_p + dt acc_p`` (blended with ``vel_p`` where ``flip != 1``),
+       ``x_p^{n+1} = x_p + dt vel_p``, the gas's update from ``L_p``
+       (:func:`mpm_fem.fused.models._gas_update`), the signal speed's maximum, and a count of the
+       particles a check refuses (factor or energy not > 0, a non-finite state);
+    C  step n+1's pass 1 over the block's new state, the basis's ``project`` kernel (``m_i``,
+       ``P_i``, ``F_i = sum_p V_p p_p G_ip``, each node's terms in particle order, the rows stored
+       where the basis stores them).
+
+The floats are those of pass 2 and pass 1 taken one after the other (:func:`mpm_fem.fused.passes._move`,
+:func:`mpm_fem.fused.project._project`): the same operations per particle in the same order, and
+each node's sum added in particle order from zero across the blocks (a block's ``project`` call
+starts from the sums the blocks before it left). Vectorising the update changes no float: it has no
+sum across particles but the maximum, which does not depend on the order. A refused particle stops
+the sweep (the loop then stops before the step, and :meth:`mpm_fem.fused.step.FusedStep.step`
+retakes it and raises as the numpy step does); a particle of step n+1 outside the grid, without
+volume, or whose row needs other columns makes the loop take step n+1's pass 1 again, which stops it.
+Compiled with ``error_model="numpy"``: a division by zero gives an infinity the checks then refuse,
+where numba's Python model would test every divisor and the update would not vectorise.
+"""
+
+import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
+
+from mpm_fem.bases.contract import Cloud
+from mpm_fem.fused.codes import IFLIP, IGGM1, IGM1, ILIN, IQUAD
+from mpm_fem.fused.models import _finite, _gas_update
+
+BLOCK = 2048  # particles per block: its slices and scratch stay in the L1/L2 cache
+ACC, VEL, GRAD, LENGTH = range(4)  # rows of the block's scratch: sum S a, sum S v^{n+1}, L_p, h_c
+
+# placeholders: each variant has its own (mpm_fem.fused.compiler)
+WIDTH = ROW = STORED = REGISTERS = ANY_GRID = MOVE_RUN = PROJECT_RUN = None
+
+
+@intrinsic
+def fmax(typingctx, a, b):
+    """``llvm.maxnum.f64(a, b)``: the larger of two floats. Equal to Python's ``max`` on finite
+    numbers that are not both zeros of opposite signs; LLVM vectorises a maximum written with it,
+    not one written with ``max`` (numba keeps Python's order of comparison)."""
+    double = ir.DoubleType()
+
+    def codegen(context, builder, signature, args):
+        fn = builder.module.declare_intrinsic("llvm.maxnum", [double], ir.FunctionType(double, [double, double]))
+        return builder.call(fn, args, fastmath=("fast",))
+
+    return types.float64(types.float64, types.float64), codegen
+
+
+def _sweep(g, stored, a_i, v_n, old, new, dt, consts, block, out):
+    """Step n's pass 2 (USL, the gas, ``old`` into ``new`` from ``a_i`` and ``v_n = v_i^{n+1}``)
+    and step n+1's pass 1 of ``new`` into ``out`` (3, n_nodes): ``m_i``, ``P_i``, ``F_i``
+    (zeroed first), the cells and, for a basis that stores them, the rows into ``stored``. ``g``:
+    :class:`~mpm_fem.bases.contract.Geometry` (a grid the basis's ``move`` and ``project`` serve:
+    any grid where ``ANY_GRID``, else one uniform to round-off); ``block`` (4, ``BLOCK``) scratch.
+    Returns ``(refused, speed, outside, empty, need)``: the first particle of the first block with
+    a refused particle (-1: none; then ``new`` is not complete), the largest ``c_p + |v_p^{n+1}|``,
+    and step n+1's first particle outside the grid, first without volume and the row width it needs
+    (:class:`~mpm_fem.bases.contract.Kernels`' ``project``)."""
+    nodes = g.nodes
+    h = g.h
+    inv_spacing = g.inv_spacing
+    rows = stored.rows
+    S = stored.S
+    G = stored.G
+    cell = stored.cell
+    x, v, V, m, rho, e, p = old.x, old.v, old.V, old.m, old.rho, old.e, old.p
+    x_new, v_new, V_new, rho_new, e_new, p_new = new.x, new.v, new.V, new.rho, new.e, new.p
+    n = x.size
+    K = WIDTH  # nodes per particle
+    gm1, g_gm1, c_lin, c_quad = consts[IGM1], consts[IGGM1], consts[ILIN], consts[IQUAD]
+    flip = consts[IFLIP] if consts.size > IFLIP else 1.0
+    keep = 1.0 - flip
+    out[:] = 0.0
+    acc, vel, grad, length = block[ACC], block[VEL], block[GRAD], block[LENGTH]
+    r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
+    cloud = Cloud(x_new, V_new, m, v_new, p_new)
+    speed, outside, empty, need = 0.0, -1, -1, 0
+    for lo in range(0, n, BLOCK):
+        hi = min(lo + BLOCK, n)
+        for j in range(hi - lo):  # A: the gather (scalar: indexed loads)
+            q = lo + j
+            if REGISTERS == 1:
+                c, acc[j], vel[j], grad[j] = MOVE_RUN(nodes, h, inv_spacing, x[q], a_i, v_n)
+            elif STORED == 1:
+                c = cell[q]
+                i = rows[q, 0]
+                sa, sv, gv = S[q, 0] * a_i[i], S[q, 0] * v_n[i], G[q, 0] * v_n[i]
+                for k in range(1, K):
+                    i = rows[q, k]
+                    sa += S[q, k] * a_i[i]
+                    sv += S[q, k] * v_n[i]
+                    gv += G[q, k] * v_n[i]
+                acc[j], vel[j], grad[j] = sa, sv, gv
+            else:
+                c = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+                sa, sv, gv = Sl[0] * a_i[r[0]], Sl[0] * v_n[r[0]], Gl[0] * v_n[r[0]]
+                for k in range(1, K):
+                    sa += Sl[k] * a_i[r[k]]
+                    sv += Sl[k] * v_n[r[k]]
+                    gv += Gl[k] * v_n[r[k]]
+                acc[j], vel[j], grad[j] = sa, sv, gv
+            length[j] = h[0, c]
+        refused = 0
+        xo, vo, mo, rho_o, eo, po = x[lo:hi], v[lo:hi], m[lo:hi], rho[lo:hi], e[lo:hi], p[lo:hi]
+        xn, vn, Vn, rho_n, en, pn = x_new[lo:hi], v_new[lo:hi], V_new[lo:hi], rho_new[lo:hi], e_new[lo:hi], \
+            p_new[lo:hi]
+        for j in range(hi - lo):  # B: the update (branch-free over contiguous slices: vectorised)
+            u = vo[j] + dt * acc[j]
+            if flip != 1.0:
+                u = flip * u + keep * vel[j]
+            y = xo[j] + dt * vel[j]
+            factor, density, energy, pressure, volume, c = _gas_update(
+                rho_o[j], eo[j], po[j], mo[j], grad[j], dt, length[j], gm1, g_gm1, c_lin, c_quad)
+            xn[j], vn[j], Vn[j], rho_n[j], en[j], pn[j] = y, u, volume, density, energy, pressure
+            speed = fmax(speed, c + abs(u))
+            ok = (factor > 0.0) & (energy > 0.0) & _finite(y, u, density, energy, pressure, volume)
+            refused += 0 if ok else 1
+        if refused:
+            return lo, speed, outside, empty, need
+        # C: step n+1's pass 1 over the block's new state
+        o, em, k_need = PROJECT_RUN(g, cloud, True, STORED == 1, lo, hi, stored, out)
+        if outside < 0:
+            outside = o
+        if empty < 0:
+            empty = em
+        need = max(need, k_need)
+    return -1, speed, outside, empty, need
