@@ -1,0 +1,111 @@
+"""The sweep (mpm_fem.fused.sweep): pass 2 of a USL gas step and the next step's pass 1 in one blocked
+pass. Runs of several blocks (more than ``BLOCK`` particles) in the compiled loop against the per-step
+path bit for bit, on every basis; a step refused in a later block, and a particle that leaves the grid
+mid-run, end as the numpy step ends; the sweep is compiled into the loop variants it serves only."""
+
+import numpy as np
+import pytest
+from numba import njit
+
+import mpm_fem.fused.compiler as fused_compiler
+import mpm_fem.fused.step as fused_module
+from mpm_fem.bases import get, names
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.particles import PositivityError, make_particles
+from mpm_fem.core.shape import OutsideGridError
+from mpm_fem.core.step import Walls
+from mpm_fem.fused.codes import BURGERS, GAS, MUSL, USF, USL
+from mpm_fem.fused.sweep import BLOCK, fmax
+from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
+from mpm_fem.run.solve import Problem, run
+
+FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
+H = 0.0004  # 2,500 cells: 10,000 particles at 4 per cell, five blocks
+
+
+@pytest.fixture
+def one_at_a_time(monkeypatch):
+    """Runs the fused step without its loop (every step through FusedStep.step), when called."""
+    return lambda: monkeypatch.setattr(fused_module.FusedStep, "loops", lambda self, problem: False)
+
+
+def _assert_same(a, b):
+    assert (a.steps, a.t, a.dt_min, a.dt_max) == (b.steps, b.t, b.dt_min, b.dt_max)
+    for name in FIELDS:
+        u, v = getattr(a.particles, name), getattr(b.particles, name)
+        assert np.array_equal(u, v), f"{name} differs by {float(np.max(np.abs(u - v))):.3g}"
+    assert np.array_equal(a.nodal_mass, b.nodal_mass) and np.array_equal(a.nodal_velocity, b.nodal_velocity)
+
+
+@pytest.mark.parametrize(("basis", "changes"), [(b, {}) for b in names()] + [
+    ("mpm", {"flip": 0.99}), ("mpm", {"layout": "jittered", "seed": 3}), ("gimp", {"layout": "jittered", "seed": 1})])
+def test_the_swept_loop_equals_the_per_step_path_over_several_blocks(basis, changes, loop_steps, one_at_a_time):
+    """Sod's tube on 2,500 cells to T = 0.01 (about 80 steps): each node's sums run across the
+    blocks' edges, the rows of the particle-domain bases are stored block by block, and the loop's
+    particles and nodal fields equal the per-step path's bit for bit."""
+    settings = SodSettings(h=H, ppc=4, T=0.01, cfl=0.3, basis=basis, **changes)
+    swept = simulate(settings, progress=False)
+    assert swept.particles.n > 4 * BLOCK and sum(loop_steps) > 50  # a widening GIMP row: a step per step
+    one_at_a_time()
+    _assert_same(simulate(settings, progress=False), swept)
+
+
+def test_a_step_refused_in_a_later_block_fails_as_the_numpy_step_does(loop_steps):
+    """A time step too long for the shock (0.6 h / 1.2, fixed): the energy of particle 5004 (the
+    third block) turns negative in the third step. The loop takes the second step, stops before
+    the third, and the per-step path raises the numpy step's error, word for word."""
+    settings = SodSettings(h=H, ppc=4)
+    grid = uniform_grid(*DOMAIN, settings.h)
+    problem = Problem(model=IdealGas(), boundary=Walls(), T=0.05, cfl=1.0, dt=0.6 * settings.h / 1.2)
+    errors = []
+    for kernel in ("numpy", "fused"):
+        with pytest.raises(PositivityError) as err:
+            run(problem, grid, initial_particles(settings, grid), progress=False, kernel=kernel)
+        errors.append(str(err.value))
+    assert errors[0] == errors[1] and "step 2 " in errors[1] and "particle 5004 " in errors[1]
+    assert sum(loop_steps) == 1 and 5004 > 2 * BLOCK
+
+
+def test_a_particle_that_leaves_the_grid_mid_loop_fails_as_the_numpy_step_does(loop_steps):
+    """Gas in [0.1, 0.5], nearly without pressure, moving right at speed 1 with a fixed dt = 1.5 h: it travels
+    1.5 h a step until the last cell's wall node (v = 0) lets its particles out at once. The sweep
+    that moves them out must not pass its sums on: the loop stops, and the per-step path raises the
+    numpy step's error, word for word, at the same step."""
+    h = 0.001
+    grid = uniform_grid(0.0, 1.0, h)
+    x = 0.1 + (np.arange(2400) + 0.5) * (0.4 / 2400)  # [0.1, 0.5], six per cell, away from the left wall
+    problem = Problem(model=IdealGas(), boundary=Walls(), T=1.0, cfl=1.0, dt=1.5 * h)
+    errors = []
+    for kernel in ("numpy", "fused"):
+        particles = make_particles(x, 0.4 / 2400, 1.0, velocity=1.0, energy=2.5e-6, pressure=1e-6)
+        with pytest.raises(OutsideGridError) as err:
+            run(problem, grid, particles, progress=False, kernel=kernel)
+        errors.append(str(err.value))
+    assert errors[0] == errors[1] and sum(loop_steps) > 100
+
+
+@pytest.mark.parametrize(("model", "scheme", "remedy", "parallel", "sweeps"), [
+    (GAS, USL, {}, False, 1), (GAS, USF, {}, False, 0), (GAS, MUSL, {}, False, 0), (BURGERS, USL, {}, False, 0),
+    (GAS, USL, {"XPIC_ON": 1}, False, 0), (GAS, USL, {"VOLUME_ON": 1}, False, 0), (GAS, USL, {"TAYLOR_ON": 1}, False, 0),
+    (GAS, USL, {}, True, 0)])
+def test_the_sweep_serves_only_the_plain_usl_gas_loop_on_one_thread(model, scheme, remedy, parallel, sweeps):
+    """The USL gas loop without a remedy, serial, compiles the sweep; every other loop keeps pass 2
+    and pass 1 apart (its SWEEP is None and the branch calling it is pruned)."""
+    constants = dict(BASIS=get("mpm"), MODEL=model, WIDTH=2, SCHEME=scheme, XPIC_ON=0, VOLUME_ON=0, TAYLOR_ON=0)
+    passes = fused_compiler._Passes(parallel)._loop_passes(**dict(constants, **remedy))
+    assert passes["SWEEP_ON"] == sweeps and (passes["SWEEP"] is not None) == bool(sweeps)
+
+
+def test_fmax_is_max_on_finite_numbers():
+    """The sweep's speed: ``llvm.maxnum`` equals Python's ``max`` where the speeds are finite."""
+    values = np.random.default_rng(7).random(1000) * 3.0
+    assert _reduce(values) == max(0.0, *values)
+
+
+@njit(cache=True)
+def _reduce(a):
+    speed = 0.0
+    for j in range(a.size):
+        speed = fmax(speed, a[j])
+    return speed
