@@ -87,8 +87,8 @@ def test_a_particle_that_leaves_the_grid_mid_loop_fails_as_the_numpy_step_does(l
 
 @pytest.mark.parametrize(("model", "scheme", "remedy", "parallel", "sweeps"), [
     (GAS, USL, {}, False, 1), (GAS, USF, {}, False, 0), (GAS, MUSL, {}, False, 0), (BURGERS, USL, {}, False, 0),
-    (GAS, USL, {"XPIC_ON": 1}, False, 0), (GAS, USL, {"VOLUME_ON": 1}, False, 0), (GAS, USL, {"TAYLOR_ON": 1}, False, 0),
-    (GAS, USL, {}, True, 0)])
+    (GAS, USL, {"XPIC_ON": 1}, False, 0), (GAS, USL, {"VOLUME_ON": 1}, False, 0),
+    (GAS, USL, {"TAYLOR_ON": 1}, False, 0), (GAS, USL, {}, True, 0)])
 def test_the_sweep_serves_only_the_plain_usl_gas_loop_on_one_thread(model, scheme, remedy, parallel, sweeps):
     """The USL gas loop without a remedy, serial, compiles the sweep; every other loop keeps pass 2
     and pass 1 apart (its SWEEP is None and the branch calling it is pruned)."""

@@ -77,7 +77,7 @@ def _sweep(g, stored, a_i, v_n, old, new, dt, consts, block, out):
     S = stored.S
     G = stored.G
     cell = stored.cell
-    x, v, V, m, rho, e, p = old.x, old.v, old.V, old.m, old.rho, old.e, old.p
+    x, v, m, rho, e, p = old.x, old.v, old.m, old.rho, old.e, old.p
     x_new, v_new, V_new, rho_new, e_new, p_new = new.x, new.v, new.V, new.rho, new.e, new.p
     n = x.size
     K = WIDTH  # nodes per particle
