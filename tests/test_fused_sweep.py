@@ -86,12 +86,12 @@ def test_a_particle_that_leaves_the_grid_mid_loop_fails_as_the_numpy_step_does(l
 
 
 @pytest.mark.parametrize(("model", "scheme", "remedy", "parallel", "sweeps"), [
-    (GAS, USL, {}, False, 1), (GAS, USF, {}, False, 0), (GAS, MUSL, {}, False, 0), (BURGERS, USL, {}, False, 0),
+    (GAS, USL, {}, False, 1), (GAS, USF, {}, False, 0), (GAS, MUSL, {}, False, 0), (BURGERS, USL, {}, False, 1),
     (GAS, USL, {"XPIC_ON": 1}, False, 0), (GAS, USL, {"VOLUME_ON": 1}, False, 0),
     (GAS, USL, {"TAYLOR_ON": 1}, False, 0), (GAS, USL, {}, True, 0)])
-def test_the_sweep_serves_only_the_plain_usl_gas_loop_on_one_thread(model, scheme, remedy, parallel, sweeps):
-    """The USL gas loop without a remedy, serial, compiles the sweep; every other loop keeps pass 2
-    and pass 1 apart (its SWEEP is None and the branch calling it is pruned)."""
+def test_the_sweep_serves_only_the_plain_usl_loop_on_one_thread(model, scheme, remedy, parallel, sweeps):
+    """The USL loop without a remedy, serial, compiles the sweep (the gas and Burgers); every other
+    loop keeps pass 2 and pass 1 apart (its SWEEP is None and the branch calling it is pruned)."""
     constants = dict(BASIS=get("mpm"), MODEL=model, WIDTH=2, SCHEME=scheme, XPIC_ON=0, VOLUME_ON=0, TAYLOR_ON=0)
     passes = fused_compiler._Passes(parallel)._loop_passes(**dict(constants, **remedy))
     assert passes["SWEEP_ON"] == sweeps and (passes["SWEEP"] is not None) == bool(sweeps)
@@ -109,3 +109,18 @@ def _reduce(a):
     for j in range(a.size):
         speed = fmax(speed, a[j])
     return speed
+
+
+@pytest.mark.parametrize(("basis", "changes"), [("mpm", {}), ("gimp", {}), ("bspline_gimp", {}),
+                                                ("mpm", {"acceleration": "exact"})])
+def test_a_swept_burgers_loop_equals_the_per_step_path_over_several_blocks(basis, changes, loop_steps, one_at_a_time):
+    """Viscous Burgers (the rarefaction, its exact data at the ends, the reservoir) on 2,500 cells,
+    about 200 steps: the viscous force reads the rows the sweep stored block by block; the loop's
+    particles and nodal fields equal the per-step path's bit for bit."""
+    from mpm_fem.problems import burgers
+
+    settings = burgers.BurgersSettings(h=H, T=2e-4, basis=basis, **changes)
+    swept = burgers.simulate(settings, progress=False)
+    assert swept.particles.n > 4 * BLOCK and sum(loop_steps) > 100
+    one_at_a_time()
+    _assert_same(burgers.simulate(settings, progress=False), swept)

@@ -74,7 +74,7 @@ CONSTANTS = {  # the constants of each function's variants (the keywords of _Pas
     _volume_reset: ("BASIS", "MODEL"),
     _move_exact: _SHAPE,
     _update_exact: ("MODEL",),
-    _sweep: _SHAPE,
+    _sweep: _MODEL,
     _advance: _MODEL + ("SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON"),
 }
 # numba's error model where it is not Python's: the sweep's divisions unchecked, so that its update vectorises
@@ -142,9 +142,9 @@ class _Passes:
         shape = dict(BASIS=BASIS, WIDTH=WIDTH)
         model = dict(shape, MODEL=MODEL)
         scatter = lambda weight: self.get(_scatter_pass, **shape, WEIGHT=weight)  # noqa: E731
-        sweep = MODEL == GAS and SCHEME not in (USF, MUSL) and not (XPIC_ON or VOLUME_ON or TAYLOR_ON or self.parallel)
+        sweep = SCHEME not in (USF, MUSL) and not (XPIC_ON or VOLUME_ON or TAYLOR_ON or self.parallel)
         return dict(PROJECT=self.get(_project, **shape), MOVE=self.get(_move, **model),
-                    SWEEP=self.get(_sweep, **shape) if sweep else None, SWEEP_ON=int(sweep),
+                    SWEEP=self.get(_sweep, **model) if sweep else None, SWEEP_ON=int(sweep),
                     UPDATE=self.get(_update, **model) if SCHEME == USF else None,
                     FINISH=self.get(_finish, **model) if SCHEME == MUSL else None,
                     VISCOUS=scatter(VISCOUS_STRESS) if MODEL == BURGERS else None,

@@ -231,7 +231,7 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[GM], grid[GP], grid[GF], grid[GV], grid[GA], grid[GVN], grid[GPMUSL]
     done, dt_min, dt_max = 0, np.inf, -np.inf
     g_t, g_next, known = np.empty(0), np.empty(0), False  # Dirichlet data at t and t + dt
-    # the sweep (USL gas, one thread, a grid the basis's own kernels serve): pass 2 and the next pass 1 together
+    # the sweep (USL, one thread, a grid the basis's own kernels serve): pass 2 and the next pass 1 together
     sweeping = SWEEP_ON == 1 and chunks == 1 and (ANY_GRID == 1 or inv_spacing > 0.0)
     block = np.empty((4, BLOCK if sweeping else 0))
     projected = False  # m_i, P_i, F_i (and the cells, rows) hold pass 1 of state[cur]: the last sweep's

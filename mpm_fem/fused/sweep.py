@@ -1,22 +1,23 @@
-"""The sweep: pass 2 of one gas step and pass 1 of the next in one pass over the particles, by blocks.
+"""The sweep: pass 2 of one USL step and pass 1 of the next in one pass over the particles, by blocks.
 
-For USL with the gas (no remedy, one thread), step n's pass 2 and step n+1's pass 1 read the same
-particles one after the other, and pass 1 needs nothing of the grid stage between them. The compiled
-loop (:func:`mpm_fem.fused.loop._advance`) therefore takes them together, :func:`_sweep`, over
-blocks of ``BLOCK`` particles, each in three loops:
+With USL (no remedy, one thread), step n's pass 2 and step n+1's pass 1 read the same particles one
+after the other, and pass 1 needs nothing of the grid stage between them. The compiled loop
+(:func:`mpm_fem.fused.loop._advance`) therefore takes them together, :func:`_sweep`, over blocks of
+``BLOCK`` particles, each in three loops:
 
     A  the gather: each particle's row at ``x_p^n`` (the basis's ``move`` kernel, pass 1's stored
        row read in place, or ``pass_row`` and the gathers) and its sums
        ``acc_p = sum_i S_ip a_i``, ``vel_p = sum_i S_ip v_i^{n+1}``, ``L_p = sum_i G_ip v_i^{n+1}``,
-       with ``h_c`` of its cell (the artificial viscosity's length), into the block's scratch;
+       with ``h_c`` of its cell (the gas's artificial viscosity length), into the block's scratch;
     B  the update over the block's contiguous slices, branch-free so that LLVM vectorises it:
        ``v_p^{n+1} = v_p + dt acc_p`` (blended with ``vel_p`` where ``flip != 1``),
-       ``x_p^{n+1} = x_p + dt vel_p``, the gas's update from ``L_p``
-       (:func:`mpm_fem.fused.models._gas_update`), the signal speed's maximum, and a count of the
-       particles a check refuses (factor or energy not > 0, a non-finite state);
+       ``x_p^{n+1} = x_p + dt vel_p``, the model's update from ``L_p`` (the gas:
+       :func:`mpm_fem.fused.models._gas_update`; viscous Burgers: ``V_p <- V_p (1 + L_p dt)``,
+       ``m_p = V_p``), the signal speed's maximum (``c_p + |v_p|``, Burgers ``|v_p|``), and a count
+       of the particles a check refuses (factor or the gas's energy not > 0, a non-finite state);
     C  step n+1's pass 1 over the block's new state, the basis's ``project`` kernel (``m_i``,
-       ``P_i``, ``F_i = sum_p V_p p_p G_ip``, each node's terms in particle order, the rows stored
-       where the basis stores them).
+       ``P_i`` and the gas's ``F_i = sum_p V_p p_p G_ip``, each node's terms in particle order, the
+       rows stored where the basis stores them).
 
 The floats are those of pass 2 and pass 1 taken one after the other (:func:`mpm_fem.fused.passes._move`,
 :func:`mpm_fem.fused.project._project`): the same operations per particle in the same order, and
@@ -36,14 +37,14 @@ from numba import types
 from numba.extending import intrinsic
 
 from mpm_fem.bases.contract import Cloud
-from mpm_fem.fused.codes import IFLIP, IGGM1, IGM1, ILIN, IQUAD
+from mpm_fem.fused.codes import GAS, IFLIP, IGGM1, IGM1, ILIN, IQUAD
 from mpm_fem.fused.models import _finite, _gas_update
 
 BLOCK = 2048  # particles per block: its slices and scratch stay in the L1/L2 cache
 ACC, VEL, GRAD, LENGTH = range(4)  # rows of the block's scratch: sum S a, sum S v^{n+1}, L_p, h_c
 
 # placeholders: each variant has its own (mpm_fem.fused.compiler)
-WIDTH = ROW = STORED = REGISTERS = ANY_GRID = MOVE_RUN = PROJECT_RUN = None
+MODEL = WIDTH = ROW = STORED = REGISTERS = ANY_GRID = MOVE_RUN = PROJECT_RUN = None
 
 
 @intrinsic
@@ -61,13 +62,13 @@ def fmax(typingctx, a, b):
 
 
 def _sweep(g, stored, a_i, v_n, old, new, dt, consts, block, out):
-    """Step n's pass 2 (USL, the gas, ``old`` into ``new`` from ``a_i`` and ``v_n = v_i^{n+1}``)
-    and step n+1's pass 1 of ``new`` into ``out`` (3, n_nodes): ``m_i``, ``P_i``, ``F_i``
-    (zeroed first), the cells and, for a basis that stores them, the rows into ``stored``. ``g``:
+    """Step n's pass 2 (USL, ``MODEL``'s update, ``old`` into ``new`` from ``a_i`` and ``v_n =
+    v_i^{n+1}``) and step n+1's pass 1 of ``new`` into ``out`` (3, n_nodes): ``m_i``, ``P_i`` and the
+    gas's ``F_i`` (zeroed first), the cells and, for a basis that stores them, the rows into ``stored``. ``g``:
     :class:`~mpm_fem.bases.contract.Geometry` (a grid the basis's ``move`` and ``project`` serve:
     any grid where ``ANY_GRID``, else one uniform to round-off); ``block`` (4, ``BLOCK``) scratch.
     Returns ``(refused, speed, outside, empty, need)``: the first particle of the first block with
-    a refused particle (-1: none; then ``new`` is not complete), the largest ``c_p + |v_p^{n+1}|``,
+    a refused particle (-1: none; then ``new`` is not complete), the largest signal speed,
     and step n+1's first particle outside the grid, first without volume and the row width it needs
     (:class:`~mpm_fem.bases.contract.Kernels`' ``project``)."""
     nodes = g.nodes
@@ -77,8 +78,8 @@ def _sweep(g, stored, a_i, v_n, old, new, dt, consts, block, out):
     S = stored.S
     G = stored.G
     cell = stored.cell
-    x, v, m, rho, e, p = old.x, old.v, old.m, old.rho, old.e, old.p
-    x_new, v_new, V_new, rho_new, e_new, p_new = new.x, new.v, new.V, new.rho, new.e, new.p
+    x, v, V, m, rho, e, p = old.x, old.v, old.V, old.m, old.rho, old.e, old.p
+    x_new, v_new, V_new, m_new, rho_new, e_new, p_new = new.x, new.v, new.V, new.m, new.rho, new.e, new.p
     n = x.size
     K = WIDTH  # nodes per particle
     gm1, g_gm1, c_lin, c_quad = consts[IGM1], consts[IGGM1], consts[ILIN], consts[IQUAD]
@@ -87,7 +88,7 @@ def _sweep(g, stored, a_i, v_n, old, new, dt, consts, block, out):
     out[:] = 0.0
     acc, vel, grad, length = block[ACC], block[VEL], block[GRAD], block[LENGTH]
     r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
-    cloud = Cloud(x_new, V_new, m, v_new, p_new)
+    cloud = Cloud(x_new, V_new, m_new, v_new, p_new)  # the gas's mass: the same floats in both sets
     speed, outside, empty, need = 0.0, -1, -1, 0
     for lo in range(0, n, BLOCK):
         hi = min(lo + BLOCK, n)
@@ -113,26 +114,42 @@ def _sweep(g, stored, a_i, v_n, old, new, dt, consts, block, out):
                     sv += Sl[k] * v_n[r[k]]
                     gv += Gl[k] * v_n[r[k]]
                 acc[j], vel[j], grad[j] = sa, sv, gv
-            length[j] = h[0, c]
+            if MODEL == GAS:
+                length[j] = h[0, c]
         refused = 0
-        xo, vo, mo, rho_o, eo, po = x[lo:hi], v[lo:hi], m[lo:hi], rho[lo:hi], e[lo:hi], p[lo:hi]
-        xn, vn, Vn, rho_n, en, pn = x_new[lo:hi], v_new[lo:hi], V_new[lo:hi], rho_new[lo:hi], e_new[lo:hi], \
-            p_new[lo:hi]
-        for j in range(hi - lo):  # B: the update (branch-free over contiguous slices: vectorised)
-            u = vo[j] + dt * acc[j]
-            if flip != 1.0:
-                u = flip * u + keep * vel[j]
-            y = xo[j] + dt * vel[j]
-            factor, density, energy, pressure, volume, c = _gas_update(
-                rho_o[j], eo[j], po[j], mo[j], grad[j], dt, length[j], gm1, g_gm1, c_lin, c_quad)
-            xn[j], vn[j], Vn[j], rho_n[j], en[j], pn[j] = y, u, volume, density, energy, pressure
-            speed = fmax(speed, c + abs(u))
-            ok = (factor > 0.0) & (energy > 0.0) & _finite(y, u, density, energy, pressure, volume)
-            refused += 0 if ok else 1
+        if MODEL == GAS:
+            xo, vo, mo, rho_o, eo, po = x[lo:hi], v[lo:hi], m[lo:hi], rho[lo:hi], e[lo:hi], p[lo:hi]
+            xn, vn, Vn, rho_n, en, pn = x_new[lo:hi], v_new[lo:hi], V_new[lo:hi], rho_new[lo:hi], e_new[lo:hi], \
+                p_new[lo:hi]
+            for j in range(hi - lo):  # B: the update (branch-free over contiguous slices: vectorised)
+                u = vo[j] + dt * acc[j]
+                if flip != 1.0:
+                    u = flip * u + keep * vel[j]
+                y = xo[j] + dt * vel[j]
+                factor, density, energy, pressure, volume, c = _gas_update(
+                    rho_o[j], eo[j], po[j], mo[j], grad[j], dt, length[j], gm1, g_gm1, c_lin, c_quad)
+                xn[j], vn[j], Vn[j], rho_n[j], en[j], pn[j] = y, u, volume, density, energy, pressure
+                speed = fmax(speed, c + abs(u))
+                ok = (factor > 0.0) & (energy > 0.0) & _finite(y, u, density, energy, pressure, volume)
+                refused += 0 if ok else 1
+        else:  # viscous Burgers: V <- V (1 + L dt), m = V
+            xo, vo, Vo = x[lo:hi], v[lo:hi], V[lo:hi]
+            xn, vn, Vn, mn = x_new[lo:hi], v_new[lo:hi], V_new[lo:hi], m_new[lo:hi]
+            for j in range(hi - lo):  # B, as the gas's
+                u = vo[j] + dt * acc[j]
+                if flip != 1.0:
+                    u = flip * u + keep * vel[j]
+                y = xo[j] + dt * vel[j]
+                factor = 1.0 + grad[j] * dt
+                volume = Vo[j] * factor
+                xn[j], vn[j], Vn[j], mn[j] = y, u, volume, volume
+                speed = fmax(speed, abs(u))
+                ok = (factor > 0.0) & _finite(y, u, volume, 0.0, 0.0, 0.0)
+                refused += 0 if ok else 1
         if refused:
             return lo, speed, outside, empty, need
         # C: step n+1's pass 1 over the block's new state
-        o, em, k_need = PROJECT_RUN(g, cloud, True, STORED == 1, lo, hi, stored, out)
+        o, em, k_need = PROJECT_RUN(g, cloud, MODEL == GAS, STORED == 1, lo, hi, stored, out)
         if outside < 0:
             outside = o
         if empty < 0:
