@@ -29,10 +29,14 @@ holds one basis's kernels only. The replacements:
     XPIC_ON,      0 or 1: whether the loop runs XPIC, the grid volume       the loop
     VOLUME_ON,    reset, the Taylor force
     TAYLOR_ON
-    PROJECT, MOVE, UPDATE, FINISH, VISCOUS, GAS_FORCE, XPIC, VOLUME, TAYLOR
+    SWEPT         1: the loop may take the sweep (the default), 0: never    the loop
+                  (the benchmarks' baseline)
+    PROJECT, MOVE, UPDATE, FINISH, VISCOUS, GAS_FORCE, XPIC, VOLUME, TAYLOR, SWEEP
                   the loop's passes: variants of the same BASIS, MODEL and  the loop
                   WIDTH (:meth:`_Passes._loop_passes`), ``None`` where its
-                  run takes none (the branch calling it is pruned)
+                  run takes none (the branch calling it is pruned); SWEEP
+                  (:mod:`mpm_fem.fused.sweep`) with ``SWEEP_ON`` 1 where
+                  SWEPT, USL, no remedy and one thread
 
 Only a registered, complete :class:`~mpm_fem.bases.contract.Basis` reaches a variant
 (:func:`_basis_globals`); :func:`_compile` refuses a variant that would leave a global of ``CONSTANTS``
@@ -60,7 +64,7 @@ LOOP_PASSES = ("PROJECT", "MOVE", "UPDATE", "FINISH", "VISCOUS", "GAS_FORCE", "X
                "SWEEP_ON")
 BASIS_GLOBALS = ("ROW", "SHAPE_ROW", "PROJECT_RUN", "MOVE_RUN", "STORED", "REGISTERS", "ANY_GRID", "TWIN_ROW",
                  "TWIN_SCALARS", "TWIN_COLUMN")
-REPLACED = frozenset(("BASIS", "MODEL", "WIDTH", "WEIGHT", "SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON")
+REPLACED = frozenset(("BASIS", "MODEL", "WIDTH", "WEIGHT", "SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON", "SWEPT")
                      + BASIS_GLOBALS + LOOP_PASSES)
 _SHAPE = ("BASIS", "WIDTH")
 _MODEL = ("BASIS", "MODEL", "WIDTH")
@@ -75,7 +79,7 @@ CONSTANTS = {  # the constants of each function's variants (the keywords of _Pas
     _move_exact: _SHAPE,
     _update_exact: ("MODEL",),
     _sweep: _MODEL,
-    _advance: _MODEL + ("SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON"),
+    _advance: _MODEL + ("SCHEME", "XPIC_ON", "VOLUME_ON", "TAYLOR_ON", "SWEPT"),
 }
 # numba's error model where it is not Python's: the sweep's divisions unchecked, so that its update vectorises
 ERROR_MODEL = {_sweep: "numpy"}
@@ -135,14 +139,14 @@ class _Passes:
             self._made[key] = _compile(fn, False if fn is _advance else self.parallel, passes, **constants)
         return self._made[key]
 
-    def _loop_passes(self, BASIS, MODEL, WIDTH, SCHEME, XPIC_ON, VOLUME_ON, TAYLOR_ON):
+    def _loop_passes(self, BASIS, MODEL, WIDTH, SCHEME, XPIC_ON, VOLUME_ON, TAYLOR_ON, SWEPT=1):
         """The passes the loop variant with these constants calls: pass 1 and 2 always, USF's update,
         MUSL's last pass, Burgers' viscous force and each remedy's passes only where they run, so a
         plain run compiles none of the remedies."""
         shape = dict(BASIS=BASIS, WIDTH=WIDTH)
         model = dict(shape, MODEL=MODEL)
         scatter = lambda weight: self.get(_scatter_pass, **shape, WEIGHT=weight)  # noqa: E731
-        sweep = SCHEME not in (USF, MUSL) and not (XPIC_ON or VOLUME_ON or TAYLOR_ON or self.parallel)
+        sweep = SWEPT == 1 and SCHEME not in (USF, MUSL) and not (XPIC_ON or VOLUME_ON or TAYLOR_ON or self.parallel)
         return dict(PROJECT=self.get(_project, **shape), MOVE=self.get(_move, **model),
                     SWEEP=self.get(_sweep, **model) if sweep else None, SWEEP_ON=int(sweep),
                     UPDATE=self.get(_update, **model) if SCHEME == USF else None,
