@@ -18,3 +18,9 @@ def loop_steps(monkeypatch):
 
     monkeypatch.setattr(fused_module.FusedStep, "advance", counting)
     return taken
+
+
+@pytest.fixture
+def one_at_a_time(monkeypatch):
+    """Runs the fused step without its loop (every step through FusedStep.step), when called."""
+    return lambda: monkeypatch.setattr(fused_module.FusedStep, "loops", lambda self, problem: False)

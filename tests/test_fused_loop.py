@@ -7,6 +7,7 @@ grid every basis takes uniform-grid arithmetic: it equals the numpy step to ``TO
 
 import numpy as np
 import pytest
+from same_runs import FIELDS, assert_same_run
 
 import mpm_fem.fused.codes as fused_codes
 import mpm_fem.fused.compiler as fused_compiler
@@ -22,7 +23,6 @@ from mpm_fem.problems import burgers
 from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
 from mpm_fem.run.solve import Problem, run
 
-FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 TOLERANCE = 1e-12  # as tests/test_fused.py: max_p |u_fused - u_numpy| <= TOLERANCE max_p |u_numpy|, each field
 
 
@@ -30,20 +30,6 @@ def _deviation(u, v):
     scale = float(np.max(np.abs(u), initial=0.0))
     gap = float(np.max(np.abs(u - v), initial=0.0))
     return gap / scale if scale > 0 else gap
-
-
-@pytest.fixture
-def one_at_a_time(monkeypatch):
-    """Runs the fused step without its loop (every step through FusedStep.step), when called."""
-    return lambda: monkeypatch.setattr(fused_module.FusedStep, "loops", lambda self, problem: False)
-
-
-def _assert_same(a, b):
-    assert (a.steps, a.t, a.dt_min, a.dt_max) == (b.steps, b.t, b.dt_min, b.dt_max)
-    for name in FIELDS:
-        u, v = getattr(a.particles, name), getattr(b.particles, name)
-        assert np.array_equal(u, v), f"{name} differs by {float(np.max(np.abs(u - v))):.3g}"
-    assert np.array_equal(a.nodal_mass, b.nodal_mass) and np.array_equal(a.nodal_velocity, b.nodal_velocity)
 
 
 def _assert_close(a, b):
@@ -67,7 +53,7 @@ def test_sod_with_the_cfl_step_equals_the_numpy_step_bit_for_bit(basis, scheme, 
     fused = simulate(SodSettings(**settings), progress=False)
     assert _assert_close(reference, fused) <= TOLERANCE
     one_at_a_time()
-    _assert_same(simulate(SodSettings(**settings), progress=False), fused)
+    assert_same_run(simulate(SodSettings(**settings), progress=False), fused)
     assert sum(loop_steps) == fused.steps - 1  # every step but the first ran in the loop
     assert fused.t == pytest.approx(0.1, rel=1e-12) and fused.dt_min < fused.dt_max
 
@@ -90,7 +76,7 @@ def test_burgers_between_walls_with_the_viscous_limit_equals_the_numpy_step(sche
     one_at_a_time()
     for (problem, stages), reference, fused in zip(cases, numpy_runs, loops, strict=False):
         _assert_close(reference, fused)
-        _assert_same(run(problem, grid, particles, stages, progress=False, kernel="fused"), fused)
+        assert_same_run(run(problem, grid, particles, stages, progress=False, kernel="fused"), fused)
 
 
 def test_the_loop_stops_where_the_run_must_fail(loop_steps):
@@ -141,7 +127,7 @@ def test_burgers_with_dirichlet_ends_and_the_reservoir_equals_the_numpy_step(bas
     n_fused = sum(acted) - n_numpy
     assert _assert_close(reference, fused) <= TOLERANCE  # uniform grid: to TOLERANCE of the numpy step,
     one_at_a_time()  # bit for bit of the per-step path
-    _assert_same(burgers.simulate(burgers.BurgersSettings(**settings), progress=False), fused)
+    assert_same_run(burgers.simulate(burgers.BurgersSettings(**settings), progress=False), fused)
     assert n_numpy >= 2 and n_fused == n_numpy  # the reservoir acted, as often on both paths
     assert sum(loop_steps) == fused.steps - 1 and len(loop_steps) >= n_numpy  # every step but the first in loops
 

@@ -1,4 +1,4 @@
-"""The sweep (mpm_fem.fused.sweep): pass 2 of a USL gas step and the next step's pass 1 in one blocked
+"""The sweep (mpm_fem.fused.sweep): pass 2 of a USL step (the gas, Burgers) and the next step's pass 1 in one blocked
 pass. Runs of several blocks (more than ``BLOCK`` particles) in the compiled loop against the per-step
 path bit for bit, on every basis; a step refused in a later block, and a particle that leaves the grid
 mid-run, end as the numpy step ends; the sweep is compiled into the loop variants it serves only."""
@@ -6,6 +6,7 @@ mid-run, end as the numpy step ends; the sweep is compiled into the loop variant
 import numpy as np
 import pytest
 from numba import njit
+from same_runs import FIELDS, assert_same_run
 
 import mpm_fem.fused.compiler as fused_compiler
 import mpm_fem.fused.step as fused_module
@@ -20,22 +21,7 @@ from mpm_fem.fused.sweep import BLOCK, fmax
 from mpm_fem.problems.sod import DOMAIN, SodSettings, initial_particles, simulate
 from mpm_fem.run.solve import Problem, run
 
-FIELDS = ("x", "velocity", "volume", "mass", "density", "energy", "pressure")
 H = 0.0004  # 2,500 cells: 10,000 particles at 4 per cell, five blocks
-
-
-@pytest.fixture
-def one_at_a_time(monkeypatch):
-    """Runs the fused step without its loop (every step through FusedStep.step), when called."""
-    return lambda: monkeypatch.setattr(fused_module.FusedStep, "loops", lambda self, problem: False)
-
-
-def _assert_same(a, b):
-    assert (a.steps, a.t, a.dt_min, a.dt_max) == (b.steps, b.t, b.dt_min, b.dt_max)
-    for name in FIELDS:
-        u, v = getattr(a.particles, name), getattr(b.particles, name)
-        assert np.array_equal(u, v), f"{name} differs by {float(np.max(np.abs(u - v))):.3g}"
-    assert np.array_equal(a.nodal_mass, b.nodal_mass) and np.array_equal(a.nodal_velocity, b.nodal_velocity)
 
 
 @pytest.mark.parametrize(("basis", "changes"), [(b, {}) for b in names()] + [
@@ -48,7 +34,7 @@ def test_the_swept_loop_equals_the_per_step_path_over_several_blocks(basis, chan
     swept = simulate(settings, progress=False)
     assert swept.particles.n > 4 * BLOCK and sum(loop_steps) > 50  # a widening GIMP row: a step per step
     one_at_a_time()
-    _assert_same(simulate(settings, progress=False), swept)
+    assert_same_run(simulate(settings, progress=False), swept)
 
 
 def test_a_step_refused_in_a_later_block_fails_as_the_numpy_step_does(loop_steps):
@@ -124,7 +110,7 @@ def test_a_swept_burgers_loop_equals_the_per_step_path_over_several_blocks(basis
     swept = burgers.simulate(settings, progress=False)
     assert swept.particles.n > 4 * BLOCK and sum(loop_steps) > 100
     one_at_a_time()
-    _assert_same(burgers.simulate(settings, progress=False), swept)
+    assert_same_run(burgers.simulate(settings, progress=False), swept)
 
 
 @pytest.mark.parametrize("basis", ["mpm", "bspline_gimp"])

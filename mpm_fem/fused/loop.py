@@ -11,7 +11,9 @@ table of the problem's own function evaluated ahead, or in object mode (the same
 travel in a few named structures (:class:`~mpm_fem.bases.contract.Geometry`, :class:`Conditions`, :class:`Clock`,
 :class:`Scratch`, :class:`Remedies`). The scheme, the remedies that run and the passes it calls are
 compile-time globals of each variant (:mod:`mpm_fem.fused.compiler`): the branches not taken are
-pruned and their passes never compile.
+pruned and their passes never compile. With USL, no remedy and one thread, pass 2 and the next
+step's pass 1 are one blocked pass over the particles (:mod:`mpm_fem.fused.sweep`, ``SWEEP_ON``):
+the next step then starts at its grid stage.
 """
 
 from typing import NamedTuple
