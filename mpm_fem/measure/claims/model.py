@@ -43,7 +43,7 @@ from scipy.optimize import nnls
 
 from mpm_fem.bases import get as get_basis
 from mpm_fem.measure.claims.base import CONFIRMED, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim
-from mpm_fem.measure.claims.remedies import REMEDY_ERRORS, _series, remedy_assessment
+from mpm_fem.measure.claims.remedies import REMEDY_ERRORS, remedy_assessment, remedy_series
 from mpm_fem.measure.claims.rows import GROWTH_ORDER, num, select, span
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import MODEL, MODEL_FIT
@@ -184,7 +184,7 @@ def remedy_rows(t: Tables) -> list[dict]:
     settings = {r["key"]: r["value"] for r in t.get("settings", []) if r["table"] == REMEDY_ERRORS}
     rows, out = t.get(REMEDY_ERRORS, []), []
     for problem in ("sod", "burgers"):
-        for name, series in _series(rows, problem).items():
+        for name, series in remedy_series(rows, problem).items():
             order = remedy_assessment(series)["min_order_particles_L1"]
             if math.isfinite(order):
                 out.append(_remedy_row(problem, name, order, settings))

@@ -103,7 +103,7 @@ def _runs(rows: list[dict], problem: str) -> dict[str, dict[str, list[dict]]]:
     return out
 
 
-def _series(rows: list[dict], problem: str) -> dict[str, list[dict]]:
+def remedy_series(rows: list[dict], problem: str) -> dict[str, list[dict]]:
     """Each remedy's main series: its run on the most meshes (the first such run in the table's order);
     the other runs (other particles per cell, jittered layouts) are read by :func:`_other_runs`."""
     return {name: max(runs.values(), key=len) for name, runs in _runs(rows, problem).items()}
@@ -152,8 +152,8 @@ def _e5(t: Tables) -> Finding:
     reference's too, so a remedy is held to the FV reference's own orders on the same meshes, not to
     first order."""
     rows = t[REMEDY_ERRORS]
-    sod = {k: v for k, v in _series(rows, "sod").items() if len(v) >= 2}
-    burgers = _series(rows, "burgers")
+    sod = {k: v for k, v in remedy_series(rows, "sod").items() if len(v) >= 2}
+    burgers = remedy_series(rows, "burgers")
     if not sod:
         return "not measured", "no remedy was run on two Sod meshes or more"
     scored, hs = [], sorted({num(r, "h") for v in sod.values() for r in v}, reverse=True)
