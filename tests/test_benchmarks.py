@@ -47,9 +47,11 @@ def test_step_cost_reports_each_basis_as_a_fraction_of_the_anchor():
     assert proc.returncode == 0, proc.stderr
     cells = lambda line: [c.strip() for c in line.strip("|").split("|")]  # noqa: E731
     rows = [cells(line) for line in proc.stdout.splitlines() if line.startswith("| mpm | 1e+03")]
-    assert len(rows) == 1  # loop rate, anchor rate, their ratio
-    loop, anchor, ratio = float(rows[0][4]), float(rows[0][7]), float(rows[0][8])
+    assert len(rows) == 1  # loop rate, the loop without the sweep, its gain, anchor rate, their ratio
+    loop, apart, gain = float(rows[0][4]), float(rows[0][5]), float(rows[0][6])
+    anchor, ratio = float(rows[0][9]), float(rows[0][10])
     assert loop > 0 and anchor > 0 and ratio == pytest.approx(loop / anchor, rel=0.02, abs=0.01)
+    assert apart > 0 and gain == pytest.approx(loop / apart, rel=0.02, abs=0.01)
     assert any(line.startswith("| anchor (benchmarks/anchor.py, P1) |") for line in proc.stdout.splitlines())
 
 
