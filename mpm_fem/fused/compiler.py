@@ -19,24 +19,18 @@ holds one basis's kernels only. The replacements:
                   the kernels ``row``, ``scalars``, ``column`` of the       every variant with BASIS
                   basis's ``domain_twin``: the rows the volume reset
                   averages over
-    MODEL         the model code (codes.GAS, BURGERS)                       _update, _move, _finish, _taylor_force,
-                                                                            _volume_reset, _update_exact; the loop
-    WIDTH         K, the nodes per particle (a row's length)                _project, _scatter_pass, _update, _move,
-                                                                            _finish, _taylor_force, _move_exact;
-                                                                            the loop
+    MODEL         the model code (codes.GAS, BURGERS)                       the passes that update; the loop
+    WIDTH         K, the nodes per particle (a row's length)                the passes that read rows; the loop
     WEIGHT        codes.PRESSURE, VISCOUS_STRESS or MOMENTUM                _scatter_pass
     SCHEME        codes.USL, USF or MUSL                                    the loop
-    XPIC_ON,      0 or 1: whether the loop runs XPIC, the grid volume       the loop
-    VOLUME_ON,    reset, the Taylor force
-    TAYLOR_ON
-    SWEPT         1: the loop may take the sweep (the default), 0: never    the loop
-                  (the benchmarks' baseline)
+    XPIC_ON, VOLUME_ON, TAYLOR_ON   0 or 1: whether the loop runs XPIC,     the loop
+                  the grid volume reset, the Taylor force
+    SWEPT         1: the loop may take the sweep, 0: never (a baseline)     the loop
     PROJECT, MOVE, UPDATE, FINISH, VISCOUS, GAS_FORCE, XPIC, VOLUME, TAYLOR, SWEEP
-                  the loop's passes: variants of the same BASIS, MODEL and  the loop
-                  WIDTH (:meth:`_Passes._loop_passes`), ``None`` where its
-                  run takes none (the branch calling it is pruned); SWEEP
-                  (:mod:`mpm_fem.fused.sweep`) with ``SWEEP_ON`` 1 where
-                  SWEPT, USL, no remedy and one thread
+                  the loop's passes (:meth:`_Passes._loop_passes`), ``None``   the loop
+                  where its run takes none (the branch calling it is
+                  pruned); SWEEP (:mod:`~mpm_fem.fused.sweep`, ``SWEEP_ON``)
+                  where SWEPT, USL, no remedy and one thread
 
 Only a registered, complete :class:`~mpm_fem.bases.contract.Basis` reaches a variant
 (:func:`_basis_globals`); :func:`_compile` refuses a variant that would leave a global of ``CONSTANTS``
