@@ -97,8 +97,37 @@ def _worker_init(parent: int, compiling=None) -> None:
     threading.Thread(target=_watch_parent, args=(parent,), daemon=True, name="watch-parent").start()
 
 
+#: The case keys that, with its function, choose the compiled kernels a case runs through: a task's
+#: group (:func:`kernel_group`). A guess from the studies' cases: a wrong one costs compiling time,
+#: never a number.
+KERNEL_KEYS = ("solver", "problem", "kind", "basis", "scheme", "mass", "transfer")
+#: For this long after a group's first task starts (or until it ends), the pool starts the group's
+#: other tasks only when no other task can start: numba compiles a group's kernels at its first task's
+#: start and caches them on disk, and a second worker starting the group meanwhile would compile them
+#: again (a cold quick tier's two workers did so, each compiling every kernel).
+COMPILE_S = 45.0
+
+
+def kernel_group(task: Task) -> tuple:
+    """The group of ``task``: its function and the values of :data:`KERNEL_KEYS` in its case."""
+    return (task.fn.__module__, task.fn.__qualname__, *(repr(task.case.get(key)) for key in KERNEL_KEYS))
+
+
+def _next_task(waiting: deque, groups: dict, first: dict, now: float):
+    """Take from ``waiting`` (``(k, path)`` in their order) the first task whose group ``groups[k]`` is
+    not being compiled: its first task (``first[group] = (start time, future)``) has ended or started
+    :data:`COMPILE_S` ago or more, or it has none; the first task when every group is."""
+    for i, (k, path) in enumerate(waiting):
+        started = first.get(groups[k])
+        if started is None or started[1].done() or now - started[0] >= COMPILE_S:
+            del waiting[i]
+            return k, path
+    return waiting.popleft()
+
+
 def _run_pool(tasks, todo, jobs: int, finish, followups=(), notice: bool = False) -> None:
-    """The tasks of ``todo`` in ``jobs`` worker processes, started in their order and at most ``jobs + 1``
+    """The tasks of ``todo`` in ``jobs`` worker processes, started in their order (but a group's tasks
+    held back while its first task compiles its kernels: :func:`_next_task`) and at most ``jobs + 1``
     at a time, so that a follow-up (a function of no arguments: ``followups``, and what ``finish``
     returns) starts ahead of the tasks still waiting. If the parent is interrupted (Ctrl-C) or fails,
     the workers are ended at once instead of finishing their cases. ``notice``: the first worker to
@@ -106,14 +135,17 @@ def _run_pool(tasks, todo, jobs: int, finish, followups=(), notice: bool = False
     compiling = multiprocessing.Value("b", 0) if notice else None
     pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(), compiling))
     waiting, ahead, running = deque(todo), deque(followups), {}
+    groups, first = {k: kernel_group(tasks[k]) for k, _ in todo}, {}
 
     def start() -> None:
         while len(running) <= jobs and (ahead or waiting):
             if ahead:
                 running[pool.submit(ahead.popleft())] = None
             else:
-                k, path = waiting.popleft()
-                running[pool.submit(timed, tasks[k].fn, tasks[k].case)] = (k, path)
+                k, path = _next_task(waiting, groups, first, time.perf_counter())
+                future = pool.submit(timed, tasks[k].fn, tasks[k].case)
+                running[future] = (k, path)
+                first.setdefault(groups[k], (time.perf_counter(), future))
 
     try:
         start()
@@ -326,12 +358,19 @@ class _Progress:
             self.bar.close()
 
 
+#: The share of the cost a run must have done before its progress says the time left: before it, the
+#: time so far is mostly numba compiling the kernels and starting the workers (a cold quick tier said
+#: "about 46 min left" after its first tenth of the cases, and took 80 s).
+RATE_AFTER = 0.1
+
+
 def time_left(elapsed: float, run: float, left: float) -> str:
     """``"about N s left"``: ``elapsed * left / run``, the cost ``left`` to run at the rate of the cost
-    ``run`` so far (costs in any unit: cases, or the cost models' seconds), ``"done"`` when none is left."""
+    ``run`` so far (costs in any unit: cases, or the cost models' seconds), ``"done"`` when none is left,
+    ``"time left unknown"`` before :data:`RATE_AFTER` of the cost has run."""
     if left <= 0:
         return "done"
-    seconds = elapsed / run * left if run > 0 else float("nan")
-    if seconds != seconds:
+    if run <= 0 or run < RATE_AFTER * (run + left):
         return "time left unknown"
+    seconds = elapsed / run * left
     return f"about {seconds:.0f} s left" if seconds < 120 else f"about {seconds / 60:.0f} min left"
