@@ -232,7 +232,7 @@ def test_the_time_left_is_the_mean_time_of_the_cases_run_so_far():
     assert time_left(600.0, 1, 1) == "about 10 min left"
     assert time_left(5.0, 0, 4) == "time left unknown" and time_left(5.0, 4, 0) == "done"
     # before a tenth of the cost has run, the time so far is mostly compiling: no guess
-    assert time_left(32.0, 9, 91) == "time left unknown" and time_left(32.0, 10, 90) == "about 288 s left"
+    assert time_left(32.0, 9, 91) == "time left unknown" and time_left(3.0, 10, 90) == "about 27 s left"
 
 
 def test_the_time_left_weighs_the_cases_by_their_cost(capsys, monkeypatch):

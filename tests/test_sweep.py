@@ -163,3 +163,38 @@ def test_off_a_terminal_a_progress_line_comes_every_tenth_of_the_cases_or_every_
     monkeypatch.setattr(sweep, "PLAIN_EVERY", 0.0)
     run_cases(square, cases, jobs=1, progress=True)
     assert [line.split()[1] for line in capsys.readouterr().err.splitlines()[1:]] == [f"{k}/40" for k in range(1, 41)]
+
+
+class _Future:
+    def __init__(self, done: bool):
+        self._done = done
+
+    def done(self) -> bool:
+        return self._done
+
+
+def test_a_group_compiling_its_kernels_is_held_back_until_its_first_task_ends_or_compile_s_passes():
+    """Tasks 0, 1 of group a, 2 of group b: while a's first task runs (started 1 s ago) the pool takes
+    b's task; once it ended, or COMPILE_S after it started, the order again; with every group held
+    back, the first task (a worker never idles)."""
+    from collections import deque
+
+    from mpm_fem.app.sweep import COMPILE_S, _next_task
+
+    groups = {0: "a", 1: "a", 2: "b"}
+    todo = [(0, None), (1, None), (2, None)]
+    running = {"a": (100.0, _Future(False))}
+    assert _next_task(deque(todo), groups, running, 101.0) == (2, None)
+    assert _next_task(deque(todo), groups, {"a": (100.0, _Future(True))}, 101.0) == (0, None)
+    assert _next_task(deque(todo), groups, running, 100.0 + COMPILE_S) == (0, None)
+    waiting = deque(todo[:2])
+    assert _next_task(waiting, groups, running, 101.0) == (0, None) and list(waiting) == [(1, None)]
+
+
+def test_the_kernel_group_is_the_function_and_the_keys_that_choose_kernels():
+    from mpm_fem.app.sweep import Task, kernel_group
+
+    sod = {"solver": "mpm", "basis": "mpm", "scheme": "usl", "mass": "lumped", "h": 0.01, "seed": 0}
+    assert kernel_group(Task(square, sod)) == kernel_group(Task(square, {**sod, "h": 0.005, "seed": 3}))
+    assert kernel_group(Task(square, sod)) != kernel_group(Task(square, {**sod, "basis": "gimp"}))
+    assert kernel_group(Task(square, sod)) != kernel_group(Task(cube, sod))
