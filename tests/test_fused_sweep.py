@@ -74,10 +74,12 @@ def test_a_particle_that_leaves_the_grid_mid_loop_fails_as_the_numpy_step_does(l
 @pytest.mark.parametrize(("model", "scheme", "remedy", "parallel", "sweeps"), [
     (GAS, USL, {}, False, 1), (GAS, USF, {}, False, 0), (GAS, MUSL, {}, False, 0), (BURGERS, USL, {}, False, 1),
     (GAS, USL, {"XPIC_ON": 1}, False, 0), (GAS, USL, {"VOLUME_ON": 1}, False, 0),
-    (GAS, USL, {"TAYLOR_ON": 1}, False, 0), (GAS, USL, {}, True, 0), (GAS, USL, {"SWEPT": 0}, False, 0)])
-def test_the_sweep_serves_only_the_plain_usl_loop_on_one_thread(model, scheme, remedy, parallel, sweeps):
-    """The USL loop without a remedy, serial, compiles the sweep (the gas and Burgers); every other
-    loop keeps pass 2 and pass 1 apart (its SWEEP is None and the branch calling it is pruned)."""
+    (GAS, USL, {"TAYLOR_ON": 1}, False, 0), (GAS, USL, {}, True, 1), (BURGERS, USL, {}, True, 1),
+    (GAS, USL, {"SWEPT": 0}, False, 0), (GAS, USL, {"SWEPT": 0}, True, 0)])
+def test_the_sweep_serves_only_the_plain_usl_loop(model, scheme, remedy, parallel, sweeps):
+    """The USL loop without a remedy, serial or threaded, compiles the sweep (the gas and Burgers);
+    every other loop keeps pass 2 and pass 1 apart (its SWEEP is None and the branch calling it is
+    pruned)."""
     constants = dict(BASIS=get("mpm"), MODEL=model, WIDTH=2, SCHEME=scheme, XPIC_ON=0, VOLUME_ON=0, TAYLOR_ON=0,
                      SWEPT=1)
     passes = fused_compiler._Passes(parallel)._loop_passes(**dict(constants, **remedy))
@@ -113,17 +115,19 @@ def test_a_swept_burgers_loop_equals_the_per_step_path_over_several_blocks(basis
     assert_same_run(burgers.simulate(settings, progress=False), swept)
 
 
-@pytest.mark.parametrize("basis", ["mpm", "bspline_gimp"])
-def test_the_loop_with_and_without_the_sweep_takes_the_same_steps_bit_for_bit(basis):
+@pytest.mark.parametrize(("basis", "threads"), [("mpm", 1), ("bspline_gimp", 1), ("mpm", 2), ("gimp", 2),
+                                                 ("bspline_gimp", 2), ("cubic", 3)])
+def test_the_loop_with_and_without_the_sweep_takes_the_same_steps_bit_for_bit(basis, threads):
     """``FusedStep(sweep=False)`` (the benchmarks' baseline) keeps pass 2 and pass 1 apart: the
-    same particles after 40 steps as the swept loop."""
+    same particles after 40 steps as the swept loop, on one thread and on several (each chunk's
+    sums added in chunk order, as pass 1's chunks are)."""
     settings = SodSettings(h=H, ppc=4, basis=basis)
     grid = uniform_grid(*DOMAIN, settings.h)
     particles = initial_particles(settings, grid)
     problem = Problem(model=IdealGas(), boundary=Walls(), T=1.0, cfl=0.3)
     out = []
     for sweep in (True, False):
-        stepper = fused_module.FusedStep(grid, IdealGas(), Walls(), settings.stages, sweep=sweep)
+        stepper = fused_module.FusedStep(grid, IdealGas(), Walls(), settings.stages, threads=threads, sweep=sweep)
         first, _ = stepper.step(particles, 0.0, 1e-5)
         new, t, done, _, _ = stepper.advance(first, 1e-5, problem, 1, 10**6, 40)
         out.append((new, t, done))
@@ -131,3 +135,33 @@ def test_the_loop_with_and_without_the_sweep_takes_the_same_steps_bit_for_bit(ba
     assert (t_a, done_a) == (t_b, done_b) and done_a == 40
     for name in FIELDS:
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+@pytest.mark.parametrize("kind", ["sod", "burgers"])
+def test_the_threaded_swept_loop_equals_the_threaded_per_step_path(kind, loop_steps, one_at_a_time):
+    """Two threads: the swept loop's run equals the per-step path's on two threads bit for bit (Sod
+    with the particle-domain B-spline's stored rows, Burgers with the point masses)."""
+    from mpm_fem.problems import burgers
+
+    if kind == "sod":
+        settings, simulate_ = SodSettings(h=H, ppc=4, T=0.01, cfl=0.3, basis="bspline_gimp", threads=2), simulate
+    else:
+        settings, simulate_ = burgers.BurgersSettings(h=H, T=2e-4, threads=2), burgers.simulate
+    swept = simulate_(settings, progress=False)
+    assert sum(loop_steps) > 50
+    one_at_a_time()
+    assert_same_run(simulate_(settings, progress=False), swept)
+
+
+def test_a_step_refused_in_the_second_chunk_fails_as_the_numpy_step_does(loop_steps):
+    """The refused step above on two threads: particle 5004 is the second chunk's (5,000 to 9,999);
+    the loop stops before the third step and the per-step path raises the numpy step's error."""
+    settings = SodSettings(h=H, ppc=4)
+    grid = uniform_grid(*DOMAIN, settings.h)
+    problem = Problem(model=IdealGas(), boundary=Walls(), T=0.05, cfl=1.0, dt=0.6 * settings.h / 1.2)
+    errors = []
+    for kernel, threads in (("numpy", 1), ("fused", 2)):
+        with pytest.raises(PositivityError) as err:
+            run(problem, grid, initial_particles(settings, grid), progress=False, kernel=kernel, threads=threads)
+        errors.append(str(err.value))
+    assert errors[0] == errors[1] and "particle 5004 " in errors[1] and sum(loop_steps) == 1

@@ -30,7 +30,7 @@ holds one basis's kernels only. The replacements:
                   the loop's passes (:meth:`_Passes._loop_passes`), ``None``   the loop
                   where its run takes none (the branch calling it is
                   pruned); SWEEP (:mod:`~mpm_fem.fused.sweep`, ``SWEEP_ON``)
-                  where SWEPT, USL, no remedy and one thread
+                  where SWEPT, USL and no remedy
 
 Only a registered, complete :class:`~mpm_fem.bases.contract.Basis` reaches a variant
 (:func:`_basis_globals`); :func:`_compile` refuses a variant that would leave a global of ``CONSTANTS``
@@ -140,7 +140,7 @@ class _Passes:
         shape = dict(BASIS=BASIS, WIDTH=WIDTH)
         model = dict(shape, MODEL=MODEL)
         scatter = lambda weight: self.get(_scatter_pass, **shape, WEIGHT=weight)  # noqa: E731
-        sweep = SWEPT == 1 and SCHEME not in (USF, MUSL) and not (XPIC_ON or VOLUME_ON or TAYLOR_ON or self.parallel)
+        sweep = SWEPT == 1 and SCHEME not in (USF, MUSL) and not (XPIC_ON or VOLUME_ON or TAYLOR_ON)
         return dict(PROJECT=self.get(_project, **shape), MOVE=self.get(_move, **model),
                     SWEEP=self.get(_sweep, **model) if sweep else None, SWEEP_ON=int(sweep),
                     UPDATE=self.get(_update, **model) if SCHEME == USF else None,

@@ -11,7 +11,7 @@ table of the problem's own function evaluated ahead, or in object mode (the same
 travel in a few named structures (:class:`~mpm_fem.bases.contract.Geometry`, :class:`Conditions`, :class:`Clock`,
 :class:`Scratch`, :class:`Remedies`). The scheme, the remedies that run and the passes it calls are
 compile-time globals of each variant (:mod:`mpm_fem.fused.compiler`): the branches not taken are
-pruned and their passes never compile. With USL, no remedy and one thread, pass 2 and the next
+pruned and their passes never compile. With USL and no remedy, pass 2 and the next
 step's pass 1 are one blocked pass over the particles (:mod:`mpm_fem.fused.sweep`, ``SWEEP_ON``):
 the next step then starts at its grid stage.
 """
@@ -233,9 +233,14 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[GM], grid[GP], grid[GF], grid[GV], grid[GA], grid[GVN], grid[GPMUSL]
     done, dt_min, dt_max = 0, np.inf, -np.inf
     g_t, g_next, known = np.empty(0), np.empty(0), False  # Dirichlet data at t and t + dt
-    # the sweep (USL, one thread, a grid the basis's own kernels serve): pass 2 and the next pass 1 together
-    sweeping = SWEEP_ON == 1 and chunks == 1 and (ANY_GRID == 1 or inv_spacing > 0.0)
-    block = np.empty((4, BLOCK if sweeping else 0))
+    # the sweep (USL, a grid the basis's own kernels serve): pass 2 and the next pass 1 together, each chunk
+    # into sums of its own (one chunk: into m_i, P_i, F_i)
+    sweeping = SWEEP_ON == 1 and (ANY_GRID == 1 or inv_spacing > 0.0)
+    block = np.empty((chunks, 4, BLOCK if sweeping else 0))
+    n_nodes = grid.shape[1]
+    sums = grid[GM:GM + 3].reshape((1, 3, n_nodes)) if chunks == 1 else np.empty((chunks if sweeping else 0, 3,
+                                                                                 n_nodes))
+    refusals = np.empty(chunks, np.int64)
     projected = False  # m_i, P_i, F_i (and the cells, rows) hold pass 1 of state[cur]: the last sweep's
     while done < budget and t < T * (1 - 1e-12):
         if fixed_dt > 0:
@@ -333,12 +338,14 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
         old, new = ParticleState(x, v, V, m, rho, e, p), ParticleState(x_n, v_new, V_n, m_n, rho_n, e_n, p_n)
         if SCHEME == USL:
             if SWEEP_ON == 1 and sweeping:  # pass 2, and the next step's pass 1 into m_i, P_i, F_i (GM, GP, GF)
-                refused, top, outside, empty, need = SWEEP(geometry, stored, target, v_n, old, new, dt, consts, block,
-                                                           grid[GM:GM + 3])
-                if refused >= 0:
+                if SWEEP(geometry, stored, target, v_n, old, new, dt, consts, chunks, block, sums, grid[GM:GM + 3],
+                         flags, speeds, refusals) >= 0:
                     break  # the per-step path retakes this step and raises
-                flags[0, 0], flags[0, 1], flags[0, 2], speeds[0] = -1, -1, -1, top
-                projected = outside < 0 and empty < 0 and (not store or need == WIDTH or n == 0)
+                need = 0
+                for k in range(chunks):
+                    need = max(need, flags[k, 2])
+                projected = not (flags[:, :2] >= 0).any() and (not store or need == WIDTH or n == 0)
+                flags[:, :] = -1
             else:
                 MOVE(geometry, stored, target, v_n, old, new, dt, consts, SCHEME, chunks, P_musl, checks)
         elif SCHEME == USF:  # the state updated already: pass 2 moves the particles only

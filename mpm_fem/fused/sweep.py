@@ -1,6 +1,6 @@
 """The sweep: pass 2 of one USL step and pass 1 of the next in one pass over the particles, by blocks.
 
-With USL (no remedy, one thread), step n's pass 2 and step n+1's pass 1 read the same particles one
+With USL and no remedy, step n's pass 2 and step n+1's pass 1 read the same particles one
 after the other, and pass 1 needs nothing of the grid stage between them. The compiled loop
 (:func:`mpm_fem.fused.loop._advance`) therefore takes them together, :func:`_sweep`, over blocks of
 ``BLOCK`` particles, each in three loops:
@@ -22,7 +22,8 @@ after the other, and pass 1 needs nothing of the grid stage between them. The co
 The floats are those of pass 2 and pass 1 taken one after the other (:func:`mpm_fem.fused.passes._move`,
 :func:`mpm_fem.fused.project._project`): the same operations per particle in the same order, and
 each node's sum added in particle order from zero across the blocks (a block's ``project`` call
-starts from the sums the blocks before it left). Vectorising the update changes no float: it has no
+starts from the sums the blocks before it left). With threads, each sweeps a contiguous chunk of the
+particles into sums of its own, added in chunk order as pass 1's chunks are. Vectorising the update changes no float: it has no
 sum across particles but the maximum, which does not depend on the order. A refused particle stops
 the sweep (the loop then stops before the step, and :meth:`mpm_fem.fused.step.FusedStep.step`
 retakes it and raises as the numpy step does); a particle of step n+1 outside the grid, without
@@ -33,12 +34,13 @@ where numba's Python model would test every divisor and the update would not vec
 
 import numpy as np
 from llvmlite import ir
-from numba import types
+from numba import prange, types
 from numba.extending import intrinsic
 
 from mpm_fem.bases.contract import Cloud
 from mpm_fem.fused.codes import GAS, IFLIP, IGGM1, IGM1, ILIN, IQUAD
 from mpm_fem.fused.models import _finite, _gas_update
+from mpm_fem.fused.sums import _chunk, _one_row, _sum_chunks
 
 BLOCK = 2048  # particles per block: its slices and scratch stay in the L1/L2 cache
 ACC, VEL, GRAD, LENGTH = range(4)  # rows of the block's scratch: sum S a, sum S v^{n+1}, L_p, h_c
@@ -61,16 +63,20 @@ def fmax(typingctx, a, b):
     return types.float64(types.float64, types.float64), codegen
 
 
-def _sweep(g, stored, a_i, v_n, old, new, dt, consts, block, out):
+def _sweep(g, stored, a_i, v_n, old, new, dt, consts, chunks, block, sums, out, flags, speeds, refusals):
     """Step n's pass 2 (USL, ``MODEL``'s update, ``old`` into ``new`` from ``a_i`` and ``v_n =
     v_i^{n+1}``) and step n+1's pass 1 of ``new`` into ``out`` (3, n_nodes): ``m_i``, ``P_i`` and the
-    gas's ``F_i`` (zeroed first), the cells and, for a basis that stores them, the rows into ``stored``. ``g``:
+    gas's ``F_i``, the cells and, for a basis that stores them, the rows into ``stored``. ``g``:
     :class:`~mpm_fem.bases.contract.Geometry` (a grid the basis's ``move`` and ``project`` serve:
-    any grid where ``ANY_GRID``, else one uniform to round-off); ``block`` (4, ``BLOCK``) scratch.
-    Returns ``(refused, speed, outside, empty, need)``: the first particle of the first block with
-    a refused particle (-1: none; then ``new`` is not complete), the largest signal speed,
-    and step n+1's first particle outside the grid, first without volume and the row width it needs
-    (:class:`~mpm_fem.bases.contract.Kernels`' ``project``)."""
+    any grid where ``ANY_GRID``, else one uniform to round-off). The particles are cut into ``chunks``
+    contiguous ranges (:func:`mpm_fem.fused.sums._chunk`, one per thread in a parallel variant), each
+    swept by blocks with its scratch ``block[k]`` (4, ``BLOCK``) into its sums ``sums[k]`` (3, n_nodes,
+    zeroed first), which are then added in chunk order into ``out`` (:func:`mpm_fem.fused.sums._sum_chunks`,
+    as pass 1's; one chunk: ``sums[0]`` is ``out``). Per chunk k: ``refusals[k]``, the first particle of
+    its first block with a refused particle (-1: none; then ``new`` is not complete), ``speeds[k]``
+    its largest signal speed, ``flags[k]`` = (its first particle of step n+1 outside the grid, first
+    without volume, the row width it needs) (:class:`~mpm_fem.bases.contract.Kernels`' ``project``).
+    Returns the first chunk's refusal (-1: none)."""
     nodes = g.nodes
     h = g.h
     inv_spacing = g.inv_spacing
@@ -85,74 +91,86 @@ def _sweep(g, stored, a_i, v_n, old, new, dt, consts, block, out):
     gm1, g_gm1, c_lin, c_quad = consts[IGM1], consts[IGGM1], consts[ILIN], consts[IQUAD]
     flip = consts[IFLIP] if consts.size > IFLIP else 1.0
     keep = 1.0 - flip
-    out[:] = 0.0
-    acc, vel, grad, length = block[ACC], block[VEL], block[GRAD], block[LENGTH]
-    r, Sl, Gl = np.empty(K, np.intp), np.empty(K), np.empty(K)
     cloud = Cloud(x_new, V_new, m_new, v_new, p_new)  # the gas's mass: the same floats in both sets
-    speed, outside, empty, need = 0.0, -1, -1, 0
-    for lo in range(0, n, BLOCK):
-        hi = min(lo + BLOCK, n)
-        for j in range(hi - lo):  # A: the gather (scalar: indexed loads)
-            q = lo + j
-            if REGISTERS == 1:
-                c, acc[j], vel[j], grad[j] = MOVE_RUN(nodes, h, inv_spacing, x[q], a_i, v_n)
-            elif STORED == 1:
-                c = cell[q]
-                i = rows[q, 0]
-                sa, sv, gv = S[q, 0] * a_i[i], S[q, 0] * v_n[i], G[q, 0] * v_n[i]
-                for k in range(1, K):
-                    i = rows[q, k]
-                    sa += S[q, k] * a_i[i]
-                    sv += S[q, k] * v_n[i]
-                    gv += G[q, k] * v_n[i]
-                acc[j], vel[j], grad[j] = sa, sv, gv
-            else:
-                c = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
-                sa, sv, gv = Sl[0] * a_i[r[0]], Sl[0] * v_n[r[0]], Gl[0] * v_n[r[0]]
-                for k in range(1, K):
-                    sa += Sl[k] * a_i[r[k]]
-                    sv += Sl[k] * v_n[r[k]]
-                    gv += Gl[k] * v_n[r[k]]
-                acc[j], vel[j], grad[j] = sa, sv, gv
+    for k in prange(chunks):
+        first, last = _chunk(n, chunks, k)
+        dest = sums[k]
+        dest[:] = 0.0
+        acc, vel, grad, length = block[k, ACC], block[k, VEL], block[k, GRAD], block[k, LENGTH]
+        r, Sl, Gl = _one_row(K)
+        speed, outside, empty, need, refused_at = 0.0, -1, -1, 0, -1
+        for lo in range(first, last, BLOCK):
+            hi = min(lo + BLOCK, last)
+            for j in range(hi - lo):  # A: the gather (scalar: indexed loads)
+                q = lo + j
+                if REGISTERS == 1:
+                    c, acc[j], vel[j], grad[j] = MOVE_RUN(nodes, h, inv_spacing, x[q], a_i, v_n)
+                elif STORED == 1:
+                    c = cell[q]
+                    i = rows[q, 0]
+                    sa, sv, gv = S[q, 0] * a_i[i], S[q, 0] * v_n[i], G[q, 0] * v_n[i]
+                    for kk in range(1, K):
+                        i = rows[q, kk]
+                        sa += S[q, kk] * a_i[i]
+                        sv += S[q, kk] * v_n[i]
+                        gv += G[q, kk] * v_n[i]
+                    acc[j], vel[j], grad[j] = sa, sv, gv
+                else:
+                    c = ROW(nodes, h, inv_spacing, x, q, rows, S, G, cell, r, Sl, Gl)
+                    sa, sv, gv = Sl[0] * a_i[r[0]], Sl[0] * v_n[r[0]], Gl[0] * v_n[r[0]]
+                    for kk in range(1, K):
+                        sa += Sl[kk] * a_i[r[kk]]
+                        sv += Sl[kk] * v_n[r[kk]]
+                        gv += Gl[kk] * v_n[r[kk]]
+                    acc[j], vel[j], grad[j] = sa, sv, gv
+                if MODEL == GAS:
+                    length[j] = h[0, c]
+            refused = 0
             if MODEL == GAS:
-                length[j] = h[0, c]
-        refused = 0
-        if MODEL == GAS:
-            xo, vo, mo, rho_o, eo, po = x[lo:hi], v[lo:hi], m[lo:hi], rho[lo:hi], e[lo:hi], p[lo:hi]
-            xn, vn, Vn, rho_n, en, pn = x_new[lo:hi], v_new[lo:hi], V_new[lo:hi], rho_new[lo:hi], e_new[lo:hi], \
-                p_new[lo:hi]
-            for j in range(hi - lo):  # B: the update (branch-free over contiguous slices: vectorised)
-                u = vo[j] + dt * acc[j]
-                if flip != 1.0:
-                    u = flip * u + keep * vel[j]
-                y = xo[j] + dt * vel[j]
-                factor, density, energy, pressure, volume, c = _gas_update(
-                    rho_o[j], eo[j], po[j], mo[j], grad[j], dt, length[j], gm1, g_gm1, c_lin, c_quad)
-                xn[j], vn[j], Vn[j], rho_n[j], en[j], pn[j] = y, u, volume, density, energy, pressure
-                speed = fmax(speed, c + abs(u))
-                ok = (factor > 0.0) & (energy > 0.0) & _finite(y, u, density, energy, pressure, volume)
-                refused += 0 if ok else 1
-        else:  # viscous Burgers: V <- V (1 + L dt), m = V
-            xo, vo, Vo = x[lo:hi], v[lo:hi], V[lo:hi]
-            xn, vn, Vn, mn = x_new[lo:hi], v_new[lo:hi], V_new[lo:hi], m_new[lo:hi]
-            for j in range(hi - lo):  # B, as the gas's
-                u = vo[j] + dt * acc[j]
-                if flip != 1.0:
-                    u = flip * u + keep * vel[j]
-                y = xo[j] + dt * vel[j]
-                factor = 1.0 + grad[j] * dt
-                volume = Vo[j] * factor
-                xn[j], vn[j], Vn[j], mn[j] = y, u, volume, volume
-                speed = fmax(speed, abs(u))
-                ok = (factor > 0.0) & _finite(y, u, volume, 0.0, 0.0, 0.0)
-                refused += 0 if ok else 1
-        if refused:
-            return lo, speed, outside, empty, need
-        # C: step n+1's pass 1 over the block's new state
-        o, em, k_need = PROJECT_RUN(g, cloud, MODEL == GAS, STORED == 1, lo, hi, stored, out)
-        if outside < 0:
-            outside = o
-        if empty < 0:
-            empty = em
-        need = max(need, k_need)
-    return -1, speed, outside, empty, need
+                xo, vo, mo, rho_o, eo, po = x[lo:hi], v[lo:hi], m[lo:hi], rho[lo:hi], e[lo:hi], p[lo:hi]
+                xn, vn, Vn, rho_n, en, pn = x_new[lo:hi], v_new[lo:hi], V_new[lo:hi], rho_new[lo:hi], \
+                    e_new[lo:hi], p_new[lo:hi]
+                for j in range(hi - lo):  # B: the update (branch-free over contiguous slices: vectorised)
+                    u = vo[j] + dt * acc[j]
+                    if flip != 1.0:
+                        u = flip * u + keep * vel[j]
+                    y = xo[j] + dt * vel[j]
+                    factor, density, energy, pressure, volume, c = _gas_update(
+                        rho_o[j], eo[j], po[j], mo[j], grad[j], dt, length[j], gm1, g_gm1, c_lin, c_quad)
+                    xn[j], vn[j], Vn[j], rho_n[j], en[j], pn[j] = y, u, volume, density, energy, pressure
+                    speed = fmax(speed, c + abs(u))
+                    ok = (factor > 0.0) & (energy > 0.0) & _finite(y, u, density, energy, pressure, volume)
+                    refused += 0 if ok else 1
+            else:  # viscous Burgers: V <- V (1 + L dt), m = V
+                xo, vo, Vo = x[lo:hi], v[lo:hi], V[lo:hi]
+                xn, vn, Vn, mn = x_new[lo:hi], v_new[lo:hi], V_new[lo:hi], m_new[lo:hi]
+                for j in range(hi - lo):  # B, as the gas's
+                    u = vo[j] + dt * acc[j]
+                    if flip != 1.0:
+                        u = flip * u + keep * vel[j]
+                    y = xo[j] + dt * vel[j]
+                    factor = 1.0 + grad[j] * dt
+                    volume = Vo[j] * factor
+                    xn[j], vn[j], Vn[j], mn[j] = y, u, volume, volume
+                    speed = fmax(speed, abs(u))
+                    ok = (factor > 0.0) & _finite(y, u, volume, 0.0, 0.0, 0.0)
+                    refused += 0 if ok else 1
+            if refused:
+                refused_at = lo
+                break
+            # C: step n+1's pass 1 over the block's new state
+            o, em, k_need = PROJECT_RUN(g, cloud, MODEL == GAS, STORED == 1, lo, hi, stored, dest)
+            if outside < 0:
+                outside = o
+            if empty < 0:
+                empty = em
+            need = max(need, k_need)
+        refusals[k], speeds[k] = refused_at, speed
+        flags[k, 0], flags[k, 1], flags[k, 2] = outside, empty, need
+    for k in range(chunks):
+        if refusals[k] >= 0:
+            return refusals[k]
+    if chunks > 1:
+        for j in range(3):
+            _sum_chunks(sums, j, out[j], 1.0)
+    return -1
