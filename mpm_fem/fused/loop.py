@@ -233,13 +233,11 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     m_i, P_i, F_i, v_i, a_i, v_n, P_musl = grid[GM], grid[GP], grid[GF], grid[GV], grid[GA], grid[GVN], grid[GPMUSL]
     done, dt_min, dt_max = 0, np.inf, -np.inf
     g_t, g_next, known = np.empty(0), np.empty(0), False  # Dirichlet data at t and t + dt
-    # the sweep (USL, a grid the basis's own kernels serve): pass 2 and the next pass 1 together, each chunk
-    # into sums of its own (one chunk: into m_i, P_i, F_i)
+    # the sweep (USL, a grid the basis's own kernels serve): pass 2 and the next pass 1 together, the first
+    # chunk's sums into m_i, P_i, F_i, each later chunk's into sums of its own
     sweeping = SWEEP_ON == 1 and (ANY_GRID == 1 or inv_spacing > 0.0)
     block = np.empty((chunks, 4, BLOCK if sweeping else 0))
-    n_nodes = grid.shape[1]
-    sums = grid[GM:GM + 3].reshape((1, 3, n_nodes)) if chunks == 1 else np.empty((chunks if sweeping else 0, 3,
-                                                                                 n_nodes))
+    sums = np.empty((chunks - 1 if sweeping else 0, 3, grid.shape[1]))
     refusals = np.empty(chunks, np.int64)
     projected = False  # m_i, P_i, F_i (and the cells, rows) hold pass 1 of state[cur]: the last sweep's
     while done < budget and t < T * (1 - 1e-12):

@@ -40,7 +40,7 @@ from numba.extending import intrinsic
 from mpm_fem.bases.contract import Cloud
 from mpm_fem.fused.codes import GAS, IFLIP, IGGM1, IGM1, ILIN, IQUAD
 from mpm_fem.fused.models import _finite, _gas_update
-from mpm_fem.fused.sums import _chunk, _one_row, _sum_chunks
+from mpm_fem.fused.sums import _chunk, _one_row
 
 BLOCK = 2048  # particles per block: its slices and scratch stay in the L1/L2 cache
 ACC, VEL, GRAD, LENGTH = range(4)  # rows of the block's scratch: sum S a, sum S v^{n+1}, L_p, h_c
@@ -70,9 +70,10 @@ def _sweep(g, stored, a_i, v_n, old, new, dt, consts, chunks, block, sums, out, 
     :class:`~mpm_fem.bases.contract.Geometry` (a grid the basis's ``move`` and ``project`` serve:
     any grid where ``ANY_GRID``, else one uniform to round-off). The particles are cut into ``chunks``
     contiguous ranges (:func:`mpm_fem.fused.sums._chunk`, one per thread in a parallel variant), each
-    swept by blocks with its scratch ``block[k]`` (4, ``BLOCK``) into its sums ``sums[k]`` (3, n_nodes,
-    zeroed first), which are then added in chunk order into ``out`` (:func:`mpm_fem.fused.sums._sum_chunks`,
-    as pass 1's; one chunk: ``sums[0]`` is ``out``). Per chunk k: ``refusals[k]``, the first particle of
+    swept by blocks with its scratch ``block[k]`` (4, ``BLOCK``) into its sums (3, n_nodes, zeroed first):
+    ``out`` for the first, ``sums[k - 1]`` for chunk k > 0, then added to ``out`` in chunk order, node
+    range by node range (the floats of :func:`mpm_fem.fused.sums._sum_chunks`, pass 1's: ``1.0 x`` is
+    ``x``). Per chunk k: ``refusals[k]``, the first particle of
     its first block with a refused particle (-1: none; then ``new`` is not complete), ``speeds[k]``
     its largest signal speed, ``flags[k]`` = (its first particle of step n+1 outside the grid, first
     without volume, the row width it needs) (:class:`~mpm_fem.bases.contract.Kernels`' ``project``).
@@ -94,7 +95,7 @@ def _sweep(g, stored, a_i, v_n, old, new, dt, consts, chunks, block, sums, out, 
     cloud = Cloud(x_new, V_new, m_new, v_new, p_new)  # the gas's mass: the same floats in both sets
     for k in prange(chunks):
         first, last = _chunk(n, chunks, k)
-        dest = sums[k]
+        dest = out if k == 0 else sums[k - 1]
         dest[:] = 0.0
         acc, vel, grad, length = block[k, ACC], block[k, VEL], block[k, GRAD], block[k, LENGTH]
         r, Sl, Gl = _one_row(K)
@@ -170,7 +171,11 @@ def _sweep(g, stored, a_i, v_n, old, new, dt, consts, chunks, block, sums, out, 
     for k in range(chunks):
         if refusals[k] >= 0:
             return refusals[k]
-    if chunks > 1:
-        for j in range(3):
-            _sum_chunks(sums, j, out[j], 1.0)
+    n_nodes = out.shape[1]
+    for part in prange(chunks if chunks > 1 else 0):  # the later chunks' sums added in their order, by node ranges
+        start, stop = _chunk(n_nodes, chunks, part)
+        for k in range(1, chunks):
+            for j in range(3):
+                for i in range(start, stop):
+                    out[j, i] += sums[k - 1, j, i]
     return -1
