@@ -50,7 +50,7 @@ from mpm_fem.fused.codes import (
 from mpm_fem.fused.models import Checks, ParticleState
 from mpm_fem.fused.remedies import Quadrature, Reset, State
 from mpm_fem.fused.sums import _divide_by_lumped
-from mpm_fem.fused.sweep import BLOCK
+from mpm_fem.fused.sweep import BLOCK, Sweeping
 
 # placeholders: each variant has its own (mpm_fem.fused.compiler)
 STORED = ANY_GRID = MODEL = WIDTH = SCHEME = XPIC_ON = VOLUME_ON = TAYLOR_ON = SWEEP_ON = None
@@ -236,9 +236,9 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     # the sweep (USL, a grid the basis's own kernels serve): pass 2 and the next pass 1 together, the first
     # chunk's sums into m_i, P_i, F_i, each later chunk's into sums of its own
     sweeping = SWEEP_ON == 1 and (ANY_GRID == 1 or inv_spacing > 0.0)
-    block = np.empty((chunks, 4, BLOCK if sweeping else 0))
-    sums = np.empty((chunks - 1 if sweeping else 0, 3, grid.shape[1]))
-    refusals = np.empty(chunks, np.int64)
+    sweep_scratch = Sweeping(np.empty((chunks, 4, BLOCK if sweeping else 0)),
+                             np.empty((chunks - 1 if sweeping else 0, 3, grid.shape[1])), flags, speeds,
+                             np.empty(chunks, np.int64))
     projected = False  # m_i, P_i, F_i (and the cells, rows) hold pass 1 of state[cur]: the last sweep's
     while done < budget and t < T * (1 - 1e-12):
         if fixed_dt > 0:
@@ -336,8 +336,8 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
         old, new = ParticleState(x, v, V, m, rho, e, p), ParticleState(x_n, v_new, V_n, m_n, rho_n, e_n, p_n)
         if SCHEME == USL:
             if SWEEP_ON == 1 and sweeping:  # pass 2, and the next step's pass 1 into m_i, P_i, F_i (GM, GP, GF)
-                if SWEEP(geometry, stored, target, v_n, old, new, dt, consts, chunks, block, sums, grid[GM:GM + 3],
-                         flags, speeds, refusals) >= 0:
+                if SWEEP(geometry, stored, target, v_n, old, new, dt, consts, chunks, grid[GM:GM + 3],
+                         sweep_scratch) >= 0:
                     break  # the per-step path retakes this step and raises
                 need = 0
                 for k in range(chunks):

@@ -23,14 +23,16 @@ The floats are those of pass 2 and pass 1 taken one after the other (:func:`mpm_
 :func:`mpm_fem.fused.project._project`): the same operations per particle in the same order, and
 each node's sum added in particle order from zero across the blocks (a block's ``project`` call
 starts from the sums the blocks before it left). With threads, each sweeps a contiguous chunk of the
-particles into sums of its own, added in chunk order as pass 1's chunks are. Vectorising the update changes no float: it has no
-sum across particles but the maximum, which does not depend on the order. A refused particle stops
-the sweep (the loop then stops before the step, and :meth:`mpm_fem.fused.step.FusedStep.step`
+particles into sums of its own, added in chunk order as pass 1's chunks are. Vectorising the update
+changes no float: it has no sum across particles but the maximum, which does not depend on the order.
+A refused particle stops the sweep (the loop then stops before the step, and :meth:`mpm_fem.fused.step.FusedStep.step`
 retakes it and raises as the numpy step does); a particle of step n+1 outside the grid, without
 volume, or whose row needs other columns makes the loop take step n+1's pass 1 again, which stops it.
 Compiled with ``error_model="numpy"``: a division by zero gives an infinity the checks then refuse,
 where numba's Python model would test every divisor and the update would not vectorise.
 """
+
+from typing import NamedTuple
 
 import numpy as np
 from llvmlite import ir
@@ -41,6 +43,17 @@ from mpm_fem.bases.contract import Cloud
 from mpm_fem.fused.codes import GAS, IFLIP, IGGM1, IGM1, ILIN, IQUAD
 from mpm_fem.fused.models import _finite, _gas_update
 from mpm_fem.fused.sums import _chunk, _one_row
+
+
+class Sweeping(NamedTuple):
+    """The sweep's scratch and what it reports, per chunk k of the particles."""
+
+    block: np.ndarray  # (chunks, 4, BLOCK): the blocks' scratch
+    sums: np.ndarray  # (chunks - 1, 3, n_nodes): the sums of chunks 1, 2, ... (chunk 0's go into ``out``)
+    flags: np.ndarray  # (chunks, 3): first particle outside the grid, first without volume, the width it needs
+    speeds: np.ndarray  # (chunks,): the largest signal speed
+    refusals: np.ndarray  # (chunks,): the first particle of the first block with a refused particle, or -1
+
 
 BLOCK = 2048  # particles per block: its slices and scratch stay in the L1/L2 cache
 ACC, VEL, GRAD, LENGTH = range(4)  # rows of the block's scratch: sum S a, sum S v^{n+1}, L_p, h_c
@@ -63,20 +76,18 @@ def fmax(typingctx, a, b):
     return types.float64(types.float64, types.float64), codegen
 
 
-def _sweep(g, stored, a_i, v_n, old, new, dt, consts, chunks, block, sums, out, flags, speeds, refusals):
+def _sweep(g, stored, a_i, v_n, old, new, dt, consts, chunks, out, scratch):
     """Step n's pass 2 (USL, ``MODEL``'s update, ``old`` into ``new`` from ``a_i`` and ``v_n =
     v_i^{n+1}``) and step n+1's pass 1 of ``new`` into ``out`` (3, n_nodes): ``m_i``, ``P_i`` and the
     gas's ``F_i``, the cells and, for a basis that stores them, the rows into ``stored``. ``g``:
     :class:`~mpm_fem.bases.contract.Geometry` (a grid the basis's ``move`` and ``project`` serve:
     any grid where ``ANY_GRID``, else one uniform to round-off). The particles are cut into ``chunks``
     contiguous ranges (:func:`mpm_fem.fused.sums._chunk`, one per thread in a parallel variant), each
-    swept by blocks with its scratch ``block[k]`` (4, ``BLOCK``) into its sums (3, n_nodes, zeroed first):
-    ``out`` for the first, ``sums[k - 1]`` for chunk k > 0, then added to ``out`` in chunk order, node
-    range by node range (the floats of :func:`mpm_fem.fused.sums._sum_chunks`, pass 1's: ``1.0 x`` is
-    ``x``). Per chunk k: ``refusals[k]``, the first particle of
-    its first block with a refused particle (-1: none; then ``new`` is not complete), ``speeds[k]``
-    its largest signal speed, ``flags[k]`` = (its first particle of step n+1 outside the grid, first
-    without volume, the row width it needs) (:class:`~mpm_fem.bases.contract.Kernels`' ``project``).
+    swept by blocks (``scratch``: :class:`Sweeping`) into its sums (3, n_nodes, zeroed first): ``out``
+    for the first, ``sums[k - 1]`` for chunk k > 0, then added to ``out`` in chunk order, node range by
+    node range (the floats of :func:`mpm_fem.fused.sums._sum_chunks`, pass 1's: ``1.0 x`` is ``x``).
+    Per chunk k: ``refusals[k]`` (-1: none; else ``new`` is not complete), ``speeds[k]``, ``flags[k]``
+    (step n+1's, :class:`~mpm_fem.bases.contract.Kernels`' ``project``).
     Returns the first chunk's refusal (-1: none)."""
     nodes = g.nodes
     h = g.h
@@ -93,6 +104,7 @@ def _sweep(g, stored, a_i, v_n, old, new, dt, consts, chunks, block, sums, out, 
     flip = consts[IFLIP] if consts.size > IFLIP else 1.0
     keep = 1.0 - flip
     cloud = Cloud(x_new, V_new, m_new, v_new, p_new)  # the gas's mass: the same floats in both sets
+    block, sums, flags, speeds, refusals = scratch
     for k in prange(chunks):
         first, last = _chunk(n, chunks, k)
         dest = out if k == 0 else sums[k - 1]
