@@ -59,3 +59,18 @@ def test_step_cost_rejects_an_unknown_basis():
     proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "step_cost.py"), "--bases", "fem"],
                           capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert proc.returncode == 2 and "unknown bases" in proc.stderr
+
+
+def test_deep_case_runs_the_loop_with_and_without_the_sweep_and_finds_the_same_result():
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "deep_case.py"), "--h", "0.005"],
+                          capture_output=True, text=True, timeout=600, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert "the two results equal" in proc.stdout
+    ratio = float(proc.stdout.split("CPU time apart / with the sweep: ")[1].split(";")[0])
+    assert 0 < ratio < 100
+
+
+def test_deep_case_rejects_a_bad_cell_size():
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "deep_case.py"), "--h", "0"],
+                          capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert proc.returncode == 2 and "--h must lie in (0, 0.01]" in proc.stderr
