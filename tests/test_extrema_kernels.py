@@ -1,4 +1,5 @@
-"""The new-extrema observer's compiled kernels (mpm_fem/measure/regions.py) equal to their numpy forms, and
+"""The new-extrema count's compiled kernels (mpm_fem/fused/extrema.py) equal to their numpy forms
+(mpm_fem/measure/regions.py), the compiled loop's count equal to the readable count of every step, and
 runs handing an observer reused arrays (``keeps_particles = False``: the extrema counter, the time
 study's recorder) seeing what runs with fresh arrays see."""
 
@@ -8,7 +9,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mpm_fem.core.grid import uniform_grid
-from mpm_fem.measure.regions import ExtremaCounter, _cells, _strict_extrema, cells, strict_extrema
+from mpm_fem.core.particles import make_particles
+from mpm_fem.fused.extrema import cells as _cells
+from mpm_fem.fused.extrema import remember, tally_step
+from mpm_fem.fused.extrema import strict_extrema as _strict_extrema
+from mpm_fem.measure.regions import ExtremaCounter, _state, cells, new_extrema, strict_extrema
 from mpm_fem.measure.timing import Recorder
 from mpm_fem.problems import burgers, sod
 from mpm_fem.run.solve import _keeps_particles
@@ -78,3 +83,75 @@ def test_the_recorder_on_reused_arrays_records_what_it_records_on_fresh_arrays()
     assert a.t.size == b.t.size > 20
     for name in ("t", "x", "v", "a_nodes"):
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+def _random_step(rng, n, shuffle):
+    """Two states of ``n`` particles on [0, 1]: the second moved by up to half a cell of NODES, its
+    density and energy rounded (plateaus and ties), and with ``shuffle`` some neighbours swapped."""
+    x = np.sort(rng.uniform(0.0, 1.0, n))
+    old = make_particles(x, 1.0 / n, np.round(rng.uniform(0.5, 1.0, n), 1), velocity=rng.normal(0.0, 1.0, n),
+                         energy=np.round(rng.uniform(1.0, 2.0, n), 1))
+    x_new = np.clip(x + rng.uniform(-0.05, 0.05, n), 0.0, 1.0)
+    if shuffle:
+        x_new = np.sort(x_new)
+        k = rng.integers(0, n - 1, n // 4)
+        x_new[k], x_new[k + 1] = x_new[k + 1], x_new[k].copy()
+    new = old.replace(x=x_new, density=np.round(rng.uniform(0.5, 1.0, n), 1), velocity=rng.normal(0.0, 1.0, n),
+                      energy=np.round(rng.uniform(1.0, 2.0, n), 1))
+    return old, new
+
+
+@pytest.mark.parametrize("shuffle", [False, True], ids=["in order", "out of order"])
+@pytest.mark.parametrize("nodes", [NODES, STRETCHED], ids=["uniform", "stretched"])
+def test_the_compiled_count_of_a_step_equals_the_readable_count(nodes, shuffle):
+    rng = np.random.default_rng(11)
+    fields = np.array([4, 5], np.int64)  # codes.IRHO, codes.IE
+    for n in (3, 40, 400):
+        old, new = _random_step(rng, n, shuffle)
+        cells_, marks = np.empty(n, np.intp), np.empty((2, n), bool)
+        remember(nodes, _state(old), fields, 1e-9, cells_, marks)
+        counts = np.zeros((3, 4), np.int64)
+        tally_step(nodes, _state(new), fields, 1e-9, 0.5, counts, cells_, marks)
+        expected = new_extrema(nodes, old, new, ("density", "energy"), 1e-9, 0.5)
+        assert counts.tolist() == expected.tolist(), n
+        assert n < 400 or (counts[1:, :2].sum(axis=0) > 0).all()  # it counts something, at crossings and elsewhere
+        assert _cells(nodes, new.x).tolist() == cells_.tolist()  # it remembers the new state
+
+
+class _Readable:
+    """An observer that counts every step with the readable :func:`new_extrema` (fresh arrays each step)."""
+
+    def __init__(self, nodes, moving_speed):
+        self.nodes, self.moving_speed, self.calls = nodes, moving_speed, 0
+        self.totals = np.zeros((3, 4), np.int64)
+
+    def __call__(self, step, t, old, new, state=None):
+        counts = new_extrema(self.nodes, old, new, ("density", "energy"), 1e-9, self.moving_speed)
+        self.totals[0] += counts[0]
+        self.totals[1:, :3] += counts[1:, :3]
+        self.totals[1:, 3] = np.maximum(self.totals[1:, 3], counts[1:, 3])
+        self.calls += 1
+
+
+def test_the_compiled_loop_counts_what_the_readable_count_of_every_step_counts():
+    """Sod at h = 0.02, 16 per cell, CFL 0.05: the counter served by the compiled loop (called for the
+    first step only) against the readable count called after every step; the same particles."""
+    settings_ = sod.SodSettings(h=0.02, ppc=16, cfl=0.05)
+    grid = uniform_grid(0.0, 1.0, 0.02)
+
+    class _Calls(ExtremaCounter):
+        calls = 0
+
+        def __call__(self, *args):
+            type(self).calls += 1
+            super().__call__(*args)
+
+    looped, readable = _Calls(grid, moving_speed=0.05), _Readable(grid.nodes, 0.05)
+    a = sod.simulate(settings_, progress=False, observer=looped)
+    b = sod.simulate(settings_, progress=False, observer=readable)
+    assert looped.totals.tolist() == readable.totals.tolist()
+    assert looped.steps == readable.calls == a.steps > 400
+    assert _Calls.calls < 5  # the loop counted the rest
+    assert looped.totals[1, 0] > 0 and looped.totals[2, 1] > 0  # new extrema at crossings and elsewhere
+    for name in ("x", "velocity", "density", "energy", "pressure", "volume"):
+        assert np.array_equal(getattr(a.particles, name), getattr(b.particles, name)), name

@@ -47,6 +47,7 @@ from mpm_fem.fused.codes import (
     USF,
     USL,
 )
+from mpm_fem.fused.extrema import tally_step
 from mpm_fem.fused.models import Checks, ParticleState
 from mpm_fem.fused.remedies import Quadrature, Reset, State
 from mpm_fem.fused.sums import _divide_by_lumped
@@ -196,7 +197,7 @@ def _nodal_rows(xpic_on, volume_on):
     return 7 + 4 * xpic_on + 2 * volume_on
 
 
-def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, remedies):
+def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, remedies, tally):
     """Up to ``clock.budget`` steps of :meth:`~mpm_fem.fused.step.FusedStep.step` with the lumped mass, each
     with the time step :func:`mpm_fem.run.solve.run` takes (``dt = min(dt_CFL / refine, T - t)``, ``dt_CFL`` from the
     previous step's ``speed``, or ``fixed_dt`` if > 0). The particles alternate between ``state[cur]``
@@ -218,7 +219,8 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
     ``reset[0]``) and then the force of the reset state; the Taylor reconstruction, its force in place
     of the particles' force. ``SCHEME``, ``XPIC_ON``, ``VOLUME_ON`` and ``TAYLOR_ON`` are compile-time
     constants of the variant; the passes it calls (``PROJECT``, ``MOVE``, ...) are its globals too.
-    Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
+    A ``tally`` with counts (:class:`~mpm_fem.fused.extrema.Tally`) counts each step's new extrema
+    (:func:`~mpm_fem.fused.extrema.tally_step`). Returns ``(cur, t, steps taken, speed, dt_min, dt_max)``."""
     nodes, h, inv_spacing = geometry
     ends, dirichlet, window, exact, times, table, accelerations = conditions
     t, T, speed, fixed_dt, cfl, h_min, refine, viscous_limit, steps, max_steps, budget = clock
@@ -358,6 +360,9 @@ def _advance(geometry, conditions, clock, consts, chunks, state, cur, scratch, r
             FINISH(geometry, stored, v_n, old, new, dt, consts, chunks, checks)
         if (flags >= 0).any():
             break
+        if tally.counts.shape[0]:
+            tally_step(tally.nodes, state[o, :, :n], tally.fields, tally.rtol, tally.moving_speed, tally.counts,
+                       tally.cells, tally.marks)
         speed = speeds.max()
         cur = 1 - cur
         t += dt

@@ -48,6 +48,7 @@ from mpm_fem.fused.codes import (
     VISCOUS_STRESS,
 )
 from mpm_fem.fused.compiler import PASSES
+from mpm_fem.fused.extrema import Tally, no_tally
 from mpm_fem.fused.loop import _LOOP_CALLS, Clock, Conditions, Geometry, Remedies, Scratch, _advance, _nodal_rows
 from mpm_fem.fused.models import Checks, ParticleState
 from mpm_fem.fused.passes import _finish, _move, _move_exact, _scatter_pass, _update, _update_exact
@@ -196,12 +197,13 @@ class FusedStep:
         quiet = getattr(problem.particle_boundary, "quiet", None)
         return None if quiet is None else quiet(self.grid)
 
-    def advance(self, particles: Particles, t: float, problem, steps: int, max_steps: int, budget: int):
+    def advance(self, particles: Particles, t: float, problem, steps: int, max_steps: int, budget: int,
+                tally: Tally | None = None):
         """Up to ``budget`` steps from ``t`` in one compiled loop (:func:`~mpm_fem.fused.loop._advance`), each the step
         :meth:`step` takes with the time step :func:`mpm_fem.run.solve.run` takes after its first step
         (from :attr:`speed`): the same numbers bit for bit. Returns ``(particles, t, steps taken,
         dt_min, dt_max)``; zero steps when the next step must go through :meth:`step` (it fails, or
-        a stored row changes width)."""
+        a stored row changes width). A ``tally`` counts new extrema on the way (:mod:`~mpm_fem.fused.extrema`)."""
         n, chunks = particles.n, max(1, min(self.threads, particles.n))
         spare = (lambda k: k // 16) if problem.particle_boundary is not None else (lambda k: 0)  # a reservoir's inflow
         if self._out is not particles or self._state.shape[2] < n + _PAD:
@@ -247,7 +249,7 @@ class FusedStep:
         try:
             cur, t, done, speed, dt_min, dt_max = loop(
                 Geometry(self.nodes, self.h, self.inv_spacing), conditions, clock, self.consts, chunks, self._state,
-                self._cur, scratch, remedies)
+                self._cur, scratch, remedies, no_tally() if tally is None else tally)
         finally:
             _LOOP_CALLS.pop()
         if done:

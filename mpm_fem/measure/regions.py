@@ -36,10 +36,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles
+from mpm_fem.fused.codes import FIELDS
+from mpm_fem.fused.extrema import Tally, merge, remember, tally_step
 
 REGION_NAMES = (
     "undisturbed",
@@ -143,70 +144,42 @@ def strict_extrema(q: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
 
 def cells(nodes: np.ndarray, x: np.ndarray) -> np.ndarray:
     """The cell of every point, ``clip(searchsorted(nodes, x, "right") - 1, 0, n_cells - 1)``
-    (the readable form; :func:`_cells` is the one a run calls per step)."""
+    (the readable form of :func:`mpm_fem.fused.extrema.cells`, which a run calls)."""
     return np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, nodes.size - 2)
 
 
-@njit(cache=True)
-def _cells(nodes, x):
-    """:func:`cells` compiled: for each point the last node ``j`` with ``nodes[j] <= x`` (-1 if
-    none; the last node for NaN, where ``searchsorted`` sorts it), clipped to the cells, found by
-    walking from the previous point's node. The particles are nearly in position order, so a step
-    costs O(particles + nodes), not a binary search per particle: the same integers."""
-    m = nodes.size
-    out = np.empty(x.size, np.intp)
-    j = -1  # the last node <= the previous point
-    for p in range(x.size):
-        y = x[p]
-        if y != y:
-            j = m - 1
-        else:
-            while j + 1 < m and nodes[j + 1] <= y:
-                j += 1
-            while j >= 0 and not (nodes[j] <= y):
-                j -= 1
-        out[p] = min(max(j, 0), m - 2)
+def new_extrema(nodes: np.ndarray, old: Particles, new: Particles, fields: tuple, rtol: float = 1e-9,
+                moving_speed: float = 0.0) -> np.ndarray:
+    """One step's counts (module docstring) in the layout of :mod:`mpm_fem.fused.extrema`, readable:
+    ``[[1, crossings, moving, particles], [new at crossings, elsewhere, at moving particles, in all] per
+    field]``. The reference the compiled count (:func:`~mpm_fem.fused.extrema.tally_step`) is tested against."""
+    crossed = cells(nodes, old.x) != cells(nodes, new.x)
+    moving = ~crossed & (np.abs(new.velocity) > moving_speed)
+    out = np.zeros((1 + len(fields), 4), np.int64)
+    out[0] = (1, crossed.sum(), moving.sum(), new.n)
+    for f, name in enumerate(fields):
+        before, after = (_by_position(getattr(s, name), s.x, rtol) for s in (old, new))
+        fresh = after & ~before
+        out[1 + f] = ((fresh & crossed).sum(), (fresh & ~crossed).sum(), (fresh & moving).sum(), fresh.sum())
     return out
 
 
-def _in_order(q: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-    """``q`` in position order (``x`` is usually sorted already: no sort then)."""
-    if np.all(x[1:] >= x[:-1]):
-        return q, None
+def _by_position(q: np.ndarray, x: np.ndarray, rtol: float) -> np.ndarray:
+    """:func:`strict_extrema` of ``q`` in the position order of ``x`` (a stable sort), per particle."""
     order = np.argsort(x, kind="stable")
-    return q[order], order
-
-
-@njit(cache=True)
-def _strict_extrema(q, rtol):
-    """:func:`strict_extrema` of ordered finite values, compiled (one pass, no temporaries): the same
-    comparisons of the same floats, so the same mask (a run's particles are finite: it stops on the
-    first that is not)."""
-    n = q.size
-    out = np.zeros(n, np.bool_)
-    for k in range(1, n - 1):
-        left, mid, right = q[k - 1], q[k], q[k + 1]
-        tol = rtol * max(max(abs(left), abs(mid)), abs(right))
-        out[k] = mid > max(left, right) + tol or mid < min(left, right) - tol
-    return out
-
-
-def _extrema_in_particle_order(q: np.ndarray, x: np.ndarray, rtol: float) -> np.ndarray:
-    ordered, order = _in_order(q, x)
-    mask = _strict_extrema(np.ascontiguousarray(ordered, dtype=float), float(rtol))
-    if order is None:
-        return mask
-    out = np.empty_like(mask)
-    out[order] = mask
+    out = np.empty(q.size, bool)
+    out[order] = strict_extrema(q[order], rtol)
     return out
 
 
 @dataclass(eq=False)
 class ExtremaCounter:
-    """An observer for :func:`mpm_fem.run.solve.run` that counts new extrema of density and energy
-    per step (module docstring), at crossings, at the other particles and at the other particles
-    that move faster than ``moving_speed``. After the run, :meth:`summary` gives the totals. It keeps
-    no particles (``keeps_particles``): a run may hand it arrays it overwrites two steps later."""
+    """An observer for :func:`mpm_fem.run.solve.run` that counts new extrema of ``fields`` per step
+    (module docstring), at crossings, at the other particles and at the other particles that move faster
+    than ``moving_speed``, with the compiled count :func:`~mpm_fem.fused.extrema.tally_step`. The compiled
+    loop counts too (:meth:`tally`, then :meth:`absorb`): the same integers. After the run, :meth:`summary`
+    gives the totals. It keeps no particles (``keeps_particles``): a run may hand it arrays it overwrites
+    two steps later; it remembers the last state's cells and extrema, and which particles they are of."""
 
     keeps_particles = False  # a class attribute, not a field: what solve.run asks of an observer
 
@@ -214,61 +187,73 @@ class ExtremaCounter:
     rtol: float = 1e-9
     fields: tuple = ("density", "energy")
     moving_speed: float = 0.0
-    steps: int = 0
-    crossings: int = 0
-    particle_steps: int = 0
-    moving_staying: int = 0
-    new_crossing: dict = field(default_factory=dict)
-    new_staying: dict = field(default_factory=dict)
-    new_moving: dict = field(default_factory=dict)
-    per_step_max: dict = field(default_factory=dict)
-    _last: tuple | None = field(default=None, repr=False)
+    totals: np.ndarray = field(init=False, repr=False)  # (1 + F, 4) int64 (mpm_fem.fused.extrema)
+    _memory: tuple | None = field(default=None, repr=False)  # (particles, cells, marks)
+
+    def __post_init__(self):
+        unknown = [name for name in self.fields if name not in FIELDS]
+        if unknown or not self.fields:
+            raise ValueError(f"ExtremaCounter counts fields of {FIELDS}, got {self.fields!r}")
+        self.totals = np.zeros((1 + len(self.fields), 4), np.int64)
+
+    @property
+    def steps(self) -> int:
+        return int(self.totals[0, 0])
+
+    def _rows(self) -> np.ndarray:
+        return np.array([FIELDS.index(name) for name in self.fields], np.int64)
+
+    def _remembered(self, particles: Particles) -> tuple[np.ndarray, np.ndarray]:
+        """The cells and extremum marks of ``particles``: remembered, or found now."""
+        if self._memory is not None and self._memory[0] is particles:
+            return self._memory[1], self._memory[2]
+        cells_, marks = np.empty(particles.n, np.intp), np.empty((len(self.fields), particles.n), bool)
+        remember(self.grid.nodes, _state(particles), self._rows(), self.rtol, cells_, marks)
+        return cells_, marks
 
     def __call__(self, step: int, t: float, old: Particles, new: Particles, state=None) -> None:
-        # the state after one step is the state before the next: reuse what was computed for it
-        if self._last is not None and self._last[0] is old:
-            old_cell, before = self._last[1], self._last[2]
-        else:
-            old_cell = _cells(self.grid.nodes, old.x)
-            before = {n: _extrema_in_particle_order(getattr(old, n), old.x, self.rtol) for n in self.fields}
-        new_cell = _cells(self.grid.nodes, new.x)
-        after = {n: _extrema_in_particle_order(getattr(new, n), new.x, self.rtol) for n in self.fields}
-        self._last = (new, new_cell, after)
-        crossed = old_cell != new_cell
-        moving = ~crossed & (np.abs(new.velocity) > self.moving_speed)
-        self.steps += 1
-        self.crossings += int(np.count_nonzero(crossed))
-        self.moving_staying += int(np.count_nonzero(moving))
-        self.particle_steps += new.n
-        for name in self.fields:
-            fresh = after[name] & ~before[name]
-            total = int(np.count_nonzero(fresh))
-            at_crossing = int(np.count_nonzero(fresh & crossed)) if total else 0
-            self.new_crossing[name] = self.new_crossing.get(name, 0) + at_crossing
-            self.new_staying[name] = self.new_staying.get(name, 0) + total - at_crossing
-            self.new_moving[name] = self.new_moving.get(name, 0) + (int(np.count_nonzero(fresh & moving))
-                                                                    if total else 0)
-            self.per_step_max[name] = max(self.per_step_max.get(name, 0), total)
+        cells_, marks = self._remembered(old)
+        counts = np.zeros_like(self.totals)
+        tally_step(self.grid.nodes, _state(new), self._rows(), self.rtol, self.moving_speed, counts, cells_, marks)
+        merge(self.totals, counts)
+        self._memory = (new, cells_, marks)
+
+    def tally(self, particles: Particles) -> Tally:
+        """What the compiled loop needs to go on counting from ``particles``."""
+        cells_, marks = self._remembered(particles)
+        return Tally(self.grid.nodes, self._rows(), float(self.rtol), float(self.moving_speed),
+                     np.zeros_like(self.totals), cells_, marks)
+
+    def absorb(self, tally: Tally, particles: Particles) -> None:
+        """Add the loop's counts; its memory is of ``particles``, the state it left."""
+        merge(self.totals, tally.counts)
+        self._memory = (particles, tally.cells, tally.marks)
 
     def summary(self) -> dict:
         """Totals over the run and rates: new extrema per crossing particle-step, per non-crossing
         particle-step and per moving non-crossing particle-step (``rate_moving``)."""
-        staying = self.particle_steps - self.crossings
-        out = {"steps": self.steps, "crossings": self.crossings, "particle_steps": self.particle_steps,
-               "moving_speed": self.moving_speed, "moving_steps": self.moving_staying}
-        for name in self.fields:
-            c, s, m = self.new_crossing.get(name, 0), self.new_staying.get(name, 0), self.new_moving.get(name, 0)
+        steps, crossings, moving, particle_steps = (int(c) for c in self.totals[0])
+        staying = particle_steps - crossings
+        out = {"steps": steps, "crossings": crossings, "particle_steps": particle_steps,
+               "moving_speed": self.moving_speed, "moving_steps": moving}
+        for name, row in zip(self.fields, self.totals[1:], strict=True):
+            c, s, m, most = (int(k) for k in row)
             out[name] = {
                 "new_at_crossing": c,
                 "new_elsewhere": s,
                 "new_moving": m,
-                "new_per_step": (c + s) / max(self.steps, 1),
-                "max_per_step": self.per_step_max.get(name, 0),
-                "rate_crossing": c / max(self.crossings, 1),
+                "new_per_step": (c + s) / max(steps, 1),
+                "max_per_step": most,
+                "rate_crossing": c / max(crossings, 1),
                 "rate_elsewhere": s / max(staying, 1),
-                "rate_moving": m / max(self.moving_staying, 1),
+                "rate_moving": m / max(moving, 1),
             }
         return out
+
+
+def _state(particles: Particles) -> np.ndarray:
+    """The particles as the compiled loop's rows (``codes.FIELDS``)."""
+    return np.vstack([getattr(particles, name) for name in FIELDS])
 
 
 def plateau_velocity(x: np.ndarray, v: np.ndarray, waves: dict, margin: float) -> dict:

@@ -131,6 +131,14 @@ def _needs_numpy_step(observer: Observer | None) -> bool:
     return observer is not None and getattr(observer, "needs_numpy_step", False) is True
 
 
+def _counts_in_loop(observer: Observer, problem: Problem) -> bool:
+    """Whether the compiled loop serves ``observer``: it counts what the loop can count (a ``tally`` and an
+    ``absorb`` method, as :class:`~mpm_fem.measure.regions.ExtremaCounter`) and no particle boundary acts
+    between steps (the loop would count before it, the per-step observer after it)."""
+    return (callable(getattr(observer, "tally", None)) and callable(getattr(observer, "absorb", None))
+            and problem.particle_boundary is None)
+
+
 def run(
     problem: Problem,
     grid: Grid,
@@ -151,10 +159,11 @@ def run(
     bit on one thread where the fused step does the numpy arithmetic, to round-off (measured at most
     6e-14 relative) where it takes a uniform grid's node arithmetic (``tests/test_fused.py``).
     ``observer(step, t, old, new, state)`` is called after every step, which then runs one at a time
-    rather than in compiled loops; the particles it is handed stay valid only for the call if it says
-    it keeps none (:func:`_keeps_particles`). An observer that reads the numpy step's grid state
-    (``needs_numpy_step = True``, as :class:`~mpm_fem.measure.defect.DefectObserver`)
-    routes the run to the numpy step whatever ``kernel`` says."""
+    rather than in compiled loops, unless the loop counts for it (:func:`_counts_in_loop`: the loop
+    takes ``observer.tally(particles)`` and hands it back to ``observer.absorb(tally, particles)``); the
+    particles it is handed stay valid only for the call if it says it keeps none (:func:`_keeps_particles`).
+    An observer that reads the numpy step's grid state (``needs_numpy_step = True``, as
+    :class:`~mpm_fem.measure.defect.DefectObserver`) routes the run to the numpy step whatever ``kernel`` says."""
     check_kernel(kernel, threads)
     fused = None
     if (kernel == "fused" and supported(problem.model, stages) is None and numpy_only(problem.model, stages) is None
@@ -164,7 +173,7 @@ def run(
     # walls or Dirichlet ends, lumped mass, no observer, and no particle boundary or one that says
     # when it acts: steps in compiled loops of about LOOP_WORK particle-steps each (the bar and
     # Ctrl-C are served between them); a loop stops after a step the particle boundary acts on
-    loop = fused is not None and observer is None and fused.loops(problem)
+    loop = fused is not None and (observer is None or _counts_in_loop(observer, problem)) and fused.loops(problem)
     exact = FieldStages(problem.exact) if problem.exact is not None else None  # the numpy step's exact stages
     start = time.perf_counter()
     t, steps = 0.0, 0
@@ -176,9 +185,12 @@ def run(
         while t < problem.T * (1 - 1e-12):
             if loop and steps > 0:
                 t_old = t
+                tally = observer.tally(particles) if observer is not None else None
                 particles, t, done, low, high = fused.advance(particles, t, problem, steps, max_steps,
-                                                              max(1, LOOP_WORK // max(particles.n, 1)))
+                                                              max(1, LOOP_WORK // max(particles.n, 1)), tally)
                 if done:
+                    if observer is not None:
+                        observer.absorb(tally, particles)
                     steps += done
                     dt_min, dt_max = min(dt_min, low), max(dt_max, high)
                     bar.update(t - t_old)
