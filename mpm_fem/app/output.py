@@ -31,7 +31,7 @@ PARTICLE_COLUMNS = ("x", "volume", "mass", "velocity", "density", "energy", "pre
 _UMASK = os.umask(0)
 os.umask(_UMASK)
 
-PACKAGES = ("mpm-fem", "numpy", "scipy", "scikit-fem", "meshio", "matplotlib")
+PACKAGES = ("mpm-fem", "numpy", "scipy", "scikit-fem", "meshio", "matplotlib", "numba")
 
 
 def settings_hash(settings: dict, length: int = 10) -> str:
@@ -40,9 +40,28 @@ def settings_hash(settings: dict, length: int = 10) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:length]
 
 
+def cpu() -> str:
+    """The processor: its model name (Linux) and the target numba's compiler takes for it. The record
+    states it because the last digits of some tables differ between processors (``CHANGES.md``,
+    thirteenth session: the same code on an AMD EPYC and on an Intel Xeon with AVX-512)."""
+    name = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as info:
+            name = next((line.split(":", 1)[1].strip() for line in info if line.startswith("model name")), name)
+    except OSError:
+        pass
+    try:
+        from llvmlite import binding
+
+        return f"{name}; llvm target {binding.get_host_cpu_name()}"
+    except (ImportError, RuntimeError):
+        return name
+
+
 def versions() -> dict[str, str]:
-    """Python, the packages a result depends on, and the git commit of the code if known."""
-    out = {"python": platform.python_version()}
+    """Python, the packages a result depends on, the processor (:func:`cpu`) and the git commit of the
+    code if known."""
+    out = {"python": platform.python_version(), "cpu": cpu()}
     for name in PACKAGES:
         try:
             out[name] = metadata.version(name)
