@@ -33,11 +33,6 @@ CASE = {"solver": "mpm", "h": 7.8125e-05, "ppc": 16, "cfl": 0.05, "av_linear": 0
         "region_half_width": 0.02, "profiles": False, "extrema": True}
 
 
-class _PerStep:
-    """Marks the per-step counter: ``studies.sod``'s ExtremaCounter without ``tally``, which
-    ``mpm_fem.run.solve`` then calls after every step instead of counting in the loop."""
-
-
 def timed_case(case: dict, way: str) -> tuple[dict, float, float]:
     """``(run_case(case), CPU s, wall s)`` in this process, taken ``way`` (one of ``WAYS``)."""
     import mpm_fem.run.solve as solve
@@ -49,7 +44,8 @@ def timed_case(case: dict, way: str) -> tuple[dict, float, float]:
     if way == "apart":
         solve.FusedStep = partial(FusedStep, sweep=False)  # what solve.run builds: this process only
     elif way == "per step":
-        sod_study.ExtremaCounter = type("PerStepCounter", (ExtremaCounter, _PerStep), {"tally": None})
+        # without tally, solve.run calls the counter after every step instead of counting in the loop
+        sod_study.ExtremaCounter = type("PerStepCounter", (ExtremaCounter,), {"tally": None})
     cpu, wall = time.process_time(), time.perf_counter()
     result = run_case(case)
     return result, time.process_time() - cpu, time.perf_counter() - wall

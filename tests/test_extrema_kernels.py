@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.core.particles import make_particles
 from mpm_fem.fused.extrema import cells as _cells
-from mpm_fem.fused.extrema import remember, tally_step
+from mpm_fem.fused.extrema import merge, remember, tally_step
 from mpm_fem.fused.extrema import strict_extrema as _strict_extrema
 from mpm_fem.measure.regions import ExtremaCounter, _state, cells, new_extrema, strict_extrema
 from mpm_fem.measure.timing import Recorder
@@ -127,9 +127,7 @@ class _Readable:
 
     def __call__(self, step, t, old, new, state=None):
         counts = new_extrema(self.nodes, old, new, ("density", "energy"), 1e-9, self.moving_speed)
-        self.totals[0] += counts[0]
-        self.totals[1:, :3] += counts[1:, :3]
-        self.totals[1:, 3] = np.maximum(self.totals[1:, 3], counts[1:, 3])
+        merge(self.totals, counts)
         self.calls += 1
 
 

@@ -41,9 +41,9 @@ def settings_hash(settings: dict, length: int = 10) -> str:
 
 
 def cpu() -> str:
-    """The processor: its model name (Linux) and the target numba's compiler takes for it. The record
-    states it because the last digits of some tables differ between processors (``CHANGES.md``,
-    thirteenth session: the same code on an AMD EPYC and on an Intel Xeon with AVX-512)."""
+    """The processor: its model name (Linux) and the target numba's compiler takes for it, e.g.
+    ``"Intel(R) Xeon(R) Processor; llvm target emeraldrapids"``. The record states it because the last
+    digits of some tables depend on the processor the same code runs on."""
     name = platform.processor() or platform.machine()
     try:
         with open("/proc/cpuinfo") as info:
