@@ -75,7 +75,8 @@ def main(argv=None) -> None:
         futures = [pool.submit(timed_case, case, way) for way in ways]
         (r_new, cpu_new, wall_new), (r_old, cpu_old, wall_old) = (f.result() for f in futures)
     equal = without_walls(r_new) == without_walls(r_old)
-    with measured_block(args.markdown, "deep_case" if args.against == "sweep" else f"deep_case_{args.against}"):
+    block = "deep_case" if args.against == "sweep" else f"deep_case_{args.against}"
+    with measured_block(args.markdown, "deep_case", block):
         print(f"Sod, h = {args.h:g}, 16 particles per cell, the two runs at once in two processes:\n")
         print("| run | CPU s | wall s |\n|---|---:|---:|")
         print(f"| {LABELS[ways[0]]} | {cpu_new:.1f} | {wall_new:.1f} |")

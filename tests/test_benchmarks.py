@@ -75,3 +75,54 @@ def test_deep_case_rejects_a_bad_cell_size():
     proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "deep_case.py"), "--h", "0"],
                           capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert proc.returncode == 2 and "--h must lie in (0, 0.01]" in proc.stderr
+
+
+def _ledger_sample(costs, k):
+    code = ("import sys, json; sys.path.insert(0, 'benchmarks'); import numpy as np; from ledger import sample; "
+            f"print(json.dumps(sample(np.array({costs!r}, float), {k})))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    return eval(proc.stdout)
+
+
+def test_the_ledger_samples_cases_in_proportion_to_their_cost():
+    # total 14: the middles of two equal halves lie at 3.5 (the fourth case) and 10.5 (the largest)
+    assert _ledger_sample([1, 1, 1, 1, 10], 2) == [3, 4]
+    # without the large case the halves' middles are 1 and 3: the first and the third case
+    assert _ledger_sample([1, 1, 1, 1], 2) == [0, 2]
+    # more groups than cases: each case once
+    assert _ledger_sample([5, 5], 4) == [0, 1]
+
+
+def test_the_ledger_times_the_tier_now_and_before_with_equal_results():
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "ledger.py"), "--tier", "quick",
+                           "--per-study", "2", "--studies", "sod"], capture_output=True, text=True, timeout=600,
+                          cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert "every pair of results equal" in proc.stdout
+    row = next(line for line in proc.stdout.splitlines() if line.startswith("| sod |"))
+    cells = [c.strip() for c in row.split("|")[1:-1]]
+    assert cells[2] == "2"  # two cases sampled
+    now, before = float(cells[3]), float(cells[4])
+    assert now > 0 and before > 0
+    ratio = float(cells[5].split()[0])  # the ratio of the sums, each printed to 0.05 CPU-s, itself to 0.005
+    assert (before - 0.05) / (now + 0.05) - 0.005 <= ratio <= (before + 0.05) / (now - 0.05) + 0.005
+
+
+def test_the_ledger_refuses_an_unknown_study():
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "ledger.py"), "--studies", "sod,nonesuch"],
+                          capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert proc.returncode == 2 and "unknown studies ['nonesuch']" in proc.stderr
+
+
+def test_a_measured_block_names_the_script_and_its_arguments_but_not_the_page(tmp_path):
+    page = tmp_path / "page.md"
+    code = ("import sys\nsys.path.insert(0, 'benchmarks')\n"
+            f"sys.argv = ['deep_case.py', '--h', '0.005', '--markdown', {str(page)!r}, '--against', 'count']\n"
+            "from measured import measured_block\n"
+            f"with measured_block({str(page)!r}, 'deep_case', 'deep_case_count'):\n    print('| x |')\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    text = page.read_text()
+    assert "<!-- begin deep_case_count" in text and "| x |" in text
+    assert "by `python benchmarks/deep_case.py --h 0.005 --against count`" in text
