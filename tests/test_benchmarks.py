@@ -1,5 +1,6 @@
 """The benchmark scripts run and print what their docstrings promise (benchmarks/)."""
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -9,10 +10,14 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def _script(name: str, *args: str, timeout: float = 120) -> subprocess.CompletedProcess:
+    """``python benchmarks/NAME ARGS`` (or ``python -c CODE`` for ``"-c"``) run from the repository's root."""
+    target = name if name == "-c" else str(ROOT / "benchmarks" / name)
+    return subprocess.run([sys.executable, target, *args], capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+
+
 def test_fem_cost_reports_numpy_compiled_and_mpm_per_mesh():
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fem_cost.py"),
-                           "--T", "0.01", "--finest", "0.0025"],
-                          capture_output=True, text=True, timeout=600, cwd=ROOT)
+    proc = _script("fem_cost.py", "--T", "0.01", "--finest", "0.0025", timeout=600)
     assert proc.returncode == 0, proc.stderr
     rows = [line.split() for line in proc.stdout.splitlines() if line.split() and line.split()[0].startswith("0.00")]
     assert [(r[0], r[1]) for r in rows] == [(h, m) for h in ("0.005000", "0.002500") for m in ("lumped", "consistent")]
@@ -22,8 +27,7 @@ def test_fem_cost_reports_numpy_compiled_and_mpm_per_mesh():
 
 
 def test_fem_cost_rejects_bad_arguments():
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fem_cost.py"), "--T", "0"],
-                          capture_output=True, text=True, timeout=120, cwd=ROOT)
+    proc = _script("fem_cost.py", "--T", "0")
     assert proc.returncode == 2 and "--T must lie in (0, 0.5]" in proc.stderr
 
 
@@ -42,8 +46,7 @@ def test_a_generated_block_replaces_only_itself(tmp_path):
 
 
 def test_step_cost_reports_each_basis_as_a_fraction_of_the_anchor():
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "step_cost.py"), "--max", "1e3", "--repeat", "1",
-                           "--bases", "mpm", "--no-threads"], capture_output=True, text=True, timeout=600, cwd=ROOT)
+    proc = _script("step_cost.py", "--max", "1e3", "--repeat", "1", "--bases", "mpm", "--no-threads", timeout=600)
     assert proc.returncode == 0, proc.stderr
     cells = lambda line: [c.strip() for c in line.strip("|").split("|")]  # noqa: E731
     rows = [cells(line) for line in proc.stdout.splitlines() if line.startswith("| mpm | 1e+03")]
@@ -56,15 +59,13 @@ def test_step_cost_reports_each_basis_as_a_fraction_of_the_anchor():
 
 
 def test_step_cost_rejects_an_unknown_basis():
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "step_cost.py"), "--bases", "fem"],
-                          capture_output=True, text=True, timeout=120, cwd=ROOT)
+    proc = _script("step_cost.py", "--bases", "fem")
     assert proc.returncode == 2 and "unknown bases" in proc.stderr
 
 
 @pytest.mark.parametrize(("against", "ratio_of"), [("sweep", "apart / swept"), ("count", "per step / swept")])
 def test_deep_case_runs_the_case_two_ways_and_finds_the_same_result(against, ratio_of):
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "deep_case.py"), "--h", "0.005",
-                           "--against", against], capture_output=True, text=True, timeout=600, cwd=ROOT)
+    proc = _script("deep_case.py", "--h", "0.005", "--against", against, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert "the two results equal" in proc.stdout
     ratio = float(proc.stdout.split(f"CPU time {ratio_of}: ")[1].split(";")[0])
@@ -72,17 +73,16 @@ def test_deep_case_runs_the_case_two_ways_and_finds_the_same_result(against, rat
 
 
 def test_deep_case_rejects_a_bad_cell_size():
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "deep_case.py"), "--h", "0"],
-                          capture_output=True, text=True, timeout=120, cwd=ROOT)
+    proc = _script("deep_case.py", "--h", "0")
     assert proc.returncode == 2 and "--h must lie in (0, 0.01]" in proc.stderr
 
 
 def _ledger_sample(costs, k):
     code = ("import sys, json; sys.path.insert(0, 'benchmarks'); import numpy as np; from ledger import sample; "
             f"print(json.dumps(sample(np.array({costs!r}, float), {k})))")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    proc = _script("-c", code)
     assert proc.returncode == 0, proc.stderr
-    return eval(proc.stdout)
+    return json.loads(proc.stdout)
 
 
 def test_the_ledger_samples_cases_in_proportion_to_their_cost():
@@ -95,9 +95,7 @@ def test_the_ledger_samples_cases_in_proportion_to_their_cost():
 
 
 def test_the_ledger_times_the_tier_now_and_before_with_equal_results():
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "ledger.py"), "--tier", "quick",
-                           "--per-study", "2", "--studies", "sod"], capture_output=True, text=True, timeout=600,
-                          cwd=ROOT)
+    proc = _script("ledger.py", "--tier", "quick", "--per-study", "2", "--studies", "sod", timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert "every pair of results equal" in proc.stdout
     row = next(line for line in proc.stdout.splitlines() if line.startswith("| sod |"))
@@ -110,8 +108,7 @@ def test_the_ledger_times_the_tier_now_and_before_with_equal_results():
 
 
 def test_the_ledger_refuses_an_unknown_study():
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "ledger.py"), "--studies", "sod,nonesuch"],
-                          capture_output=True, text=True, timeout=120, cwd=ROOT)
+    proc = _script("ledger.py", "--studies", "sod,nonesuch")
     assert proc.returncode == 2 and "unknown studies ['nonesuch']" in proc.stderr
 
 
@@ -121,7 +118,7 @@ def test_a_measured_block_names_the_script_and_its_arguments_but_not_the_page(tm
             f"sys.argv = ['deep_case.py', '--h', '0.005', '--markdown', {str(page)!r}, '--against', 'count']\n"
             "from measured import measured_block\n"
             f"with measured_block({str(page)!r}, 'deep_case', 'deep_case_count'):\n    print('| x |')\n")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    proc = _script("-c", code)
     assert proc.returncode == 0, proc.stderr
     text = page.read_text()
     assert "<!-- begin deep_case_count" in text and "| x |" in text
