@@ -33,19 +33,31 @@ CASE = {"solver": "mpm", "h": 7.8125e-05, "ppc": 16, "cfl": 0.05, "av_linear": 0
         "region_half_width": 0.02, "profiles": False, "extrema": True}
 
 
-def timed_case(case: dict, way: str) -> tuple[dict, float, float]:
-    """``(run_case(case), CPU s, wall s)`` in this process, taken ``way`` (one of ``WAYS``)."""
+_ORIGINAL = {}  # this process's FusedStep and ExtremaCounter as solve.run and studies.sod take them
+
+
+def run_as(*before: str) -> None:
+    """Make this process's runs take issue 47's kernel except for the changes named in ``before``, which run
+    as they did before it: ``"apart"``, pass 2 and the next pass 1 apart (``FusedStep(sweep=False)``, what
+    ``solve.run`` builds); ``"per step"``, Sod's extrema counter called after every step (it has no ``tally``,
+    so ``solve.run`` steps one at a time instead of counting in the loop). No names: the kernel as it is."""
     import mpm_fem.run.solve as solve
     import studies.sod as sod_study
-    from mpm_fem.fused.step import FusedStep
-    from mpm_fem.measure.regions import ExtremaCounter
+
+    if not _ORIGINAL:
+        _ORIGINAL.update(step=solve.FusedStep, counter=sod_study.ExtremaCounter)
+    solve.FusedStep, sod_study.ExtremaCounter = _ORIGINAL["step"], _ORIGINAL["counter"]
+    if "apart" in before:
+        solve.FusedStep = partial(_ORIGINAL["step"], sweep=False)
+    if "per step" in before:
+        sod_study.ExtremaCounter = type("PerStepCounter", (_ORIGINAL["counter"],), {"tally": None})
+
+
+def timed_case(case: dict, way: str) -> tuple[dict, float, float]:
+    """``(run_case(case), CPU s, wall s)`` in this process, taken ``way`` (one of ``WAYS``)."""
     from studies.sod import run_case
 
-    if way == "apart":
-        solve.FusedStep = partial(FusedStep, sweep=False)  # what solve.run builds: this process only
-    elif way == "per step":
-        # without tally, solve.run calls the counter after every step instead of counting in the loop
-        sod_study.ExtremaCounter = type("PerStepCounter", (ExtremaCounter,), {"tally": None})
+    run_as(*(() if way == "swept" else (way,)))
     cpu, wall = time.process_time(), time.perf_counter()
     result = run_case(case)
     return result, time.process_time() - cpu, time.perf_counter() - wall

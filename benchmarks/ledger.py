@@ -35,31 +35,14 @@ import os
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
-from functools import partial
 
 import numpy as np
-from deep_case import without_walls  # benchmarks/deep_case.py, beside this script
+from deep_case import run_as, without_walls  # benchmarks/deep_case.py, beside this script
 from measured import add_markdown_option, measured_block  # benchmarks/measured.py
 
 from mpm_fem.app.study import STUDIES
 
 WAYS = ("now", "before")
-_ORIGINAL = {}  # this process's FusedStep and ExtremaCounter as the studies import them
-
-
-def take_way(way: str) -> None:
-    """Make this process run its next cases ``way`` (this process only)."""
-    import mpm_fem.run.solve as solve
-    import studies.sod as sod_study
-    from mpm_fem.measure.regions import ExtremaCounter
-
-    if not _ORIGINAL:
-        _ORIGINAL.update(step=solve.FusedStep, counter=sod_study.ExtremaCounter)
-    solve.FusedStep, sod_study.ExtremaCounter = _ORIGINAL["step"], _ORIGINAL["counter"]
-    if way == "before":
-        solve.FusedStep = partial(_ORIGINAL["step"], sweep=False)  # what solve.run builds
-        # without tally, solve.run calls the counter after every step instead of counting in the loop
-        sod_study.ExtremaCounter = type("PerStepCounter", (ExtremaCounter,), {"tally": None})
 
 
 def pin(cpu: int) -> None:
@@ -71,7 +54,7 @@ def pin(cpu: int) -> None:
 
 def timed(way: str, fn, case: dict) -> tuple[dict, float]:
     """``(fn(case), CPU seconds of this process)``, the case run ``way``."""
-    take_way(way)
+    run_as(*(("apart", "per step") if way == "before" else ()))
     cpu = time.process_time()
     result = fn(case)
     return result, time.process_time() - cpu

@@ -123,3 +123,14 @@ def test_a_measured_block_names_the_script_and_its_arguments_but_not_the_page(tm
     text = page.read_text()
     assert "<!-- begin deep_case_count" in text and "| x |" in text
     assert "by `python benchmarks/deep_case.py --h 0.005 --against count`" in text
+
+
+def test_the_kernel_before_issue_47_is_switched_on_and_off_per_change():
+    code = ("import sys\nsys.path.insert(0, 'benchmarks')\nfrom deep_case import run_as\n"
+            "import mpm_fem.run.solve as solve, studies.sod as sod\nfrom mpm_fem.fused.step import FusedStep\n"
+            "run_as('apart', 'per step')\n"
+            "assert solve.FusedStep.keywords == {'sweep': False} and sod.ExtremaCounter.tally is None\n"
+            "run_as('per step')\nassert solve.FusedStep is FusedStep and sod.ExtremaCounter.tally is None\n"
+            "run_as()\nassert solve.FusedStep is FusedStep and sod.ExtremaCounter.tally is not None\n")
+    proc = _script("-c", code)
+    assert proc.returncode == 0, proc.stderr
