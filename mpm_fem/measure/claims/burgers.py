@@ -9,7 +9,7 @@ from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY
 from mpm_fem.measure.claims.identification import source_matching
 from mpm_fem.measure.claims.mass import MASS_RULE, mass_finding
 from mpm_fem.measure.claims.rows import FIRST_ORDER, FLOOR_ORDER, GROWTH_ORDER, num, saturation, select, span
-from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, SATURATION, lumping_claim, ppc_claim
+from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, SATURATION, ppc_claim
 from mpm_fem.measure.claims.stages import SUBSETS
 from mpm_fem.measure.schema import BURGERS_DIAGNOSIS, BURGERS_LUMPING, BURGERS_ORDERS, BURGERS_PPC
 from mpm_fem.measure.seeds import side
@@ -237,6 +237,5 @@ def _c15_burgers(t: Tables) -> Finding:
             if labels.get(r["method"]) == label:
                 at.setdefault(r["h"], {})[r["mass"]] = num(r, "L2")
         ratios[label] = {h: m["consistent"] / m["lumped"] for h, m in at.items() if {"consistent", "lumped"} <= set(m)}
-    second = lumping_claim(ratios, judged=("MPM calculated a", "MPM exact a")) if rows else (
-        "not measured", f"no table `{BURGERS_LUMPING.name}.csv`")
-    return mass_finding(t, "burgers", second, "Burgers")
+    return mass_finding(t, "burgers", ratios if rows else None, ("MPM calculated a", "MPM exact a"), "Burgers",
+                        f"no table `{BURGERS_LUMPING.name}.csv`")

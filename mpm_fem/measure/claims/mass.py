@@ -11,16 +11,20 @@ cell, layout and seed where recorded), with ``v(S)`` the error with the stages o
 
 Per norm, mesh and particles per cell the runs (layouts and seeds) give ranges. A case is a *source*
 when ``alone`` is at least SOURCE_SHARE over every run, *separable* when ``tangled`` is at most
-ATTRIBUTABLE over every run. The consistent/lumped comparison (:mod:`.shared`) is a second reading.
+ATTRIBUTABLE over every run. The consistent/lumped comparison (:mod:`.shared`) is a second reading;
+it decides where the direct one cannot: when no case is separable (the direct reading is swamped by
+the interactions) and the consistent mass raises every judged method's error on every mesh (ratio
+above 1 / LUMPING_BAND: :func:`~.shared.consistent_raises`), lumping compensates: ``differs``.
 """
 
 from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Finding, Tables
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables
 from mpm_fem.measure.claims.rows import select
 from mpm_fem.measure.claims.rules import rule
+from mpm_fem.measure.claims.shared import LUMPING_BAND, consistent_raises, lumping_claim
 from mpm_fem.measure.claims.stages import SUBSETS, decomposition, runs
 from mpm_fem.measure.spread import Spread, spread
 
@@ -33,7 +37,10 @@ MASS_RULE = (f"from the error budget (budget/subsets, the point-mass basis): the
              f"interactions with the other stages at most {ATTRIBUTABLE:g}x its own effect -> separable. A separable "
              "source on every norm, mesh and particles per cell -> confirmed; a source on some, or a source whose "
              "interactions exceed it -> partly; alone it lowers the error on every case -> differs (it "
-             "compensates); otherwise -> refuted. The consistent/lumped comparison beside, as a second reading")
+             "compensates); otherwise -> refuted. The consistent/lumped comparison beside, as a second reading, which "
+             "decides where the direct reading is swamped (separable on no case): the consistent mass raising the "
+             f"error of every judged method on every mesh (consistent/lumped above {1 / LUMPING_BAND:.3g}) -> "
+             "differs (lumping compensates)")
 
 
 def mass_stage(rows: list[dict]) -> dict[tuple, dict[str, Spread]]:
@@ -61,42 +68,67 @@ _SECOND_READING = {CONFIRMED: "with the consistent mass the error is smaller on 
                    REFUTED: "and the consistent mass leaves the error as it is"}
 
 
-def mass_finding(t: Tables, problem: str, second: tuple[str, str], sentence_name: str) -> Finding:
-    """C15 on ``problem`` from the budget's mass stage, with the consistent/lumped reading ``second``
-    (its verdict and evidence) beside."""
+def mass_finding(t: Tables, problem: str, ratios: dict[str, dict[str, float]] | None, judged: tuple[str, ...],
+                 sentence_name: str, missing: str = "") -> Finding:
+    """C15 on ``problem`` from the budget's mass stage, with the consistent/lumped ``ratios`` (``{method:
+    {h: consistent / lumped error}}``, the methods of ``judged`` judged; ``None`` when their table is
+    missing, said by ``missing``) as the second reading (module docstring)."""
+    second = lumping_claim(ratios, judged) if ratios is not None else (NOT_MEASURED, missing)
     second_verdict, second_evidence = second
+    raised = consistent_raises(ratios or {}, judged)
     cases = mass_stage(select(t[SUBSETS], problem=problem))
     if not cases:
-        return Finding("not measured", f"no complete budget of the {BASIS} basis on {problem}")
+        return Finding(NOT_MEASURED, f"no complete budget of the {BASIS} basis on {problem}")
     source = {k: c["alone"].above(SOURCE_SHARE) for k, c in cases.items()}
     separable = {k: c["tangled"].below(ATTRIBUTABLE) or c["tangled"].hi == ATTRIBUTABLE for k, c in cases.items()}
     lowers = all(c["alone"].below(0) for c in cases.values())
     n, hits = len(cases), sum(source.values())
-    verdict = (CONFIRMED if hits == n and all(separable.values()) else PARTLY if hits else
-               DIFFERS if lowers else REFUTED)
+    swamped_and_raised = not any(separable.values()) and raised.everywhere
+    verdict = (CONFIRMED if hits == n and all(separable.values()) else DIFFERS if swamped_and_raised else
+               PARTLY if hits else DIFFERS if lowers else REFUTED)
     table = tuple({"norm": norm, "h": f"{h:g}", "ppc": ppc or "study's", "mass alone / all-MPM":
                    _text(c["alone"], ".2f"), "its interactions / its effect": _text(c["tangled"], ".2g"),
                    "Shapley / gap": _text(c["shapley"], ".2f")} for (norm, h, ppc), c in cases.items())
     alone = [c["alone"] for c in cases.values()]
     tangled = [c["tangled"] for c in cases.values()]
     lo, hi = min(a.lo for a in alone), max(a.hi for a in alone)
-    t_lo, t_hi = min(x.lo for x in tangled), max(x.hi for x in tangled)
-    evidence = (f"the mass stage alone adds {lo:.0%} to {hi:.0%} of the all-MPM error to the all-exact one (a "
-                f"source on {hits} of {n} norms and meshes, at least {SOURCE_SHARE:.0%}); its interactions are "
-                f"{t_lo:.2g}-{t_hi:.2g}x its own effect (separable at most {ATTRIBUTABLE:g}x on "
-                f"{sum(separable.values())} of {n}); "
-                + "; ".join(f"{r['norm']} h = {r['h']}: alone {r['mass alone / all-MPM']}, interactions "
-                            f"{r['its interactions / its effect']}, Shapley {r['Shapley / gap']}" for r in table)
-                + f". Second reading, consistent against lumped mass ({second_verdict}): {second_evidence}")
+    t_lo, t_hi = _times(min(x.lo for x in tangled)), _times(max(x.hi for x in tangled))
+    methods = " and ".join(judged)
+    raised_text = (f"on {raised.meshes} of {raised.total} meshes the consistent mass raises MPM's error "
+                   f"{raised.lo:.2f}-{raised.hi:.2f}x ({methods}, each above {1 / LUMPING_BAND:.3g}x): lumping "
+                   "compensates")
+    direct = (f"the mass stage alone adds {lo:.0%} to {hi:.0%} of the all-MPM error to the all-exact one (a "
+              f"source on {hits} of {n} norms and meshes, at least {SOURCE_SHARE:.0%}); its interactions are "
+              f"{t_lo}-{t_hi}x its own effect (separable at most {ATTRIBUTABLE:g}x on "
+              f"{sum(separable.values())} of {n}); "
+              + "; ".join(f"{r['norm']} h = {r['h']}: alone {r['mass alone / all-MPM']}, interactions "
+                          f"{r['its interactions / its effect']}, Shapley {r['Shapley / gap']}" for r in table))
+    second_text = f"Second reading, consistent against lumped mass ({second_verdict}): {second_evidence}"
+    if swamped_and_raised and verdict == DIFFERS:
+        evidence = (f"{raised_text}; the direct reading is swamped (separable on none of {n} norms and meshes): "
+                    f"{direct}. {second_text}")
+        sentence = (f"on {sentence_name} the consistent mass raises MPM's error {raised.lo:.2f} to {raised.hi:.2f} "
+                    f"times on {raised.meshes} of {raised.total} meshes: lumping compensates; in the error budget "
+                    f"the lumped-mass FE stage's own effect ({lo:.0%} to {hi:.0%} of MPM's error) is swamped by "
+                    f"its interactions with the other stages ({t_lo} to {t_hi} times that effect)")
+        return Finding(verdict, evidence, sentence, table)
+    evidence = f"{direct}. {second_text}"
     if hits:
         sentence = (f"on {sentence_name} the lumped-mass FE stage alone adds {lo:.0%} to {hi:.0%} of MPM's error to "
-                    f"the error with every stage exact, but its interactions with the other stages are {t_lo:.2g} "
-                    f"to {t_hi:.2g} times that effect")
+                    f"the error with every stage exact, but its interactions with the other stages are {t_lo} "
+                    f"to {t_hi} times that effect")
     else:
         sentence = (f"on {sentence_name} the lumped-mass FE stage alone changes the all-exact error by {lo:.0%} to "
                     f"{hi:.0%} of MPM's error")
     sentence += "; " + _SECOND_READING.get(second_verdict, "consistent against lumped mass not measured")
+    if raised.meshes and second_verdict == PARTLY:
+        sentence += f" (on {raised.meshes} of {raised.total} meshes the consistent mass raises MPM's error)"
     return Finding(verdict, evidence, sentence, table)
+
+
+def _times(x: float) -> str:
+    """A factor in two significant digits, a whole number from 100 on (``6.3``, ``650``)."""
+    return f"{x:.0f}" if abs(x) >= 100 else f"{x:.2g}"
 
 
 def _text(s: Spread, fmt: str) -> str:

@@ -4,6 +4,7 @@ lumping), each judged per problem (``sod/ppc``, ``burgers/ppc``; ``sod/mass``, `
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 from mpm_fem.measure.claims.base import DIFFERS, REFUTED
 from mpm_fem.measure.claims.rows import count_verdict, saturation, span
@@ -62,6 +63,36 @@ def lumping_claim(ratios: dict[str, dict[str, float]], judged: tuple[str, ...]) 
     return verdict, ("; ".join(text(m) for m in judged if m in ratios)
                      + (f"; beside, on the same meshes: {'; '.join(text(m) for m in beside)}" if beside else "")
                      + f"; source of error below {LUMPING_BAND:g}, compensating above {1 / LUMPING_BAND:.3g}")
+
+
+class Raised(NamedTuple):
+    """Where the consistent mass raises the judged methods' error: on ``meshes`` of ``total`` meshes every
+    judged method's consistent/lumped ratio is above 1 / LUMPING_BAND (lumping compensates there), the
+    judged ratios spanning ``lo`` to ``hi``."""
+
+    meshes: int
+    total: int
+    lo: float
+    hi: float
+
+    @property
+    def everywhere(self) -> bool:
+        return self.total > 0 and self.meshes == self.total
+
+
+def consistent_raises(ratios: dict[str, dict[str, float]], judged: tuple[str, ...]) -> Raised:
+    """:class:`Raised` of ``ratios`` (``{method: {h: consistent / lumped error}}``) over the methods of
+    ``judged``: a mesh counts when every judged method has a finite ratio there and each is above
+    1 / LUMPING_BAND."""
+    present = [m for m in judged if ratios.get(m)]
+    at: dict[float, list[float]] = {}
+    for m in present:
+        for h, x in ratios[m].items():
+            at.setdefault(float(h), []).append(x)
+    measured = {h: xs for h, xs in at.items() if len(xs) == len(present) and all(math.isfinite(x) for x in xs)}
+    values = [x for xs in measured.values() for x in xs]
+    raised = sum(all(x > 1 / LUMPING_BAND for x in xs) for xs in measured.values())
+    return Raised(raised, len(measured), min(values, default=math.nan), max(values, default=math.nan))
 
 
 LUMPING_RULE = (f"the error with the consistent mass over that with the lumped mass, all else equal, on every mesh: "

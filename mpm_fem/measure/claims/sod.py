@@ -22,7 +22,7 @@ from mpm_fem.measure.claims.identification import source_matching
 from mpm_fem.measure.claims.mass import MASS_RULE, mass_finding
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, saturation, select, span
 from mpm_fem.measure.claims.rules import rule
-from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, SATURATION, lumping_claim, ppc_claim
+from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, SATURATION, ppc_claim
 from mpm_fem.measure.claims.stages import SUBSETS
 from mpm_fem.measure.regions import REGION_NAMES
 from mpm_fem.measure.schema import (
@@ -418,9 +418,8 @@ def _c15_sod(t: Tables) -> Finding:
               for label, key in (("MPM nodes", "mpm_consistent_over_lumped_nodes"),
                                  ("MPM particles", "mpm_consistent_over_lumped_particles"),
                                  ("FEM", "fem_consistent_over_lumped"))}
-    second = lumping_claim(ratios, judged=("MPM nodes", "MPM particles")) if rows else (
-        "not measured", f"no table `{SOD_MASS.name}.csv`")
-    return mass_finding(t, "sod", second, "Sod")
+    return mass_finding(t, "sod", ratios if rows else None, ("MPM nodes", "MPM particles"), "Sod",
+                        f"no table `{SOD_MASS.name}.csv`")
 
 
 def _growth(rows: list[dict], convergence: list[dict], key: str) -> tuple[Spread, float, float]:
