@@ -15,6 +15,7 @@ The layers are the folders:
    e. ``mpm_fem/fused/`` (the compiled step);
    f. ``mpm_fem/run/`` (the time loop, choosing between the numpy and the compiled step);
    g. ``mpm_fem/problems/`` (the problem set-ups, which run through the time loop);
+   h. ``mpm_fem/plane/`` (the 2D package: its grid, tensor bases, step, problems and runs);
 3. measurements: ``mpm_fem/measure/``;
 4. the application: ``mpm_fem/app/``;
 5. the studies: ``studies/``.
@@ -46,6 +47,7 @@ FOLDERS = {
     "mpm_fem.fused": (2, 4),
     "mpm_fem.run": (2, 5),
     "mpm_fem.problems": (2, 6),
+    "mpm_fem.plane": (2, 7),
     "mpm_fem.measure": (3, 0),
     "mpm_fem.app": (4, 0),
     "studies": (5, 0),
@@ -149,7 +151,7 @@ def test_layer_two_packages_import_in_their_order():
     assert not found, "\n".join(found)
     order = sorted((p for p in FOLDERS if FOLDERS[p][0] == 2), key=FOLDERS.get)
     assert order[:3] == ["mpm_fem.core.grid", "mpm_fem.bases", "mpm_fem.core"], order
-    assert order[-3:] == ["mpm_fem.fused", "mpm_fem.run", "mpm_fem.problems"], order
+    assert order[-4:] == ["mpm_fem.fused", "mpm_fem.run", "mpm_fem.problems", "mpm_fem.plane"], order
 
 
 def test_the_order_check_finds_the_time_loop_in_the_core():

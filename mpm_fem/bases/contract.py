@@ -117,6 +117,8 @@ class Basis(ABC):
     uniform         whether the basis needs a uniform grid (:meth:`check_grid` raises otherwise)
     kernels         the compiled pieces (:class:`Kernels`), or ``None`` for a basis that runs on the numpy
                     step only (a researcher's first version, :mod:`mpm_fem.bases.plugins`)
+    tensor          whether the tensor product of its rows per axis is its 2D form (:mod:`mpm_fem.plane.bases`;
+                    a particle-domain basis then averages over a rectangle); default True
     """
 
     name: str
@@ -128,6 +130,7 @@ class Basis(ABC):
     degree: int
     uniform: bool
     kernels: Kernels | None
+    tensor: bool = True
 
     @abstractmethod
     def shape(self, grid: Grid, x: np.ndarray, volume: np.ndarray | None = None) -> Shape:

@@ -1,0 +1,116 @@
+"""The exact forms of the 2D stages (the equations of :mod:`mpm_fem.exact_stages.stage`), on a
+manufactured solution given in reference coordinates (``baselines.exact.solids``).
+
+The fields are Lagrangian, ``f(X, t)``; a grid node sits at a spatial position, so its exact value
+is that of the material point there: ``X`` solving ``X + u(X, t) = x_i`` (:func:`reference_of`,
+Newton's method with ``F``). The symplectic Euler step's times: the velocity at ``t - dt/2``, the
+acceleration and the stress at ``t``, so
+
+    v*_i = v(X(x_i, t - dt/2), t - dt/2),     a*_i = a(X(x_i, t), t).
+
+Projection exact: the integrals over the current body by a quadrature in the reference one,
+points ``X_q`` and weights ``w_q`` (scikit-fem's Gauss rule of order ``order`` on the mesh cells,
+or the caller's), whose points act as particles at ``x_q = X_q + u(X_q, t)``:
+
+    m*_i = sum_q w_q rho_0 S_i(x_q),    P*_i = sum_q w_q rho_0 v(X_q, t - dt/2) S_i(x_q),
+    f*_i = - sum_q w_q J_q sigma(X_q, t) grad S_i(x_q) + sum_q w_q rho_0 b(X_q, t) S_i(x_q),
+
+with ``S_i`` the grid functions of the basis (the hats for GIMP, the B-splines for the B-spline
+averaged over the particle). The integrand is smooth on each reference cell up to the kinks of
+``S_i`` in the current configuration: the rule is exact to the accuracy of the Gauss rule across
+those kinks (they move by ``|u|`` from the cell edges). Interpolation exact at the particles:
+``v(X_p, t - dt/2)``, ``a(X_p, t)`` and the velocity gradient ``L = dF/dt F^-1`` at ``t + dt/2``
+(``dF/dt`` by the central difference of step ``DT_FD`` of the period, round-off about 1e-10 of ``L``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from skfem import Basis as SkBasis
+from skfem import ElementQuad1
+
+from mpm_fem.bases import get
+from mpm_fem.bases.contract import Basis
+from mpm_fem.plane.bases import plane_shape, tensor_basis
+from mpm_fem.plane.grid import PlaneGrid
+from mpm_fem.plane.step import consistent_solver, lumped
+
+NEWTON_STEPS = 30
+DT_FD = 1e-6  # the time step of the central difference of F, as a share of the period
+
+
+def _vector(f, X: np.ndarray, t: float) -> np.ndarray:
+    return np.ascontiguousarray(np.asarray(f(X[:, 0], X[:, 1], t), dtype=float).T)
+
+
+def reference_of(solution, x: np.ndarray, t: float, tol: float = 1e-13) -> np.ndarray:
+    """The reference positions ``X`` (n, 2) with ``X + u(X, t) = x`` (n, 2), by Newton's method
+    from ``X = x``; raises ``ArithmeticError`` if it does not converge."""
+    X = x.copy()
+    scale = 1.0 + np.abs(x).max()
+    for _ in range(NEWTON_STEPS):
+        r = X + _vector(solution.displacement, X, t) - x
+        if np.abs(r).max() <= tol * scale:
+            return X
+        F = np.asarray(solution.deformation_gradient(X[:, 0], X[:, 1], t), dtype=float).reshape(-1, 2, 2)
+        X = X - np.linalg.solve(F, r[:, :, None])[:, :, 0]
+    raise ArithmeticError(f"the reference position of a grid node did not converge at t={t:.6g} "
+                          f"(residual {np.abs(r).max():.3g})")
+
+
+def cell_quadrature(grid: PlaneGrid, order: int = 6) -> tuple[np.ndarray, np.ndarray]:
+    """scikit-fem's Gauss rule of ``order`` on the mesh cells: points (n_q, 2), weights (n_q,)."""
+    sk = SkBasis(grid.mesh, ElementQuad1(), intorder=order)
+    x = np.asarray(sk.global_coordinates().value)
+    return np.column_stack((x[0].ravel(), x[1].ravel())), np.asarray(sk.dx).ravel()
+
+
+@dataclass(frozen=True, eq=False)
+class ExactStages2:
+    """The exact stages of :func:`mpm_fem.plane.step.step` on ``solution`` with the reference
+    quadrature ``points`` (n_q, 2), ``weights`` (n_q,) (module docstring)."""
+
+    solution: object
+    points: np.ndarray = field(repr=False)
+    weights: np.ndarray = field(repr=False)
+
+    def projection(self, grid: PlaneGrid, basis: str | Basis, t: float, dt: float):
+        """``(m*_i, P*_i, f*_i, solver)``: the quadrature's sums, and ``solver(kind)`` giving the
+        lumped (``m*_i``) or consistent (the points' mass matrix) solve of its data."""
+        s, X, w = self.solution, self.points, self.weights
+        functions = get(tensor_basis(basis).grid_functions)
+        x = X + _vector(s.displacement, X, t)
+        F = np.asarray(s.deformation_gradient(X[:, 0], X[:, 1], t), dtype=float).reshape(-1, 2, 2)
+        J = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
+        shape = plane_shape(grid, functions, x)
+        mass = w * s.material.rho0
+        m_i = shape.scatter(mass)
+        P_i = shape.scatter(mass[:, None] * _vector(s.velocity, X, t - 0.5 * dt))
+        sigma = np.asarray(s.stress(X[:, 0], X[:, 1], t), dtype=float).reshape(-1, 2, 2)
+        f_i = -shape.scatter_gradient((w * J)[:, None, None] * sigma)
+        f_i += shape.scatter(mass[:, None] * _vector(s.body_force, X, t))
+
+        def solver(kind):
+            if kind == "consistent":
+                return consistent_solver(shape, mass)
+            return lambda rhs: lumped(rhs, m_i)
+
+        return m_i, P_i, f_i, solver
+
+    def nodal(self, grid: PlaneGrid, t: float, dt: float):
+        """``(v*_i, a*_i)`` (n_nodes, 2) at the nodes (module docstring)."""
+        s, x = self.solution, grid.nodes
+        half = t - 0.5 * dt
+        return _vector(s.velocity, reference_of(s, x, half), half), _vector(s.acceleration, reference_of(s, x, t), t)
+
+    def at_particles(self, X: np.ndarray, t: float, dt: float):
+        """``(v(X_p, t - dt/2), a(X_p, t), L(X_p, t + dt/2))``: (n_p, 2), (n_p, 2), (n_p, 2, 2)."""
+        s = self.solution
+        half = t + 0.5 * dt
+        e = DT_FD * s.period
+        F = lambda tau: np.asarray(s.deformation_gradient(X[:, 0], X[:, 1], tau), float).reshape(-1, 2, 2)  # noqa: E731
+        rate = (F(half + e) - F(half - e)) / (2 * e)
+        L = np.einsum("pab,pbc->pac", rate, np.linalg.inv(F(half)))
+        return _vector(s.velocity, X, t - 0.5 * dt), _vector(s.acceleration, X, t), L

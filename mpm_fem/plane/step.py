@@ -1,0 +1,192 @@
+"""One explicit 2D MPM step, update stress last (USL), symplectic Euler: the numpy reference.
+
+The particles carry ``v_p^{n-1/2}`` (the run starts from the exact ``v(X_p, -dt/2)``), ``x_p^n``,
+``F_p^n``; one step from ``t_n`` to ``t_n + dt``:
+
+    m_i = sum_p m_p S_ip,      P_i = sum_p m_p v_p S_ip,
+    f_i = - sum_p V_p sigma_p G_ip + sum_p m_p b(X_p, t_n) S_ip         (internal + body force)
+    v_i = P_i / m_i,  a_i = f_i / m_i            (lumped; consistent: M v = P, M a = f with the
+                                                  particle mass matrix M_ij = sum_p m_p S_ip S_jp)
+    v_i^+ = v_i + dt a_i
+    v_p <- flip (v_p + dt sum_i S_ip a_i) + (1 - flip) sum_i S_ip v_i^+      (FLIP/PIC blend)
+    x_p <- x_p + dt sum_i S_ip v_i^+
+    F_p <- (I + dt sum_i v_i^+ (x) G_ip) F_p,   V_p = det(F_p) V_p^0,   sigma_p: :mod:`~mpm_fem.plane.model`
+
+(``S_ip``, ``G_ip``: :mod:`~mpm_fem.plane.bases`). A node without mass gets ``v_i = a_i = 0``.
+The stage switches are the 1D :class:`~mpm_fem.core.step.Stages` (``mass``, ``projection``,
+``interpolation``, ``acceleration``, ``flip``; ``refine`` is the time loop's), their exact forms
+those of :mod:`mpm_fem.exact_stages.stage` as :mod:`mpm_fem.plane.exact` gives them; the 1D-only
+switches (``scheme``, ``xpic``, ``reconstruct``, ``volume``, ``transfer``, ``volume_rate``) must keep
+their defaults. The basis is the ``basis`` argument (``stages.basis`` is not read). No Python loop
+runs over particles or nodes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Protocol
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+from mpm_fem.bases.contract import Basis
+from mpm_fem.core.step import Stages
+from mpm_fem.plane.bases import PlaneShape, plane_shape
+from mpm_fem.plane.grid import PlaneGrid
+from mpm_fem.plane.model import check_orientation, determinant, neo_hookean_stress, update_deformation
+from mpm_fem.plane.state import PlaneParticles
+
+#: the 1D switches the 2D step does not offer, with the value they must keep
+ONE_D_ONLY = {"scheme": "usl", "xpic": 0, "reconstruct": "none", "volume": "carried", "transfer": "flip",
+              "volume_rate": "point"}
+BodyForce = Callable[[np.ndarray, np.ndarray, float], np.ndarray]  # (X, Y, t) -> (2, n) per unit mass
+
+
+def check_stages(stages: Stages) -> None:
+    """Raise ``ValueError`` for a switch the 2D step does not take (module docstring)."""
+    for name, value in ONE_D_ONLY.items():
+        if getattr(stages, name) != value:
+            raise ValueError(f"the 2D step runs with {name}={value!r}, got {getattr(stages, name)!r}")
+
+
+@dataclass(frozen=True, eq=False)
+class PlaneGridState:
+    """What the grid held in one step: ``mass`` (n_nodes,), ``velocity`` ``v_i``, ``acceleration``
+    ``a_i`` and ``new_velocity`` ``v_i^+`` (n_nodes, 2)."""
+
+    mass: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    new_velocity: np.ndarray
+
+
+class ExactPlane(Protocol):
+    """The exact stages as the step reaches them (:class:`mpm_fem.plane.exact.ExactStages2`)."""
+
+    def projection(self, grid: PlaneGrid, basis: Basis, t: float, dt: float) -> tuple: ...
+
+    def nodal(self, grid: PlaneGrid, t: float, dt: float) -> tuple: ...
+
+    def at_particles(self, X: np.ndarray, t: float, dt: float) -> tuple: ...
+
+
+def lumped(rhs: np.ndarray, m_i: np.ndarray) -> np.ndarray:
+    """``rhs_i / m_i`` (n_nodes, 2) where ``m_i > 0``, else 0."""
+    out = np.zeros_like(rhs)
+    np.divide(rhs, m_i[:, None], out=out, where=(m_i > 0)[:, None])
+    return out
+
+
+def consistent_solver(shape: PlaneShape, mass: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    """``rhs -> M^{-1} rhs`` (n_nodes, 2) with the particle mass matrix ``M = S^T diag(m) S``
+    factorised once (sparse LU) on the nodes with mass; the others get 0."""
+    S = shape.matrix()
+    M = (S.T @ sp.diags(mass) @ S).tocsc()
+    active = np.flatnonzero(M.diagonal() > 0)
+    try:
+        lu = splu(M[active][:, active].tocsc())
+    except RuntimeError as error:
+        raise FloatingPointError("the consistent particle mass matrix is singular (too few particles in "
+                                 "some cells); use the lumped mass or more particles per cell") from error
+
+    def solve(rhs):
+        out = np.zeros_like(rhs)
+        out[active] = lu.solve(np.ascontiguousarray(rhs[active]))
+        if not np.all(np.isfinite(out)):
+            raise FloatingPointError("the consistent particle mass matrix is singular; use the lumped mass")
+        return out
+
+    return solve
+
+
+def step_with_grid(state: PlaneParticles, grid: PlaneGrid, basis: str | Basis, material, dt: float, t: float,
+                   body_force: BodyForce | None, stages: Stages = Stages(),
+                   exact: ExactPlane | None = None) -> tuple[PlaneParticles, PlaneGridState]:
+    """:func:`step`, also returning the grid's :class:`PlaneGridState`."""
+    check_stages(stages)
+    if stages.uses_exact_fields or stages.acceleration == "exact":
+        if exact is None:
+            raise ValueError("the exact projection, mass, interpolation and acceleration stages need the "
+                             "problem's exact solution (exact=...)")
+    shape = plane_shape(grid, basis, state.x, state.lengths)
+    m = state.mass
+    m_i = shape.scatter(m)
+    P_i = shape.scatter(m[:, None] * state.v)
+    f_i = -shape.scatter_gradient(state.volume[:, None, None] * neo_hookean_stress(state.F, material.mu, material.lam))
+    if body_force is not None:
+        f_i += shape.scatter(m[:, None] * np.asarray(body_force(state.X[:, 0], state.X[:, 1], t)).T)
+
+    if stages.mass == "consistent":
+        solve = consistent_solver(shape, m)
+    else:
+        solve = lambda rhs: lumped(rhs, m_i)  # noqa: E731
+    star = exact.nodal(grid, t, dt) if exact is not None and _needs_nodal(stages) else None
+    if stages.projection == "exact" or stages.mass == "exact":
+        quad = exact.projection(grid, basis, t, dt)  # (m*, P*, f*, solver of the quadrature's mass)
+    if stages.projection == "exact" and stages.mass == "exact":
+        v_i, a_i = star[0].copy(), star[1].copy()
+    elif stages.projection == "exact":
+        solve_q = quad[3](stages.mass)
+        v_i, a_i = solve_q(quad[1]), solve_q(quad[2])
+    elif stages.mass == "exact":  # mpm_fem.exact_stages.stage: v*_i + [solve(MPM data) - solve(exact data)]
+        v_i = star[0] + lumped(P_i, m_i) - lumped(quad[1], quad[0])
+        a_i = star[1] + lumped(f_i, m_i) - lumped(quad[2], quad[0])
+    else:
+        v_i, a_i = solve(P_i), solve(f_i)
+    if stages.acceleration == "exact":
+        a_i = star[1].copy()
+    active = (m_i > 0)[:, None]
+    v_i, a_i = np.where(active, v_i, 0.0), np.where(active, a_i, 0.0)
+    v_new = v_i + dt * a_i
+
+    if stages.interpolation == "exact":  # f_p = f*(X_p) + sum_i S_ip (f_i - f*_i)
+        v_star, a_star, L_star = exact.at_particles(state.X, t, dt)
+        star_new = star[0] + dt * star[1]
+        acceleration = a_star + shape.gather(a_i - star[1])
+        moving = v_star + dt * a_star + shape.gather(v_new - star_new)
+        L = L_star + shape.gather_gradient(v_new - star_new)
+    else:
+        acceleration, moving = shape.gather(a_i), shape.gather(v_new)
+        L = shape.gather_gradient(v_new)
+    v = stages.flip * (state.v + dt * acceleration) + (1.0 - stages.flip) * moving
+    x = state.x + dt * moving
+    F = update_deformation(state.F, L, dt)
+    J = determinant(F)
+    check_orientation(J, x)
+    new = state.replace(x=x, v=v, F=F, volume=J * state.volume0)
+    return new, PlaneGridState(m_i, v_i, a_i, v_new)
+
+
+def _needs_nodal(stages: Stages) -> bool:
+    """Whether a stage reads the exact nodal ``v*_i``, ``a*_i``."""
+    return (stages.mass == "exact" or stages.interpolation == "exact" or stages.acceleration == "exact")
+
+
+def step(state: PlaneParticles, grid: PlaneGrid, basis: str | Basis, material, dt: float, t: float,
+         body_force: BodyForce | None, stages: Stages = Stages(), exact: ExactPlane | None = None) -> PlaneParticles:
+    """Advance the particles from ``t`` to ``t + dt`` (module docstring).
+
+    Parameters
+    ----------
+    state : PlaneParticles
+        The particles at ``t`` (velocity at ``t - dt/2``).
+    grid : PlaneGrid
+    basis : str or Basis
+        The 1D basis whose tensor product is the 2D basis.
+    material
+        ``mu``, ``lam`` (Pa): the neo-Hookean constants.
+    dt, t : float
+        Time step and time (s).
+    body_force : callable or None
+        ``b(X, Y, t) -> (2, n)`` per unit mass at the reference positions.
+    stages : Stages
+        The stage switches; ``exact`` serves their exact forms.
+
+    Returns
+    -------
+    PlaneParticles
+        The particles at ``t + dt`` (velocity at ``t + dt/2``). Raises
+        :class:`~mpm_fem.plane.model.InversionError` for a particle with ``det F <= 0``.
+    """
+    return step_with_grid(state, grid, basis, material, dt, t, body_force, stages, exact)[0]
