@@ -3,14 +3,18 @@
     S_ip = N((x_p - x_i)/h),    G_ip = N'((x_p - x_i)/h) / h,
     N(r) = 3/4 - r^2 for |r| <= 1/2,   (3/2 - |r|)^2 / 2 for 1/2 <= |r| <= 3/2,   0 beyond,
 
-at the nodes ``c - 1 .. c + 2`` of the particle's cell ``c``. The spline of the ghost node outside
-each end is folded into the end node, which keeps the partition of unity on the whole grid.
-``S_ip`` and ``G_ip`` are continuous in ``x_p``: a particle crossing a node sees no jump in
-``dS/dx`` (slides: the jump in the third derivative of ``x_p``). ``int S_i dx`` by two-point Gauss
-rules on each half cell, exact for the piecewise quadratics (an end node with its folded ghost
-integrates to ``25h/48``, its neighbour to ``47h/48``). The compiled row on a grid uniform to
-round-off takes the three splines around the nearest node ``n = floor(s + 1/2)``, ``s = (x - x_0)/h``
-(equal to the numpy rows to round-off); elsewhere the numpy arithmetic, bit for bit.
+at the nodes ``c - 1 .. c + 2`` of the particle's cell ``c`` (a ghost column outside the grid
+holds 0). At the walls the first and last three functions are the end functions of the open knot
+vector ``0, 0, 0, 3/2, 5/2, ..., n - 3/2, n, n, n`` (:mod:`mpm_fem.bases.ends`): the functions sum
+to 1 on the whole grid and only the end node's is nonzero at a wall, so a velocity that is 0 at the
+wall nodes interpolates to 0 at the walls. ``S_ip`` and ``G_ip`` are continuous in ``x_p``: a
+particle crossing a node sees no jump in ``dS/dx`` (slides: the jump in the third derivative of
+``x_p``). ``int S_i dx`` by two-point Gauss rules on each half cell, exact for the piecewise
+quadratics (the end node integrates to ``h/2``, the next two to ``5h/6`` and ``7h/6``, the others
+to ``h``: :data:`~mpm_fem.bases.ends.QUADRATIC_TOTAL`). The compiled row on a grid uniform to round-off takes
+the three splines around the nearest node ``n = floor(s + 1/2)``, ``s = (x - x_0)/h``, and within
+four cells of a wall the row's four functions from :func:`_spline` (equal to the numpy rows to
+round-off); elsewhere the numpy arithmetic, bit for bit. A grid needs at least five cells.
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ from numba import njit
 from mpm_fem.bases.cells import locate as _locate
 from mpm_fem.bases.cells import scaled
 from mpm_fem.bases.contract import Basis, Kernels
+from mpm_fem.bases.ends import clamp_rows, quadratic_end, require_cells
 from mpm_fem.bases.shape import Shape, locate
 
 if TYPE_CHECKING:
@@ -49,12 +54,15 @@ def require_uniform(grid: Grid) -> None:
 def bspline_shape(grid: Grid, x: np.ndarray) -> Shape:
     """The quadratic B-spline's ``S_ip``, ``G_ip`` (module docstring)."""
     require_uniform(grid)
+    require_cells(grid, 2, "quadratic B-spline")
     h = grid.h
     cell, xi = locate(grid, x)
     offsets = np.arange(-1, 3)
     r = xi[:, None] - offsets  # (x_p - x_{c+k}) / h for k = -1, 0, 1, 2
     S, dS = quadratic_bspline(r)
-    nodes = np.clip(cell[:, None] + offsets, 0, grid.n_nodes - 1)
+    j = cell[:, None] + offsets
+    S, dS = clamp_rows(2, j, (cell + xi)[:, None], grid.n_cells, S, dS)
+    nodes = np.clip(j, 0, grid.n_nodes - 1)
     return Shape(nodes, S, dS / h[0], grid.n_nodes, cell)
 
 
@@ -81,6 +89,48 @@ def _nearest(s, top):
 
 
 @njit(cache=True, inline="always")
+def _uniform(r):
+    """``N(r)`` and ``N'(r)`` of :func:`quadratic_bspline` at one ``r``."""
+    a = abs(r)
+    if a <= 0.5:
+        return 0.75 - r * r, -2.0 * r
+    if a < 1.5:
+        return 0.5 * ((1.5 - a) * (1.5 - a)), -(1.5 - a) * (1.0 if r > 0 else (-1.0 if r < 0 else 0.0))
+    return 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def _end_column(j, s, n, r):
+    """Column ``j`` of a row at ``s`` on ``n`` cells, value and slope per unit ``s``: the uniform
+    spline at ``r = s - j`` (:func:`_uniform`), but 0 for a ghost, the end function for ``j <= 2``
+    or ``j >= n - 2`` (:func:`~mpm_fem.bases.ends.clamp_rows`, the same floats)."""
+    if j < 0 or j > n:
+        return 0.0, 0.0
+    if j <= 2:
+        return quadratic_end(j, s)
+    if j >= n - 2:
+        v, g = quadratic_end(n - j, n - s)
+        return v, -g
+    return _uniform(r)
+
+
+@njit(cache=True, inline="always")
+def _near_wall(c, top):
+    """Whether the row ``c - 1 .. c + 2`` of cell ``c`` holds an end function or a ghost (``top``: the last node)."""
+    return c <= 3 or c >= top - 4
+
+
+@njit(cache=True, inline="always")
+def _spline(c, s, top):
+    """The row ``c - 1 .. c + 2`` at ``s`` near a wall, value and slope per unit ``s`` of each column."""
+    v0, g0 = _end_column(c - 1, s, top, s - (c - 1))
+    v1, g1 = _end_column(c, s, top, s - c)
+    v2, g2 = _end_column(c + 1, s, top, s - (c + 1))
+    v3, g3 = _end_column(c + 2, s, top, s - (c + 2))
+    return v0, v1, v2, v3, g0, g1, g2, g3
+
+
+@njit(cache=True, inline="always")
 def _row(nodes, h, inv_spacing, x, V, row, S, G):
     """``S_ip``, ``G_ip`` of one particle into ``row``, ``S``, ``G`` (``V`` unused): the nodes
     ``c - 1 .. c + 2``; its cell and 4."""
@@ -93,22 +143,20 @@ def _row(nodes, h, inv_spacing, x, V, row, S, G):
         for k in range(4):
             row[k] = min(max(c + k - 1, 0), n_nodes - 1)
             S[k], G[k] = 0.0, 0.0
+        if _near_wall(c, n_nodes - 1):
+            S[0], S[1], S[2], S[3], G[0], G[1], G[2], G[3] = _spline(c, s, n_nodes - 1)
+            for k in range(4):
+                G[k] = G[k] * inv_spacing
+            return c, 4
         S[first], S[first + 1], S[first + 2] = w_l, w_0, w_r
         G[first], G[first + 1], G[first + 2] = ((t - 0.5) * inv_spacing, (-2.0 * t) * inv_spacing,
                                                 (t + 0.5) * inv_spacing)
         return c, 4
-    # a grid not uniform to round-off: the formula at the nodes c-1 .. c+2, ghosts folded into the ends
+    # a grid not uniform to round-off: the formula at the nodes c-1 .. c+2, the end functions at the walls
     c, xi = _locate(nodes, inv_spacing, x)
+    s = c + xi
     for k in range(4):
-        r = xi - (k - 1)
-        a = abs(r)
-        if a <= 0.5:
-            value, slope = 0.75 - r * r, -2.0 * r
-        elif a < 1.5:
-            value = 0.5 * ((1.5 - a) * (1.5 - a))
-            slope = -(1.5 - a) * (1.0 if r > 0 else (-1.0 if r < 0 else 0.0))
-        else:
-            value, slope = 0.0, 0.0
+        value, slope = _end_column(c + k - 1, s, n_nodes - 1, xi - (k - 1))
         row[k] = min(max(c + k - 1, 0), n_nodes - 1)
         S[k] = value
         G[k] = slope / h[0, 0]
@@ -127,8 +175,8 @@ def _project(geometry, cloud, gas_force, store, lo, hi, stored, buf):
     """Pass 1 over particles ``lo .. hi-1`` on a uniform grid (:class:`~mpm_fem.bases.contract.Kernels`):
     the row from :func:`_nearest` (three nodes around the nearest node ``n``), and the three nodes'
     sums held in registers while consecutive particles share ``n`` (each node's terms still added
-    in particle order). A particle whose nearest node is an end node (its ghost spline folded into
-    it) adds into ``buf`` directly."""
+    in particle order). A particle within four cells of a wall (:func:`_near_wall`: end functions
+    or ghosts in its row) adds its row of :func:`_spline` into ``buf`` directly."""
     nodes, h, inv_spacing = geometry
     x, V, m, v, p = cloud
     rows, S, G, cell = stored
@@ -143,36 +191,34 @@ def _project(geometry, cloud, gas_force, store, lo, hi, stored, buf):
                 outside = q
             continue
         s, c = scaled(nodes, inv_spacing, x[q])
-        n, t, w_l, w_0, w_r = _nearest(s, top)
-        g_l, g_0, g_r = (t - 0.5) * inv_spacing, (-2.0 * t) * inv_spacing, (t + 0.5) * inv_spacing
         cell[q] = c
-        if store:  # the row c-1 .. c+2, as _row stores it
-            first = n - c
-            for k in range(4):
-                rows[q, k], S[q, k], G[q, k] = min(max(c + k - 1, 0), top), 0.0, 0.0
-            S[q, first], S[q, first + 1], S[q, first + 2] = w_l, w_0, w_r
-            G[q, first], G[q, first + 1], G[q, first + 2] = g_l, g_0, g_r
         mq = m[q]
         mv = mq * v[q]
         Vp = V[q] * p[q] if gas_force else 0.0
-        if n == 0 or n == top:  # a ghost folded into the end node: straight into buf
+        if _near_wall(c, top):  # end functions or ghosts in the row c-1 .. c+2: straight into buf
             if held >= 0:
                 buf[0, held - 1], buf[1, held - 1], buf[2, held - 1] = m0, P0, F0
                 buf[0, held], buf[1, held], buf[2, held] = m1, P1, F1
                 buf[0, held + 1], buf[1, held + 1], buf[2, held + 1] = m2, P2, F2
                 held = -1
-            i_l, i_r = max(n - 1, 0), min(n + 1, top)
-            buf[0, i_l] += w_l * mq
-            buf[1, i_l] += w_l * mv
-            buf[0, n] += w_0 * mq
-            buf[1, n] += w_0 * mv
-            buf[0, i_r] += w_r * mq
-            buf[1, i_r] += w_r * mv
-            if gas_force:
-                buf[2, i_l] += g_l * Vp
-                buf[2, n] += g_0 * Vp
-                buf[2, i_r] += g_r * Vp
+            e = _spline(c, s, top)
+            for k in range(4):
+                i, w, g = min(max(c + k - 1, 0), top), e[k], e[4 + k] * inv_spacing
+                if store:
+                    rows[q, k], S[q, k], G[q, k] = i, w, g
+                buf[0, i] += w * mq
+                buf[1, i] += w * mv
+                if gas_force:
+                    buf[2, i] += g * Vp
             continue
+        n, t, w_l, w_0, w_r = _nearest(s, top)
+        g_l, g_0, g_r = (t - 0.5) * inv_spacing, (-2.0 * t) * inv_spacing, (t + 0.5) * inv_spacing
+        if store:  # the row c-1 .. c+2, as _row stores it
+            first = n - c
+            for k in range(4):
+                rows[q, k], S[q, k], G[q, k] = c + k - 1, 0.0, 0.0
+            S[q, first], S[q, first + 1], S[q, first + 2] = w_l, w_0, w_r
+            G[q, first], G[q, first + 1], G[q, first + 2] = g_l, g_0, g_r
         if n != held:
             if held >= 0:
                 buf[0, held - 1], buf[1, held - 1], buf[2, held - 1] = m0, P0, F0
@@ -205,11 +251,17 @@ def _move(nodes, h, inv_spacing, x, a_i, v_n):
     ``c``, ``sum S a``, ``sum S v``, ``sum G v``."""
     top = nodes.size - 1
     s, c = scaled(nodes, inv_spacing, x)
+    if _near_wall(c, top):  # the row c-1 .. c+2 of :func:`_spline`, columns left to right
+        w0, w1, w2, w3, g0, g1, g2, g3 = _spline(c, s, top)
+        i0, i3 = max(c - 1, 0), min(c + 2, top)
+        return (c, w0 * a_i[i0] + w1 * a_i[c] + w2 * a_i[c + 1] + w3 * a_i[i3],
+                w0 * v_n[i0] + w1 * v_n[c] + w2 * v_n[c + 1] + w3 * v_n[i3],
+                (g0 * inv_spacing) * v_n[i0] + (g1 * inv_spacing) * v_n[c] + (g2 * inv_spacing) * v_n[c + 1]
+                + (g3 * inv_spacing) * v_n[i3])
     n, t, w_l, w_0, w_r = _nearest(s, top)
-    i_l, i_r = max(n - 1, 0), min(n + 1, top)
-    return (c, w_l * a_i[i_l] + w_0 * a_i[n] + w_r * a_i[i_r], w_l * v_n[i_l] + w_0 * v_n[n] + w_r * v_n[i_r],
-            ((t - 0.5) * inv_spacing) * v_n[i_l] + ((-2.0 * t) * inv_spacing) * v_n[n]
-            + ((t + 0.5) * inv_spacing) * v_n[i_r])
+    return (c, w_l * a_i[n - 1] + w_0 * a_i[n] + w_r * a_i[n + 1], w_l * v_n[n - 1] + w_0 * v_n[n] + w_r * v_n[n + 1],
+            ((t - 0.5) * inv_spacing) * v_n[n - 1] + ((-2.0 * t) * inv_spacing) * v_n[n]
+            + ((t + 0.5) * inv_spacing) * v_n[n + 1])
 
 
 class BSpline(Basis):
@@ -226,3 +278,7 @@ class BSpline(Basis):
 
     def integrals(self, grid):
         return spline_integrals(grid)
+
+    def check_grid(self, grid):
+        super().check_grid(grid)
+        require_cells(grid, 2, self.name)

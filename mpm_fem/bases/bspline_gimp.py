@@ -4,13 +4,16 @@
     G_ip = 1/V_p int N'((x - x_i)/h)/h chi_p(x) dx = (N(r_+) - N(r_-)) / (x_+ - x_-),
 
 with ``x_+- = x_p +- V_p/2`` cut at the ends of the grid (as for GIMP), ``r_+- = (x_+- - x_i)/h``,
-``N`` the quadratic B-spline (:mod:`mpm_fem.bases.bspline`) and ``M`` its antiderivative. The ghost
-splines outside each end fold into the end nodes: the partition of unity holds on the whole grid. A
-row spans the splines ``j = c_- - 1 .. c_+ + 2``: 5 columns to start, wider as a domain spans more
-cells. ``int S_i dx`` is the B-splines' (:func:`~mpm_fem.bases.bspline.spline_integrals`). The
-compiled row on a grid uniform to round-off evaluates ``M`` and ``N`` at each end of the domain only
-in the three pieces that do not vanish (:func:`_pieces`), the formula's floats; elsewhere the numpy
-arithmetic, bit for bit.
+``N`` the quadratic B-spline (:mod:`mpm_fem.bases.bspline`) and ``M`` its antiderivative; at the
+walls the end functions of the open knot vector and their antiderivatives (:mod:`mpm_fem.bases.ends`,
+a ghost column outside the grid 0): the partition of unity holds on the whole grid, and at a wall
+only the end node's function is nonzero. A row spans the splines ``j = c_- - 1 .. c_+ + 2``: 5
+columns to start, wider as a domain spans more cells. ``int S_i dx`` is the B-splines'
+(:func:`~mpm_fem.bases.bspline.spline_integrals`). The compiled row on a grid uniform to round-off
+evaluates ``M`` and ``N`` at each end of the domain only in the three pieces that do not vanish
+(:func:`_pieces`), the formula's floats; elsewhere the numpy arithmetic, bit for bit; a column of
+an end function (or a ghost) from :func:`~mpm_fem.bases.ends.quadratic_end_pair`. A grid needs at
+least five cells.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from mpm_fem.bases.bspline import quadratic_bspline, require_uniform, spline_int
 from mpm_fem.bases.cells import DOMAIN_FIELDS, domain_ends, put, stored_row
 from mpm_fem.bases.cells import locate as _locate
 from mpm_fem.bases.contract import Basis, Kernels
+from mpm_fem.bases.ends import clamp_antiderivatives, quadratic_end_pair, require_cells
 from mpm_fem.bases.shape import Shape, particle_domains
 
 if TYPE_CHECKING:
@@ -42,16 +46,19 @@ def bspline_integral(r: np.ndarray) -> np.ndarray:
 def bspline_gimp_shape(grid: Grid, x: np.ndarray, volume: np.ndarray) -> Shape:
     """The particle-domain B-spline's ``S_ip``, ``G_ip`` (module docstring)."""
     require_uniform(grid)
+    require_cells(grid, 2, "particle-domain B-spline")
     h = grid.h
     cell, lo, hi, c_lo, c_hi = particle_domains(grid, x, volume, "the particle-domain B-spline needs")
     a = grid.nodes[0]
     k = int((c_hi - c_lo).max()) + 4
     j = c_lo[:, None] - 1 + np.arange(k)  # spline centres x_j = a + j h, ghosts at j = -1 and n_nodes
-    r_lo = (lo[:, None] - a) / h[0] - j
-    r_hi = (hi[:, None] - a) / h[0] - j
+    y_lo, y_hi = (lo[:, None] - a) / h[0], (hi[:, None] - a) / h[0]
+    r_lo, r_hi = y_lo - j, y_hi - j
     length = (hi - lo)[:, None]
-    S = h[0] * (bspline_integral(r_hi) - bspline_integral(r_lo)) / length
-    G = (quadratic_bspline(r_hi)[0] - quadratic_bspline(r_lo)[0]) / length
+    M_lo, N_lo = clamp_antiderivatives(j, y_lo, grid.n_cells, bspline_integral(r_lo), quadratic_bspline(r_lo)[0])
+    M_hi, N_hi = clamp_antiderivatives(j, y_hi, grid.n_cells, bspline_integral(r_hi), quadratic_bspline(r_hi)[0])
+    S = h[0] * (M_hi - M_lo) / length
+    G = (N_hi - N_lo) / length
     nodes = np.clip(j, 0, grid.n_nodes - 1)
     return Shape(nodes, S, G, grid.n_nodes, cell)
 
@@ -134,19 +141,31 @@ def _scalars(a, b, top_cell, inv_spacing, x, V):
 
 
 @njit(cache=True, inline="always")
+def _end_node(j, last):
+    """Whether the spline of node ``j`` is a ghost or an end function (``last``: the last node)."""
+    return j <= 2 or j >= last - 2
+
+
+@njit(cache=True, inline="always")
 def _column(k, inv_spacing, last, D):
     """Node, ``S`` and ``G`` of column ``k`` from :func:`_scalars`' ``D`` (``last``: the last node):
     the spline of node ``j = c_- - 1 + k`` (ghosts folded into the end nodes), ``S = (M(s_+ - j) -
     M(s_- - j)) / (s_+ - s_-)``, ``G = (N(s_+ - j) - N(s_- - j)) / (x_+ - x_-)``, ``M`` and ``N`` at
     each end from its pieces (:func:`_piece`: the columns where each end's three splines start are
-    ``d_-`` and ``d_+ + c_+ - c_-``)."""
+    ``d_-`` and ``d_+ + c_+ - c_-``); a ghost's or an end function's column from
+    :func:`~mpm_fem.bases.ends.quadratic_end_pair`."""
     (_, _, c_lo, c_hi, s_lo, s_hi, inv_w, d_lo, Ml_lo, M0_lo, Mr_lo, Nl_lo, N0_lo, Nr_lo,
      d_hi, Ml_hi, M0_hi, Mr_hi, Nl_hi, N0_hi, Nr_hi) = D
+    j = c_lo - 1 + k
+    if _end_node(j, last):
+        M_hi, N_hi = quadratic_end_pair(j, s_hi, last)
+        M_lo, N_lo = quadratic_end_pair(j, s_lo, last)
+        return min(max(j, 0), last), (M_hi - M_lo) * inv_w, (N_hi - N_lo) * (inv_w * inv_spacing)
     d_hi += c_hi - c_lo
     S = (_piece(k - d_hi, _M_TOP, Ml_hi, M0_hi, Mr_hi) - _piece(k - d_lo, _M_TOP, Ml_lo, M0_lo, Mr_lo)) * inv_w
     G = ((_piece(k - d_hi, 0.0, Nl_hi, N0_hi, Nr_hi) - _piece(k - d_lo, 0.0, Nl_lo, N0_lo, Nr_lo))
          * (inv_w * inv_spacing))
-    return min(max(c_lo - 1 + k, 0), last), S, G
+    return j, S, G
 
 
 @njit(cache=True, inline="always")
@@ -203,8 +222,14 @@ def _row(nodes, h, inv_spacing, x, V, row, S, G):
         j = c_lo - 1 + k
         r_lo, r_hi = y_lo - j, y_hi - j
         row[k] = min(max(j, 0), n_nodes - 1)
-        S[k] = h0 * (_bspline_antiderivative(r_hi) - _bspline_antiderivative(r_lo)) / length
-        G[k] = (_bspline_value(r_hi) - _bspline_value(r_lo)) / length
+        if _end_node(j, n_nodes - 1):
+            M_hi, N_hi = quadratic_end_pair(j, y_hi, n_nodes - 1)
+            M_lo, N_lo = quadratic_end_pair(j, y_lo, n_nodes - 1)
+        else:
+            M_hi, N_hi = _bspline_antiderivative(r_hi), _bspline_value(r_hi)
+            M_lo, N_lo = _bspline_antiderivative(r_lo), _bspline_value(r_lo)
+        S[k] = h0 * (M_hi - M_lo) / length
+        G[k] = (N_hi - N_lo) / length
     return c, c_hi - c_lo + 4
 
 
@@ -237,7 +262,7 @@ def _project(geometry, cloud, gas_force, store, lo, hi, stored, buf):
         mq = m[q]
         mv = mq * v[q]
         Vp = V[q] * p[q]
-        if K == 5:
+        if K == 5 and not (_end_node(D.c_lo - 1, last) or _end_node(D.c_lo + 3, last)):
             S0, S1, S2, S3, S4, G0, G1, G2, G3, G4 = _five_columns(inv_spacing, D)
             first = D.c_lo - 1  # the columns' nodes c_- - 1 + j, ghosts folded into the end nodes
             put(q, 0, min(max(first, 0), last), S0, G0, (mq, mv, Vp), gas_force, rows, S, G, buf)
@@ -268,3 +293,7 @@ class BSplineGimp(Basis):
 
     def integrals(self, grid):
         return spline_integrals(grid)
+
+    def check_grid(self, grid):
+        super().check_grid(grid)
+        require_cells(grid, 2, self.name)
