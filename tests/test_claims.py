@@ -150,3 +150,62 @@ def test_e4_refutes_a_folder_of_mixed_tiers(tier):
     assert_flips("E4", mixed, current)
     verdict, evidence = judge("E4", mixed)
     assert verdict == "refuted" and f"other tiers: sod/extrema ({tier})" in evidence
+
+
+# ---------------------------------------------------------------- E6: only what lies out of sample counts
+
+MODEL_TABLE = "defect/model"
+
+
+def _exact_model(tables, **where):
+    """``tables`` whose defect model equals the measured error on the rows matching ``where``."""
+    return mutate(tables, MODEL_TABLE, where, model_L1=lambda r: r["measured_L1"], ratio=1.0)
+
+
+def test_e6_counts_only_the_other_particle_count_and_meshes_two_beyond_the_fit():
+    """On the committed tables the judged settings are those at 8 per cell (the other particle count): the
+    4-per-cell rows checked one mesh beyond the fit are shown, not counted. Without the remedies' table, a
+    model exact on every row is confirmed; one 8-per-cell row three times off makes it partly, while the
+    one-mesh-beyond rows five times off leave it confirmed."""
+    from mpm_fem.measure.claims.model import FIT_PPC
+
+    bare = {k: v for k, v in TABLES.items() if k != "remedies/errors"}
+    found = claim_named("E6").finding(TABLES)
+    assert {r["setting"].split(", ")[1] for r in found.table} == {"8 ppc"}, found.table
+    assert found.evidence.startswith("out of sample (another particle count than the fit's, or 2 meshes or more "
+                                     "beyond it) the model predicts within 2x with the measured trend on 0 of 4 "
+                                     "settings"), found.evidence
+    assert "in sample or one mesh beyond the fit, not counted: burgers, 4 ppc, jittered at h = 0.01" in found.evidence
+    exact = _exact_model(bare)
+    near = mutate(exact, MODEL_TABLE, {"ppc": FIT_PPC, "role": "checked"}, ratio=5.0,
+                  model_L1=lambda r: 5 * float(r["measured_L1"]))
+    off = mutate(exact, MODEL_TABLE, {"ppc": 8, "problem": "sod", "layout": "regular", "h": 0.00125}, ratio=3.0,
+                 model_L1=lambda r: 3 * float(r["measured_L1"]))
+    assert_flips("E6", off, near)
+    assert judge("E6", near)[1].startswith("out of sample (another particle count than the fit's, or 2 meshes or "
+                                          "more beyond it) the model predicts within 2x with the measured trend on "
+                                          "4 of 4 settings")
+    assert "not on sod, 8 ppc, regular (1.00..3.00, trend 3 of 3)" in judge("E6", off)[1]
+
+
+def test_e6_a_mesh_two_beyond_the_fit_is_out_of_sample_and_the_next_one_is_not():
+    from mpm_fem.measure.claims.model import out_of_sample
+
+    def row(ppc, h, role):
+        return {"problem": "sod", "ppc": str(ppc), "h": str(h), "role": role}
+
+    meshes = (0.01, 0.005, 0.0025, 0.00125, 0.000625)
+    rows = [row(4, h, "fitted" if h >= 0.0025 else "checked") for h in meshes] + [row(8, h, "checked") for h in meshes]
+    marks = dict(zip(((int(r["ppc"]), float(r["h"])) for r in rows), out_of_sample(rows), strict=True))
+    assert [marks[4, h] for h in meshes] == [False, False, False, False, True]
+    assert all(marks[8, h] for h in meshes)
+
+
+def test_e6_reports_an_order_on_the_bound_of_its_search_as_a_bound():
+    """Sod's fitted p = 2.00 is the search's upper bound: the evidence says p >= 2.00; Burgers' 1.70 is inside."""
+    from mpm_fem.measure.claims.model import ORDERS
+
+    evidence = judge("E6", TABLES)[1]
+    assert f"sod p >= {ORDERS[-1]:.2f}, on the search's upper bound" in evidence and "burgers p = 1.70" in evidence
+    inside = mutate(TABLES, "defect/model_fit", {"problem": "sod"}, p=1.5)
+    assert "sod p = 1.50" in judge("E6", inside)[1]

@@ -15,7 +15,7 @@ import math
 
 from mpm_fem.app.markdown import figure, prose
 from mpm_fem.measure.claims import num, ppc_needed, span
-from mpm_fem.measure.claims.model import remedy_rows
+from mpm_fem.measure.claims.model import order_text, out_of_sample, remedy_rows
 from mpm_fem.measure.tables import Tables
 
 QUANTITY = {"sod": "density", "burgers": "velocity"}
@@ -143,28 +143,35 @@ def model_paragraph(tables: Tables, captions: dict) -> list[str]:
     if not model or not fit:
         return []
     parts = []
+    out = {id(r) for r, m in zip(model, out_of_sample(model), strict=True) if m}
     for problem in ("sod", "burgers"):
         rows = [r for r in fit if r["problem"] == problem]
-        checked = [num(r, "ratio") for r in model if r["problem"] == problem and r["role"] == "checked"]
+        checked = [num(r, "ratio") for r in model if r["problem"] == problem and id(r) in out]
+        near = [num(r, "ratio") for r in model if r["problem"] == problem and r["role"] == "checked"
+                and id(r) not in out]
         if not rows or not checked:
             continue
         laws = "; ".join(f"{r['layout']} d = {num(r, 'D'):.3g} h^{num(r, 'q'):.2f} n^-{num(r, 'r'):.2f}" for r in rows)
         needed = "; ".join(f"{r['layout']} " + ", ".join(f"{ppc_needed(r, h):.3g} at h = {h:g}" for h in NEEDED_AT)
                            for r in rows)
         parts.append(f"On {problem.capitalize()} ({rows[0]['driver']}): {laws}; E = {num(rows[0], 'A'):.3g} "
-                     f"h^{num(rows[0], 'p'):.2f} + {num(rows[0], 'B'):.3g} d; on the checked rows model / measured "
-                     f"{span(checked)}. Particles per cell it needs to keep converging: {needed}.")
+                     f"h^{num(rows[0], 'p'):.2f} + {num(rows[0], 'B'):.3g} d ({order_text(rows)}); out of sample "
+                     f"model / measured {span(checked)}"
+                     + (f", on the mesh next to the fit (not counted) {span(near)}" if near else "")
+                     + f". Particles per cell it needs to keep converging: {needed}.")
     lines = ["", "#### A closed-form model of the growth (E6)", ""]
     lines += prose(
         "The defect's mean per step, d, is fitted as a power law in h and in the particles per cell n on every run "
         "(a defect, not an error), and the particle error as a converging term plus the accumulated defect, "
-        "E = A h^p + B d, on the coarse meshes at 4 per cell only; the finer meshes and 8 per cell are predicted "
-        "(`defect/model.csv`, E6). " + " ".join(parts) + " The defect falls slowly with the particles per cell "
+        "E = A h^p + B d, on the coarse meshes at 4 per cell only; 8 per cell and the meshes two refinements or "
+        "more beyond the fit are predicted out of sample, and only those count (`defect/model.csv`, E6). "
+        + " ".join(parts) + " The defect falls slowly with the particles per cell "
         "(r below one) and grows under refinement (q below zero), so the particles needed to keep converging "
         "grow faster than 1/h: the model says point-mass MPM cannot be kept converging by adding particles at "
         "any practical count on these layouts. Those counts are extrapolations far beyond the 4 and 8 per cell "
         "the model was fitted and checked on, and its converging term's order p is the fit's choice among the "
-        "orders tried (`MODEL_P_MIN` to `MODEL_P_MAX` in the rule book): read them as orders of magnitude. "
+        "orders tried (`MODEL_P_MIN` to `MODEL_P_MAX` in the rule book; on a bound, a bound): read them as orders of "
+        "magnitude. "
         + _remedy_sentence(tables))
     if "model.png" in captions:
         lines += figure("defect", "model.png", captions)

@@ -20,16 +20,23 @@ converges; ``B d`` is the defect's accumulation, which grows under refinement wh
 Particles per cell needed: the error keeps converging down to ``h`` (``dE/dh > 0``) while
 ``A p h^(p-1) > B D |q| h^(q-1) n^-r``, i.e. ``n > (B D |q| h^(q-p) / (A p))^(1/r)`` (:func:`ppc_needed`).
 
-E6 per setting (problem, particles per cell, layout class), on the checked rows: it *holds* when
-``model / measured`` lies within ``PREDICTION_FACTOR`` on every checked row and the model's trend
-(error down or up between successive meshes whose finer one is checked) has the measured sign on
-every seed. The same model says which remedies help (:func:`remedy_rows`): the growth is the point-mass
+E6 counts as predicted only the *out-of-sample* checked rows (:func:`out_of_sample`): those at another
+particle count than the fitted rows', and those at the fitting count whose mesh lies at least
+``MODEL_OUT_MESHES`` refinements beyond the finest fitted mesh; the mesh next to the fit is a one-step
+extrapolation, shown but not counted. Per setting (problem, particles per cell, layout class), on its
+out-of-sample rows: it *holds* when ``model / measured`` lies within ``PREDICTION_FACTOR`` on every
+such row and the model's trend (error down or up between successive meshes whose finer one is out of
+sample) has the measured sign on every seed. A fitted ``p`` on a bound of the orders tried is reported
+as a bound (``p >= MODEL_P_MAX``): the fit would move it further (on Sod the converging term only
+shapes the coarsest mesh, and a wider search moves p to its new bound with the predictions unchanged).
+
+The same model says which remedies help (:func:`remedy_rows`): the growth is the point-mass
 quadrature's defect, so a remedy that changes the quadrature (a particle-domain basis of the registry, or
 the reconstructed stress) stops it and one that does not (a transfer, the volume, a point basis) leaves it;
 checked against ``remedies/errors`` (each remedy's main series, as E5 reads it: its least successive
 particle L1 order at least ``GROWTH_ORDER``: it stops). Every judged setting holds and every remedy
 agrees -> confirmed; some of either -> partly; none -> refuted; no setting with ``MODEL_MIN_CHECKED``
-checked rows -> not measured.
+out-of-sample rows -> not measured.
 """
 
 from __future__ import annotations
@@ -55,6 +62,7 @@ FIT_PPC = int(rule("MODEL_FIT_PPC"))
 FIT_H = {"sod": rule("MODEL_FIT_H_SOD"), "burgers": rule("MODEL_FIT_H_BURGERS")}
 ORDERS = np.linspace(rule("MODEL_P_MIN"), rule("MODEL_P_MAX"), int(rule("MODEL_P_STEPS")))
 MIN_CHECKED = int(rule("MODEL_MIN_CHECKED"))
+OUT_MESHES = int(rule("MODEL_OUT_MESHES"))
 
 
 class Law(NamedTuple):
@@ -156,24 +164,59 @@ def _settings(rows: list[dict]) -> dict:
     return groups
 
 
-def setting_holds(rows: list[dict]) -> tuple[bool, float, float, int, int]:
+def out_of_sample(rows: list[dict]) -> list[bool]:
+    """Per ``defect/model`` row, whether it is out of sample (module docstring): a checked row at a particle
+    count no fitted row of its problem has, or one whose mesh lies at least OUT_MESHES refinements (of its
+    problem's meshes) beyond the finest fitted mesh."""
+    fit: dict[str, set] = {}
+    meshes: dict[str, list[float]] = {}
+    for r in rows:
+        meshes.setdefault(r["problem"], []).append(num(r, "h"))
+        if r["role"] == "fitted":
+            fit.setdefault(r["problem"], set()).add(int(num(r, "ppc")))
+    order = {p: sorted(set(hs), reverse=True) for p, hs in meshes.items()}
+    finest = {p: max((order[p].index(num(r, "h")) for r in rows if r["problem"] == p and r["role"] == "fitted"),
+                     default=-OUT_MESHES) for p in order}
+    return [r["role"] == "checked" and (int(num(r, "ppc")) not in fit.get(r["problem"], set())
+                                        or order[r["problem"]].index(num(r, "h")) - finest[r["problem"]] >= OUT_MESHES)
+            for r in rows]
+
+
+def setting_holds(rows: list[dict], counted: list[bool] | None = None) -> tuple[bool, float, float, int, int]:
     """``(holds, ratio_lo, ratio_hi, trends_right, trends)`` of one setting's model rows (module
-    docstring): the checked rows' ratios and the trends between successive meshes of each seed whose
-    finer mesh is checked."""
-    checked = [r for r in rows if r["role"] == "checked"]
-    ratios = [num(r, "ratio") for r in checked]
+    docstring) over the rows ``counted`` marks (default: the checked rows): their ratios and the trends
+    between successive meshes of each seed whose finer mesh is counted."""
+    counted = [r["role"] == "checked" for r in rows] if counted is None else counted
+    mark = {id(r): c for r, c in zip(rows, counted, strict=True)}
+    ratios = [num(r, "ratio") for r in rows if mark[id(r)]]
     right = total = 0
     for seed in {int(num(r, "seed")) for r in rows}:
         runs = sorted((r for r in rows if int(num(r, "seed")) == seed), key=lambda r: -num(r, "h"))
         for coarse, fine in zip(runs, runs[1:], strict=False):
-            if fine["role"] != "checked":
+            if not mark[id(fine)]:
                 continue
             total += 1
             measured = num(fine, "measured_L1") - num(coarse, "measured_L1")
             modelled = num(fine, "model_L1") - num(coarse, "model_L1")
             right += measured * modelled > 0
     within = all(1 / FACTOR <= x <= FACTOR for x in ratios)
-    return within and right == total, min(ratios), max(ratios), right, total
+    return within and right == total, min(ratios, default=math.nan), max(ratios, default=math.nan), right, total
+
+
+def order_text(fit: list[dict]) -> str:
+    """The converging term's order ``p`` per problem of ``defect/model_fit`` rows, a bound where it sits on a
+    bound of the orders tried (``"sod p >= 2.00, on the search's upper bound"``)."""
+    step = (ORDERS[-1] - ORDERS[0]) / max(len(ORDERS) - 1, 1)
+    parts = []
+    for problem in dict.fromkeys(r["problem"] for r in fit):
+        p = num(next(r for r in fit if r["problem"] == problem), "p")
+        if p >= ORDERS[-1] - step / 2:
+            parts.append(f"{problem} p >= {p:.2f}, on the search's upper bound")
+        elif p <= ORDERS[0] + step / 2:
+            parts.append(f"{problem} p <= {p:.2f}, on the search's lower bound")
+        else:
+            parts.append(f"{problem} p = {p:.2f}")
+    return ", ".join(parts)
 
 
 def remedy_rows(t: Tables) -> list[dict]:
@@ -203,21 +246,25 @@ def _remedy_row(problem: str, name: str, order: float, settings: dict) -> dict:
 def _e6(t: Tables) -> Finding:
     """A closed-form model built from the local defect (a converging term plus the per-step defect's
     closed form in h, particles per cell and layout) is fitted on the coarser meshes at one number of
-    particles per cell and predicts the particle error of the finer meshes and the other number: within a
-    factor and with the right trend under refinement on every seed, per setting."""
+    particles per cell and predicts the particle error out of sample (the other number of particles per
+    cell, and meshes two refinements or more beyond the fit): within a factor and with the right trend
+    under refinement on every seed, per setting. The mesh next to the fit is shown, not counted."""
     rows = t[MODEL.name]
-    groups = {k: g for k, g in _settings(rows).items()
-              if sum(r["role"] == "checked" for r in g) >= MIN_CHECKED}
+    marks = out_of_sample(rows)
+    out = {id(r) for r, m in zip(rows, marks, strict=True) if m}
+    settings = _settings(rows)
+    groups = {k: g for k, g in settings.items() if sum(id(r) in out for r in g) >= MIN_CHECKED}
     if not groups:
-        return Finding(NOT_MEASURED, f"no setting with {MIN_CHECKED} checked rows in `{MODEL.name}.csv`")
+        return Finding(NOT_MEASURED, f"no setting with {MIN_CHECKED} out-of-sample rows (another particle count, or "
+                                     f"{OUT_MESHES} meshes or more beyond the fit) in `{MODEL.name}.csv`")
     table, held = [], []
     for (problem, ppc, layout), g in sorted(groups.items()):
-        holds, lo, hi, right, total = setting_holds(g)
+        holds, lo, hi, right, total = setting_holds(g, [id(r) in out for r in g])
         held.append(holds)
-        table.append({"setting": f"{problem}, {ppc} ppc, {layout}", "checked rows": sum(r["role"] == "checked"
-                                                                                       for r in g),
+        table.append({"setting": f"{problem}, {ppc} ppc, {layout}", "out-of-sample rows": sum(id(r) in out for r in g),
                       "model / measured": span([lo, hi]), "trend right": f"{right} of {total}",
                       "holds": "yes" if holds else "no"})
+    near = _near(settings, out)
     remedies = remedy_rows(t)
     agree = [r for r in remedies if r["agrees"]]
     wrong = [f"{r['problem']} {r['remedy']} ({r['least particle order']:.2f})" for r in remedies if not r["agrees"]]
@@ -226,22 +273,43 @@ def _e6(t: Tables) -> Finding:
     good = [row["setting"] for row, h in zip(table, held, strict=True) if h]
     bad = [f"{row['setting']} ({row['model / measured']}, trend {row['trend right']})"
            for row, h in zip(table, held, strict=True) if not h]
-    evidence = (f"the model predicts the checked rows within {FACTOR:g}x with the measured trend on "
-                f"{sum(held)} of {len(held)} settings" + (f": {'; '.join(good)}" if good else "")
-                + (f"; not on {'; '.join(bad)}" if bad else "")
+    orders = order_text(t.get(MODEL_FIT.name, []))
+    evidence = (f"out of sample (another particle count than the fit's, or {OUT_MESHES} meshes or more beyond it) the "
+                f"model predicts within {FACTOR:g}x with the measured trend on {sum(held)} of {len(held)} settings"
+                + (f": {'; '.join(good)}" if good else "") + (f"; not on {'; '.join(bad)}" if bad else "")
+                + (f"; in sample or one mesh beyond the fit, not counted: {near}" if near else "")
+                + (f"; the converging term's order: {orders}" if orders else "")
                 + (f"; which remedies stop the growth (they change the quadrature): right on {len(agree)} of "
                    f"{len(remedies)} remedies" + (f", not on {', '.join(wrong)}" if wrong else "") if remedies else
                    "; the remedies table is not here"))
-    sentence = (f"fitted on the coarse meshes at {FIT_PPC} per cell, the defect model predicts the particle error "
-                f"of the finer meshes and the other particle counts within {FACTOR:g}x, with the measured trend, on "
-                f"{sum(held)} of {len(held)} settings" + (f" ({'; '.join(good)})" if good and bad else "")
+    sentence = (f"fitted on the coarse meshes at {FIT_PPC} per cell, the defect model predicts the particle error out "
+                f"of sample (the other particle count, or {OUT_MESHES} meshes or more beyond the fit) within "
+                f"{FACTOR:g}x, with the measured trend, on {sum(held)} of {len(held)} settings"
+                + (f" ({'; '.join(good)})" if good and bad else "")
                 + (f"; it says which remedies stop the growth on {len(agree)} of {len(remedies)}" if remedies else ""))
     return Finding(verdict, evidence, sentence, tuple(table))
 
 
-_E6_RULE = (f"per setting (problem, particles per cell, layout class) with {MIN_CHECKED} checked rows: model / "
-            f"measured within [1/{FACTOR:g}, {FACTOR:g}] on every checked row and the model's trend between successive "
-            "meshes (finer one checked) of the measured sign on every seed -> the setting holds; per remedy of "
+def _near(settings: dict, out: set) -> str:
+    """The settings whose checked rows are all in sample or one mesh beyond the fit, with whether the model
+    holds there (shown beside the verdict, never counted)."""
+    parts = []
+    for (problem, ppc, layout), g in sorted(settings.items()):
+        near = [r["role"] == "checked" and id(r) not in out for r in g]
+        if any(near) and not any(id(r) in out for r in g):
+            _, lo, hi, right, total = setting_holds(g, near)
+            hs = ", ".join(f"{h:g}" for h in sorted({num(r, "h") for r, n in zip(g, near, strict=True) if n}))
+            parts.append(f"{problem}, {ppc} ppc, {layout} at h = {hs} (model / measured {span([lo, hi])}, trend "
+                         f"{right} of {total})")
+    return "; ".join(parts)
+
+
+_E6_RULE = (f"only out-of-sample rows count: another particle count than the fit's, or a mesh at least {OUT_MESHES} "
+            "refinements beyond the finest fitted mesh (MODEL_OUT_MESHES; the mesh next to the fit is shown, not "
+            f"counted); per setting (problem, particles per cell, layout class) with {MIN_CHECKED} out-of-sample rows: "
+            f"model / measured within [1/{FACTOR:g}, {FACTOR:g}] on every out-of-sample row and the model's trend "
+            "between successive meshes (finer one out of sample) of the measured sign on every seed -> the setting "
+            "holds; a fitted order p on a bound of the orders tried is reported as a bound; per remedy of "
             "remedies/errors: it changes the quadrature (a particle-domain basis or the reconstructed stress) exactly "
             f"when its least particle order is at least {GROWTH_ORDER:g} -> it agrees; every setting holds and every "
             "remedy agrees -> confirmed; some of either -> partly; none -> refuted. Fitted on h >= MODEL_FIT_H_SOD "

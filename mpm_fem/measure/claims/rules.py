@@ -186,12 +186,19 @@ _add("MODEL_P_MIN", 0.5,
      _STUDY + ": half order, the L1 order of a smeared contact discontinuity", ("E6",))
 _add("MODEL_P_MAX", 2.0,
      "E6: the largest order p of the converging term tried",
-     _STUDY + ": second order, the best a smooth region gives with linear elements", ("E6",))
+     _STUDY + ": second order, the best a smooth region gives with linear elements; a fitted p on this bound is "
+     "reported as a bound (p >= it), not as an order", ("E6",))
 _add("MODEL_P_STEPS", 31,
      "E6: the orders p tried, evenly spaced from MODEL_P_MIN to MODEL_P_MAX (a step of 0.05)",
      _STUDY + ": finer than the orders' spread over the seeds", ("E6",))
+_add("MODEL_OUT_MESHES", 2,
+     "E6: a checked row at the fitting particle count is out of sample when its mesh lies at least this many "
+     "refinements beyond the finest fitted mesh (a row at another particle count always is); only out-of-sample "
+     "rows are counted as predicted",
+     _STUDY + ": the mesh next to the fit is an extrapolation of one step, which any smooth fit through the fitted "
+     "meshes makes well; a prediction is tested two steps out", ("E6",))
 _add("MODEL_MIN_CHECKED", 3,
-     "E6: the checked rows a setting (problem, particles per cell, layout) needs before it is judged",
+     "E6: the out-of-sample rows a setting (problem, particles per cell, layout) needs before it is judged",
      _STUDY + ": a trend needs two meshes and a factor more than one row", ("E6",))
 
 
