@@ -127,8 +127,9 @@ def mass_finding(t: Tables, problem: str, ratios: dict[str, dict[str, float]] | 
 
 
 def _times(x: float) -> str:
-    """A factor in two significant digits, a whole number from 100 on (``6.3``, ``650``)."""
-    return f"{x:.0f}" if abs(x) >= 100 else f"{x:.2g}"
+    """A factor in two significant digits, a whole number where that would need an exponent (``6.3``, ``650``)."""
+    short = f"{x:.2g}"
+    return f"{x:.0f}" if "e+" in short else short
 
 
 def _text(s: Spread, fmt: str) -> str:
