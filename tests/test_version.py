@@ -72,7 +72,6 @@ def test_a_file_that_does_not_parse_enters_by_its_bytes(tree):
 # ------------------------------------------------------------------ the version a case runs through
 
 def _case_version(tree: Path, study: str, fn: str = "run_case") -> str:
-    version._model_version.cache_clear()
     return version.case_source_version(tree / "studies" / f"{study}.py", fn, tree)
 
 
@@ -162,3 +161,121 @@ def test_a_remembered_version_is_the_computed_one_and_an_edit_computes_it_anew(t
     assert source_version(tree) == version._source_version(tree.resolve()) != computed
     memo.write_text("not json")
     assert source_version(tree) == version._source_version(tree.resolve())
+
+
+# ------------------------------------------------------------------ the import closure of a case
+
+_ONE_D = (("sod", "run_case"), ("burgers", "run_case"), ("time", "run_case"), ("remedies", "run_case"))
+
+
+def _versions(tree: Path, cases=_ONE_D) -> dict:
+    return {(s, f): _case_version(tree, s, f) for s, f in cases}
+
+
+#: Files that nothing of the 1D code imports: the 2D package, its FEM baseline and exact solutions
+#: (taken out of the copy, then put back when the tree holds them), and a few written here.
+_NEW = ("mpm_fem/plane", "baselines/fem_solid.py", "baselines/exact/solids.py")
+_WRITTEN = {"mpm_fem/plane2/__init__.py": '"""A second 2D package."""\n',
+            "mpm_fem/plane2/step.py": "from mpm_fem.bases import get\nfrom mpm_fem.core.step import Stages\n"
+                                      "from . import grid2\n\nSTAGES = Stages()\nP1 = get(\"mpm\")\n",
+            "mpm_fem/plane2/grid2.py": "import numpy as np\n\nN = np.arange(3)\n",
+            "baselines/fem_solid2.py": "from baselines.galerkin import *  # noqa\n\nE = 1.0\n",
+            "mpm_fem/bases/tensor.py": "from mpm_fem.bases.contract import Basis\n\nT = Basis\n",
+            "mpm_fem/problems/plane_sod.py": "from mpm_fem.plane2.step import STAGES\n"}
+
+
+def test_new_packages_leave_the_1d_case_versions(tree):
+    """A 2D package, a new FEM baseline, an exact solution and a new method module that nothing of
+    the 1D code imports (the package's lazy ``mpm_fem.plane`` aside) are outside every 1D case's
+    closure: no 1D case recomputes when they are added."""
+    for name in _NEW:
+        shutil.rmtree(tree / name, ignore_errors=True) if (tree / name).is_dir() else (tree / name).unlink(True)
+    before, code = _versions(tree), source_version(tree)
+    for name in _NEW:
+        if (ROOT / name).is_dir():
+            shutil.copytree(ROOT / name, tree / name, ignore=shutil.ignore_patterns("__pycache__", ".*"))
+        elif (ROOT / name).is_file():
+            shutil.copy(ROOT / name, tree / name)
+    for name, text in _WRITTEN.items():
+        (tree / name).parent.mkdir(exist_ok=True)
+        (tree / name).write_text(text)
+    assert _versions(tree) == before
+    assert source_version(tree) != code
+    files = {p.relative_to(tree.resolve()).as_posix() for p in version.case_files(tree / "studies/sod.py", "run_case",
+                                                                                   tree)}
+    assert not {f for f in files if f.startswith(_NEW + tuple(_WRITTEN))}, sorted(files)
+    assert {"mpm_fem/core/step.py", "mpm_fem/bases/point.py", "baselines/fem_euler.py"} <= files, sorted(files)
+
+
+@pytest.mark.parametrize("edited", ["mpm_fem/bases/point.py", "mpm_fem/core/step.py"])
+def test_an_edit_in_the_import_closure_changes_the_case_versions(tree, edited):
+    before = _versions(tree)
+    path = tree / edited
+    path.write_text(path.read_text() + "\n_UNUSED = 1\n")
+    after = _versions(tree)
+    assert all(after[c] != before[c] for c in before), (before, after)
+
+
+@pytest.mark.parametrize("edited", ["mpm_fem/bases/cubic.py", "mpm_fem/core/transfers/apic.py"])
+def test_a_module_only_a_registry_reaches_changes_the_case_versions(tree, edited):
+    """No 1D case imports the cubic B-spline or APIC by name: they reach a run through the registries
+    their packages' ``__init__.py`` fill (a case names them by a string), and they are in the closure."""
+    before = _versions(tree)
+    path = tree / edited
+    _edit(path, "from __future__ import annotations", "from __future__ import annotations\n\n_UNUSED = 1")
+    after = _versions(tree)
+    assert all(after[c] != before[c] for c in before), (before, after)
+
+
+@pytest.mark.parametrize("edited", ["mpm_fem/bases/point.py", "mpm_fem/core/step.py", "mpm_fem/bases/cubic.py"])
+def test_a_docstring_edit_in_the_closure_leaves_the_case_versions(tree, edited):
+    before = _versions(tree)
+    path = tree / edited
+    _edit(path, '"""', '"""In words: ')  # the module's docstring
+    path.write_text(path.read_text() + "\n# a comment\n")
+    assert _versions(tree) == before
+
+
+def test_function_local_and_relative_imports_enter_the_closure(tree):
+    (tree / "mpm_fem/core/relative.py").write_text("from .grid import uniform_grid\n\nG = uniform_grid\n")
+    (tree / "studies/local.py").write_text("def run_case(case):\n    from mpm_fem.core import relative\n"
+                                           "    from mpm_fem.bases.registry import get\n\n"
+                                           "    return {'n': relative.G(0.0, 1.0, case['h']).n_nodes,\n"
+                                           "            'b': get('mpm').name}\n")
+    files = {p.relative_to(tree.resolve()).as_posix() for p in version.case_files(tree / "studies/local.py",
+                                                                                   "run_case", tree)}
+    # the registry's package runs first and registers every basis: the bases enter through it
+    assert {"mpm_fem/__init__.py", "mpm_fem/core/__init__.py", "mpm_fem/core/relative.py", "mpm_fem/core/grid.py",
+            "mpm_fem/bases/__init__.py", "mpm_fem/bases/registry.py", "mpm_fem/bases/cubic.py"} <= files, sorted(files)
+    assert "mpm_fem/core/transfers/apic.py" not in files and "mpm_fem/fused/step.py" not in files, sorted(files)
+    before = _case_version(tree, "local")
+    grid = tree / "mpm_fem/core/grid.py"
+    grid.write_text(grid.read_text() + "\n_UNUSED = 1\n")
+    assert _case_version(tree, "local") != before
+
+
+def test_every_dynamic_import_names_its_modules_but_the_specs_given_at_run_time():
+    """Every ``import_module``/``__import__`` of the versioned code names its module by a constant or
+    an f-string's head (whose package's modules all enter the closure), but the two that import a
+    ``package.module:Name`` given at run time, from outside the packages: the extensions' loader and
+    the method study's hash of that module's source (which the case carries in its settings)."""
+    import ast
+    unresolved = set()
+    for path in versioned_files():
+        for node in ast.walk(ast.parse(path.read_bytes())):
+            argument = version._dynamic_name(node)
+            if argument is not None and version.dynamic_modules(ROOT, argument) is None:
+                unresolved.add(path.relative_to(ROOT).as_posix())
+    assert unresolved == {"mpm_fem/bases/loader.py", "studies/method.py"}, unresolved
+    problems = {p for p in (ROOT / "mpm_fem/problems").glob("*.py")}
+    files = set(version.case_files(ROOT / "studies/method.py", "run_case"))
+    assert problems <= files, sorted(p.name for p in problems - files)  # f"mpm_fem.problems.{problem}"
+
+
+def test_a_sod_case_runs_through_fewer_files_than_the_model():
+    files = version.case_files(ROOT / "studies/sod.py", "run_case")
+    model = version.model_files()
+    assert set(files) < set(model), sorted(set(files) - set(model))
+    names = {p.relative_to(ROOT).as_posix() for p in files}
+    assert "mpm_fem/problems/burgers.py" not in names and "baselines/fem_burgers.py" not in names, sorted(names)
+    assert {"mpm_fem/bases/cubic.py", "mpm_fem/core/transfers/apic.py", "mpm_fem/fused/step.py"} <= names

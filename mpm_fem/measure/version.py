@@ -13,14 +13,25 @@ compares the stamps of the tables with the version of the code that judges them
 (:mod:`mpm_fem.measure.claims.reproduce`).
 
 A case's cache key (:mod:`mpm_fem.app.sweep`) uses a narrower version, :func:`case_version`: the code
-one case runs through. That is the model (:func:`model_files`: every versioned file but the studies,
-the application layer, the verdicts and this module, none of which the model imports) and, of the
-case function's own module, the top-level statements the function depends on (:func:`closure`). A
-study's plan (which meshes, seeds and tiers) chooses cases but computes none, so changing a plan
-leaves every finished case valid, while an edit of the model, of the case function or of a constant
-it reads recomputes the cases.
+one case runs through, found by reading the imports (:func:`case_files`). Of the case function's own
+module, and of each module outside the model it reads a name from (another study, the verdicts, the
+application layer: :data:`OUTSIDE_THE_MODEL`), only the top-level statements the function depends
+on enter (:func:`closure`); of the model (:func:`model_files`), every file those statements import,
+then every file those files import, to a fixed point: ``import m`` and ``from m import a`` at the top
+or inside a function, relative imports, the ``__init__.py`` of every package on the way (so the
+registries, which their packages' ``__init__.py`` fill, bring every basis and transfer: a case names
+them by a string), and ``importlib.import_module`` / ``__import__`` calls, a constant name as the
+module and an f-string's head (``f"mpm_fem.problems.{problem}"``) as every module it can start.
+A module's lazy ``__getattr__`` (PEP 562: the notebook entry points and the 2D package of
+``mpm_fem/__init__.py``) is not followed, nor a ``package.module:Name`` given at run time (the
+extensions' loader): it names a module outside the packages, whose source's hash the method study
+puts in its cases' settings.
+So a study's plan (which meshes, seeds and tiers) chooses cases but computes none, and a package no
+case imports (a 2D package, a new baseline) is in no case's version: changing either leaves every
+finished case valid, while an edit of a model file a case imports, of the case function or of a
+constant it reads recomputes the cases.
 The version is 12 hexadecimal digits of a SHA-256; it depends on the Python version only through
-:func:`ast.dump`. Parsing every file takes about 3 CPU-s, once per process: each version computed is
+:func:`ast.dump`. Parsing the files takes a few CPU-s, once per process: each version computed is
 remembered on disk (:func:`_remembered`, in the user's cache folder) under a SHA-256 of the bytes of
 every versioned file, so a process whose files are unchanged reads it in milliseconds (the same
 value: any changed byte computes it anew). No project imports.
@@ -203,73 +214,216 @@ def closure(tree: ast.Module, name: str) -> list[ast.stmt]:
     return [stmt for k, stmt in enumerate(tree.body) if included[k]]
 
 
-@lru_cache(maxsize=None)
-def _model_version(root: Path) -> bytes:
-    digest = hashlib.sha256()
-    for path in model_files(root):
-        digest.update(path.relative_to(root).as_posix().encode() + b"\0" + file_text(path) + b"\0")
-    return digest.digest()
+def _module_parts(root: Path, path: Path) -> tuple[str, ...]:
+    """The dotted name of the module in ``path``, as parts (a package's ``__init__.py`` names the
+    package); ``()`` for a file outside ``root``."""
+    if not path.is_relative_to(root):
+        return ()
+    parts = path.relative_to(root).with_suffix("").parts
+    return parts[:-1] if parts[-1] == "__init__" else parts
 
 
-def _module_file(root: Path, module: str | None, level: int, here: Path) -> Path | None:
-    """The file of a project module named in an import (relative to ``here`` when ``level`` > 0), or
-    ``None`` for a module outside the project."""
-    base = here.parent
-    for _ in range(level - 1):
-        base = base.parent
-    parts = (module or "").split(".") if module else []
-    folder = (base if level else root).joinpath(*parts)
-    for candidate in (folder.with_suffix(".py") if parts else None, folder / "__init__.py"):
-        if candidate is not None and candidate.is_file():
+def _file_of(root: Path, parts: tuple[str, ...]) -> Path | None:
+    """The file of the project module ``parts`` (``a/b.py`` or ``a/b/__init__.py``), ``None`` for one
+    outside :data:`PACKAGES`."""
+    if not parts or parts[0] not in PACKAGES:
+        return None
+    folder = root.joinpath(*parts)
+    for candidate in (folder.with_suffix(".py"), folder / "__init__.py"):
+        if candidate.is_file():
             return candidate
     return None
 
 
-def _outside_the_model(root: Path, path: Path) -> bool:
-    return path.is_relative_to(root) and path.relative_to(root).as_posix().startswith(OUTSIDE_THE_MODEL)
+def _packages_of(root: Path, parts: tuple[str, ...]) -> list[Path]:
+    """The ``__init__.py`` files that importing the module ``parts`` runs first, outermost first."""
+    return [f for k in range(1, len(parts)) if (f := _file_of(root, parts[:k])) is not None]
 
 
-def _closure_texts(root: Path, path: Path, name: str, seen: set) -> list[bytes]:
-    """What the definition ``name`` of the file ``path`` contributes to a case version: its
-    :func:`closure`, and, for every name that closure imports from a module outside the model (another
-    study, the verdicts), that name's closure there (a whole module when the name is a module)."""
+#: The calls that import a module named by a string at run time: ``importlib.import_module(name)``,
+#: ``import_module(name)`` and ``__import__(name)``.
+_DYNAMIC = ("import_module", "__import__")
+
+
+def _dynamic_name(node: ast.AST) -> ast.AST | None:
+    """The argument naming the module of a call in :data:`_DYNAMIC`; ``None`` for any other node."""
+    if not (isinstance(node, ast.Call) and node.args):
+        return None
+    func = node.func
+    called = func.attr if isinstance(func, ast.Attribute) else func.id if isinstance(func, ast.Name) else ""
+    return node.args[0] if called in _DYNAMIC else None
+
+
+def dynamic_modules(root: Path, argument: ast.AST) -> list[tuple[str, ...]] | None:
+    """The modules a dynamic import whose name is ``argument`` can load, as dotted parts: the one a
+    constant names; every project module whose dotted name starts with an f-string's constant head
+    (``f"mpm_fem.problems.{problem}"``: every module of that package); ``None`` when the source does
+    not write the name (a ``package.module:Name`` given at run time, :mod:`mpm_fem.bases.loader`)."""
+    if isinstance(argument, ast.Constant) and isinstance(argument.value, str):
+        return [tuple(argument.value.split("."))]
+    head = ""
+    if isinstance(argument, ast.JoinedStr):
+        for value in argument.values:
+            if not (isinstance(value, ast.Constant) and isinstance(value.value, str)):
+                break
+            head += value.value
+    if not head or head.split(".")[0] not in PACKAGES:
+        return None
+    found = {_module_parts(root, f) for package in PACKAGES for f in (root / package).rglob("*.py")}
+    return sorted(parts for parts in found if ".".join(parts).startswith(head))
+
+
+#: One import a statement makes: the module's dotted name as parts and, for ``from m import a as b``,
+#: the pairs (imported name, bound name); ``None`` for ``import m`` and a dynamic import.
+_Request = tuple[tuple[str, ...], tuple[tuple[str, str], ...] | None]
+
+
+def _node_requests(root: Path, here: Path, node: ast.AST) -> list[_Request]:
+    """The imports ``node`` itself makes (not those of the nodes inside it), relative ones resolved
+    against the file ``here``."""
+    if isinstance(node, ast.Import):
+        return [(tuple(a.name.split(".")), None) for a in node.names]
+    if isinstance(node, ast.ImportFrom):
+        package = _module_parts(root, here)
+        if here.name != "__init__.py":
+            package = package[:-1]
+        if node.level and node.level - 1 > len(package):
+            return []
+        base = package[:len(package) - node.level + 1] if node.level else ()
+        parts = base + (tuple(node.module.split(".")) if node.module else ())
+        return [(parts, tuple((a.name, a.asname or a.name) for a in node.names))]
+    argument = _dynamic_name(node)
+    return [(parts, None) for parts in dynamic_modules(root, argument) or ()] if argument is not None else []
+
+
+def _lazy(stmt: ast.stmt) -> bool:
+    """Whether ``stmt`` is a module's ``__getattr__`` (PEP 562): what it imports loads on the first
+    access of an attribute the module lacks (the package's notebook entry points and its 2D package,
+    ``mpm_fem/__init__.py``), not when the module is imported."""
+    return isinstance(stmt, (ast.FunctionDef, ast.AsyncFunctionDef)) and stmt.name == "__getattr__"
+
+
+@lru_cache(maxsize=None)
+def _file_requests(root: Path, path: Path, source: bytes) -> tuple[_Request, ...]:
+    """Every import anywhere in the file ``path`` holding ``source`` (in its functions too, and the
+    dynamic imports :func:`dynamic_modules` can name) but in its lazy ``__getattr__`` (:func:`_lazy`);
+    none when it does not parse."""
+    try:
+        tree = ast.parse(source)
+    except (SyntaxError, ValueError):
+        return ()
+    return tuple(r for stmt in tree.body if not _lazy(stmt) for node in ast.walk(stmt)
+                 for r in _node_requests(root, path, node))
+
+
+def _request_files(root: Path, request: _Request) -> list[Path]:
+    """The project files an import runs: the packages' ``__init__.py`` files, the module, and, for
+    ``from package import name``, the submodule ``name`` when there is one."""
+    parts, names = request
+    files = _packages_of(root, parts) + [f for f in [_file_of(root, parts)] if f is not None]
+    for name, _ in names or ():
+        files += [f for f in [_file_of(root, parts + (name,))] if f is not None]
+    return files
+
+
+def _import_closure(root: Path, seeds: set[Path], model: frozenset[Path]) -> list[Path]:
+    """The files of ``model`` that importing the files ``seeds`` runs, ``seeds`` of the model included,
+    sorted: the transitive closure of every import in them (:func:`_file_requests`) within ``model``.
+    The model imports nothing outside it but in the lazy ``__getattr__`` of ``mpm_fem/__init__.py``
+    (the notebook entry points load the application on first use), which is not followed
+    (tests/test_version.py)."""
+    done, todo = set(), [s for s in seeds if s in model]
+    while todo:
+        path = todo.pop()
+        if path in done:
+            continue
+        done.add(path)
+        for request in _file_requests(root, path, path.read_bytes()):
+            todo += [f for f in _request_files(root, request) if f in model and f not in done]
+    return sorted(done)
+
+
+@lru_cache(maxsize=None)
+def _tree(source: bytes) -> ast.Module:
+    """The syntax tree of ``source`` without docstrings, parsed once per content (read, never changed)."""
+    return _without_docstrings(ast.parse(source))
+
+
+def _closure_texts(root: Path, path: Path, name: str | None, model: frozenset[Path], seen: set,
+                   seeds: set[Path]) -> list[bytes]:
+    """What the definition ``name`` of the file ``path`` (the whole file for ``None``) contributes to a
+    case version outside the model: its :func:`closure`, and, for every name that closure imports
+    from a module outside the model (another study, the verdicts), that name's closure there; a whole
+    module for ``import m``, a submodule or a dynamic import. The model files the statements import
+    (at the top or in a function) and their packages' ``__init__.py`` are added to ``seeds``; the
+    ``__init__.py`` of a package outside the model enters by the names read from it only."""
     if (path, name) in seen:
         return []
     seen.add((path, name))
+    if path in model:
+        seeds.add(path)
     label = path.relative_to(root).as_posix() if path.is_relative_to(root) else path.name
-    statements = closure(_without_docstrings(ast.parse(path.read_bytes())), name)
-    if not statements:
-        raise ValueError(f"{label} defines no top-level {name!r}")
-    texts = [f"{label}\0{name}".encode()] + [ast.dump(stmt).encode() for stmt in statements]
+    tree = _tree(path.read_bytes())
+    if name is None:
+        statements, texts = tree.body, [f"{label}\0".encode() + file_text(path)]
+    else:
+        statements = closure(tree, name)
+        if not statements:
+            raise ValueError(f"{label} defines no top-level {name!r}")
+        texts = [f"{label}\0{name}".encode()] + [ast.dump(stmt).encode() for stmt in statements]
     needed = set().union(*map(_names, statements))
     for stmt in statements:
-        if isinstance(stmt, ast.ImportFrom):
-            source = _module_file(root, stmt.module, stmt.level, path)
-            for alias in stmt.names if source is not None and _outside_the_model(root, source) else ():
-                if (alias.asname or alias.name) not in needed:
+        for node in ast.walk(stmt):
+            for parts, names in _node_requests(root, path, node):
+                seeds.update(_packages_of(root, parts))
+                source = _file_of(root, parts)
+                if source is None:
                     continue
-                submodule = _module_file(root, alias.name, 1, source) if source.name == "__init__.py" else None
-                texts += [file_text(submodule)] if submodule is not None and submodule != source \
-                    else _closure_texts(root, source, alias.name, seen)
-        elif isinstance(stmt, ast.Import):
-            for alias in stmt.names:
-                source = _module_file(root, alias.name, 0, path)
-                if source is not None and _outside_the_model(root, source):
-                    texts.append(file_text(source))
+                seeds.add(source)
+                if names is None and source not in model:
+                    texts += _closure_texts(root, source, None, model, seen, seeds)
+                for imported, bound in names or ():
+                    submodule = _file_of(root, parts + (imported,)) if source.name == "__init__.py" else None
+                    if submodule is not None:
+                        seeds.add(submodule)
+                        if submodule not in model:
+                            texts += _closure_texts(root, submodule, None, model, seen, seeds)
+                    elif source not in model and (node is not stmt or bound in needed):  # nested: all used
+                        texts += _closure_texts(root, source, None if imported == "*" else imported, model,
+                                                seen, seeds)
     return texts
 
 
+def _case_parts(path: Path, name: str, root: Path) -> tuple[list[Path], list[bytes]]:
+    """The model files a case of ``name`` in ``path`` runs (:func:`_import_closure`) and the texts of
+    what it reads outside the model (:func:`_closure_texts`)."""
+    model, seeds = frozenset(model_files(root)), set()
+    texts = _closure_texts(root, path, name, model, set(), seeds)
+    return _import_closure(root, seeds, model), texts
+
+
+def case_files(path: Path, qualname: str, root: Path = ROOT) -> list[Path]:
+    """The files of the model that a case of the definition ``qualname`` (its first dotted part) of
+    the file ``path`` runs through, sorted by path (:func:`_import_closure`)."""
+    root, path = Path(root).resolve(), Path(path).resolve()
+    return _case_parts(path, qualname.split(".")[0], root)[0]
+
+
 def case_source_version(path: Path, qualname: str, root: Path = ROOT) -> str:
-    """12 hexadecimal digits of the SHA-256 of the model (:func:`model_files` under ``root``) and of
-    what the definition ``qualname`` (its first dotted part) of the file ``path`` depends on outside
-    the model (:func:`_closure_texts`)."""
+    """12 hexadecimal digits of the SHA-256 of the model files a case of the definition ``qualname``
+    (its first dotted part) of the file ``path`` runs through (:func:`case_files` under ``root``: the
+    path and :func:`file_text` of each) and of what it reads outside the model (:func:`_closure_texts`)."""
     root, path = Path(root).resolve(), Path(path).resolve()
     return _remembered(f"case\0{root}\0{path}\0{qualname}", root, lambda: _case_source_version(path, qualname, root))
 
 
 def _case_source_version(path: Path, qualname: str, root: Path) -> str:
-    digest = hashlib.sha256(_model_version(root))
-    for text in _closure_texts(root, path, qualname.split(".")[0], set()):
+    files, texts = _case_parts(path, qualname.split(".")[0], root)
+    digest = hashlib.sha256()
+    for file in files:
+        digest.update(file.relative_to(root).as_posix().encode() + b"\0" + file_text(file) + b"\0")
+    digest.update(b"\0")
+    for text in texts:
         digest.update(text + b"\0")
     return digest.hexdigest()[:12]
 
