@@ -209,3 +209,50 @@ def test_e6_reports_an_order_on_the_bound_of_its_search_as_a_bound():
     assert f"sod p >= {ORDERS[-1]:.2f}, on the search's upper bound" in evidence and "burgers p = 1.70" in evidence
     inside = mutate(TABLES, "defect/model_fit", {"problem": "sod"}, p=1.5)
     assert "sod p = 1.50" in judge("E6", inside)[1]
+
+
+# ---------------------------------------------------------------- failed runs: named with count and cause
+
+POSITIVITY = "positivity lost at step 12 (t=0.001) in particle 7 at x=0.5: 1 - (dv/dx) dt = -2.1; reduce the CFL number"
+
+
+def test_a_failed_runs_cause_is_its_message_without_its_particulars():
+    from mpm_fem.measure.claims import failure_cause
+
+    assert failure_cause(POSITIVITY) == "positivity lost"
+    assert failure_cause("particle 0 at x=-1.7e-06 lies outside the grid [0.0, 1.0] (1 such particles)") \
+        == "a particle lies outside the grid [0.0, 1.0]"
+
+
+def test_c3_names_the_runs_that_failed_with_their_count_and_cause():
+    """P1 loses positivity at 1 particle per cell on two meshes of sod/ppc: C3 names them; one more failed run
+    (another cause) is counted in a line of its own, and the verdict is judged on the runs that finished."""
+    found = claim_named("C3 (sod)").finding(TABLES)
+    assert found.failed == ("sod/ppc: 2 of 18 runs failed (ppc = 1; h = 0.0025, 0.000625): positivity lost",)
+    assert "sod/ppc: 2 of 18 runs failed (ppc = 1; h = 0.0025, 0.000625): positivity lost (left out)" in found.evidence
+    more = mutate(TABLES, "sod/ppc", {"ppc": 2, "h": 0.01}, ok="False", nodes_L1="", particles_L1="",
+                  error="particle 3 at x=1.00001 lies outside the grid [0.0, 1.0] (1 such particles)")
+    assert set(claim_named("C3 (sod)").finding(more).failed) == {
+        "sod/ppc: 2 of 18 runs failed (ppc = 1; h = 0.0025, 0.000625): positivity lost",
+        "sod/ppc: 1 of 18 runs failed (ppc = 2; h = 0.01): a particle lies outside the grid [0.0, 1.0]"}
+    none = mutate(TABLES, "sod/ppc", {"ok": "False"}, ok="True", error="")
+    assert claim_named("C3 (sod)").finding(none).failed == ()
+
+
+def test_every_failed_run_of_a_table_a_claim_reads_is_named_in_its_finding():
+    """On the committed tables and with a failed run put into a table whose criterion does not name failures
+    itself (sod/seeds, read by C11 and E3): the report's findings name every one, with count and cause."""
+    from mpm_fem.app.paper import judge as judge_all
+    from mpm_fem.measure.claims import failed
+
+    broken = mutate(TABLES, "sod/seeds", {"ppc": 16, "h": 0.01, "seed": 0}, ok="False", error=POSITIVITY)
+    import re
+
+    for tables in (TABLES, broken):
+        for c, f in judge_all(tables).values():
+            for name in c.tables:
+                named = sum(int(m.group(1)) for line in f.failed if line.startswith(name)
+                            for m in [re.search(r": (\d+) of \d+ runs failed", line)] if m)
+                assert named == len(failed(tables.get(name) or [])), (c.label, name, f.failed)
+    found = judge_all(broken)["C11"][1]
+    assert "sod/seeds: 1 of " in found.failed[0] and found.failed[0].endswith("(h = 0.01): positivity lost")

@@ -358,3 +358,11 @@ def test_a_finding_with_a_sentence_and_a_table_is_said_in_words(tables):
     assert "| ppc | last order |" in section and "| 8 | -0.52 |" in section
     assert sentence.rstrip(".") + " (C11)." in text.split("## 5 Conclusions")[1].split("## Appendix")[0]
     assert "The evidence in full: orders 0.18, -0.24; the rest." in text.split('<a id="rule-c11"></a>')[1]
+
+
+def test_failed_runs_are_named_in_the_claims_section(rendered):
+    """P1 losing positivity at 1 particle per cell (sod/ppc): C3's section names the failed runs, their count
+    and their cause, beside the verdict judged on the runs that finished."""
+    section = rendered.split('<a id="c3-sod"></a>')[1].split("<a id=")[0]
+    assert ("Runs that failed, left out of the verdict: sod/ppc: 2 of 18 runs failed (ppc = 1; h = 0.0025, "
+            "0.000625): positivity lost.") in section, section[-600:]

@@ -14,6 +14,7 @@ conclusions, no key number is cut, and no paragraph passes :data:`mpm_fem.app.ma
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 from mpm_fem.app.discussion import defect_section
 from mpm_fem.app.markdown import (
@@ -27,7 +28,18 @@ from mpm_fem.app.markdown import (
     split_outside,
 )
 from mpm_fem.app.pages import Page
-from mpm_fem.measure.claims import CLAIMS, STATEMENTS, Claim, Finding, claims_of, identification, num, select, span
+from mpm_fem.measure.claims import (
+    CLAIMS,
+    STATEMENTS,
+    Claim,
+    Finding,
+    claims_of,
+    failures,
+    identification,
+    num,
+    select,
+    span,
+)
 from mpm_fem.measure.claims.base import DIFFERS, PARTLY, REFUTED
 from mpm_fem.measure.claims.drift import STUDY, mechanism
 from mpm_fem.measure.claims.rules import RULES, VERDICT_MEANING
@@ -54,8 +66,17 @@ REPRODUCTION = Page("reproduce", "Reproduction", "Every table carries the versio
 
 
 def judge(tables: Tables) -> Found:
-    """Every registered claim's finding on ``tables``, by label, in the order of :data:`CLAIMS`."""
-    return {c.label: (c, c.finding(tables)) for c in CLAIMS}
+    """Every registered claim's finding on ``tables``, by label, in the order of :data:`CLAIMS`; a finding
+    that names no failed run while a table its claim reads holds some gets them named
+    (:func:`mpm_fem.measure.claims.failures`), so that no failed run is left out silently."""
+    return {c.label: (c, _with_failures(c, c.finding(tables), tables)) for c in CLAIMS}
+
+
+def _with_failures(c: Claim, f: Finding, tables: Tables) -> Finding:
+    if f.failed:
+        return f
+    lines = tuple(line for name in c.tables for line in failures(tables.get(name) or [], ("h",), name))
+    return replace(f, failed=lines) if lines else f
 
 
 def first_clause(f: Finding) -> str:
@@ -305,7 +326,14 @@ def claim_section(c: Claim, f: Finding, figure_lines: list[str] = (), appendix: 
         + (f"; all of the study's tables: [appendix](#{appendix})." if appendix else ".")
     return [f'<a id="{anchor_of(c.label)}"></a>', "", f"#### {c.label}: {c.statement}", "",
             f"**{f.verdict}**. Source: {c.source}.", "",
-            *([f.sentence.strip(), ""] if f.sentence else []), *figure_lines, *evidence(f), links, ""]
+            *([f.sentence.strip(), ""] if f.sentence else []), *figure_lines, *evidence(f), *failed_runs(f), links, ""]
+
+
+def failed_runs(f: Finding) -> list[str]:
+    """The runs of the finding's tables that failed, by cause (count, where, cause), as a paragraph."""
+    if not f.failed:
+        return []
+    return [f"Runs that failed, left out of the verdict: {'; '.join(f.failed)}.", ""]
 
 
 def claim_figure(c: Claim, page: Page | None, captions: dict) -> list[str]:

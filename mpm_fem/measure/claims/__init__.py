@@ -30,7 +30,17 @@ from mpm_fem.measure.claims.base import (
     claim,
     claims_of,
 )
-from mpm_fem.measure.claims.rows import count_verdict, num, saturation, select, span, successive_orders
+from mpm_fem.measure.claims.rows import (
+    count_verdict,
+    failed,
+    failure_cause,
+    failures,
+    num,
+    saturation,
+    select,
+    span,
+    successive_orders,
+)
 
 # the per-study modules, in the order their claims are registered (CLAIMS keeps that order)
 # isort: off
@@ -53,7 +63,7 @@ from mpm_fem.measure.claims.model import model_rows, ppc_needed
 
 __all__ = [
     "VERDICTS", "STATEMENTS", "Tables", "Criterion", "Claim", "Finding", "CLAIMS", "claim", "claims_of",
-    "num", "select", "span", "count_verdict", "saturation", "successive_orders",
+    "num", "select", "span", "count_verdict", "saturation", "successive_orders", "failed", "failure_cause", "failures",
     "BAND_TOLERANCE", "JUDGED_LAYOUTS", "ORDERS",
     "SATURATION", "LUMPING_BAND", "lumping_sign",
     "CONVERGENCE", "FLOOR_ORDER", "CONVERGING_ORDER", "FLOOR_MESHES", "FLOOR_STEPS", "WAVE_REGIONS", "WAVE_DENSITY",

@@ -58,12 +58,15 @@ class Finding:
     formatted from the numbers, its first clause the key number of the summary), a ``sentence`` in
     plain words for the abstract and the results (formatted from the same numbers by a template, no
     verdict word pasted in; empty when the criterion has none) and a small evidence ``table`` (rows
-    of ``{column: value}``, e.g. one row per setting and one column per quantity; empty when none)."""
+    of ``{column: value}``, e.g. one row per setting and one column per quantity; empty when none) and the
+    runs of its tables that ``failed`` (one line per cause: count, where, cause; :func:`.rows.failures`),
+    left out of the verdict and named beside it, never silently."""
 
     verdict: str
     evidence: str
     sentence: str = ""
     table: tuple[dict, ...] = ()
+    failed: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Finding, Tables, claim
-from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, failures, num, select, span, successive_orders
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.claims.stages import STEP_ORDER, SUBSETS, decomposition, run_label, runs, values
 from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_ROUNDOFF
@@ -225,18 +225,18 @@ def _e2(t: Tables) -> Finding:
     sentence = (f"over the last {FLOOR_STEPS} refinements the particle density error's order is "
                 + ", ".join(f"{r['particle density orders']} with {_BASIS_NAMES.get(r['basis'], r['basis'])}"
                             for r in table))
-    failed = [r for r in t[BUDGET_BASES.name] if r.get("ok") != "True"]
-    failures = "".join(f"; {len(select(failed, basis=b))} {b} run(s) failed and are left out (e.g. "
-                       f"{select(failed, basis=b)[0].get('error', '').split(' (')[0]})"
-                       for b in dict.fromkeys(r["basis"] for r in failed))
+    bases = t[BUDGET_BASES.name]
+    failed = tuple(line for b in dict.fromkeys(r["basis"] for r in bases)
+                   for line in failures(select(bases, basis=b), ("ppc", "h"), f"{BUDGET_BASES.name} {b}"))
+    failed_text = "".join(f"; {line} (left out)" for line in failed)
     return Finding(verdict, (f"particle density L1 orders over the last {FLOOR_STEPS} refinements ({runs_n} run"
                              f"{'s' if runs_n > 1 else ''} each): "
                              + "; ".join(f"{r['basis']} {r['particle density orders']}"
                                          for r in table)
                              + "; nodes " + "; ".join(f"{r['basis']} {r['nodal density orders']}" for r in table)
                              + f"; plateau std(v_p) at h = {finest}: "
-                             + ", ".join(f"{b} {v}" for b, v in noise.items()) + failures),
-                   sentence, table)
+                             + ", ".join(f"{b} {v}" for b, v in noise.items()) + failed_text),
+                   sentence, table, failed)
 
 
 _BASIS_NAMES = {"mpm": "P1", "gimp": "GIMP", "bspline": "the C1 B-spline",

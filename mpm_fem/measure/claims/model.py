@@ -51,7 +51,7 @@ from scipy.optimize import nnls
 from mpm_fem.bases import get as get_basis
 from mpm_fem.measure.claims.base import CONFIRMED, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim
 from mpm_fem.measure.claims.remedies import REMEDY_ERRORS, remedy_assessment, remedy_series
-from mpm_fem.measure.claims.rows import GROWTH_ORDER, num, select, span
+from mpm_fem.measure.claims.rows import GROWTH_ORDER, failures, num, select, span
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import MODEL, MODEL_FIT
 
@@ -282,12 +282,14 @@ def _e6(t: Tables) -> Finding:
                 + (f"; which remedies stop the growth (they change the quadrature): right on {len(agree)} of "
                    f"{len(remedies)} remedies" + (f", not on {', '.join(wrong)}" if wrong else "") if remedies else
                    "; the remedies table is not here"))
+    failed = failures(t.get(REMEDY_ERRORS, []), ("problem", "remedy", "h"), REMEDY_ERRORS)
+    evidence += "".join(f"; {line} (a remedy without a particle order on every mesh is left out)" for line in failed)
     sentence = (f"fitted on the coarse meshes at {FIT_PPC} per cell, the defect model predicts the particle error out "
                 f"of sample (the other particle count, or {OUT_MESHES} meshes or more beyond the fit) within "
                 f"{FACTOR:g}x, with the measured trend, on {sum(held)} of {len(held)} settings"
                 + (f" ({'; '.join(good)})" if good and bad else "")
                 + (f"; it says which remedies stop the growth on {len(agree)} of {len(remedies)}" if remedies else ""))
-    return Finding(verdict, evidence, sentence, tuple(table))
+    return Finding(verdict, evidence, sentence, tuple(table), failed)
 
 
 def _near(settings: dict, out: set) -> str:

@@ -7,7 +7,7 @@ import math
 
 from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Finding, Tables, claim
 from mpm_fem.measure.claims.budget import SUBSETS, e1_result
-from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span, successive_orders
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, failures, num, select, span, successive_orders
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.claims.stages import run_label
 from mpm_fem.measure.schema import BUDGET_SHAPLEY, REMEDIES_ERRORS, SETTINGS
@@ -197,13 +197,15 @@ def _e5(t: Tables) -> Finding:
                 f"{max(s[f'max_fv_ratio_{m}'] for m in REMEDY_MEASURES):.2f}x the finite-volume error"
                 if s["removes_plateau"] else f"no remedy keeps Sod's density error converging on every mesh of "
                 f"{over}; the closest is {name}")
+    failed = failures(rows, ("problem", "remedy", "h"), REMEDY_ERRORS)
+    why += "".join(f"; {line} (a failed run fails every condition it enters)" for line in failed)
     if s["removes_plateau"] and fv and b_ok:
-        return Finding(CONFIRMED, "meets the goal: " + text + f"; {why}", sentence, table)
+        return Finding(CONFIRMED, "meets the goal: " + text + f"; {why}", sentence, table, failed)
     if removers:
         return Finding(PARTLY, text + f"; the Sod plateau is removed by {', '.join(removers)}; {why}", sentence,
-                       table)
+                       table, failed)
     return Finding(REFUTED, f"closest: {text}; no remedy converges as the FV reference does on every Sod mesh; "
-                            f"{why}", sentence, table)
+                            f"{why}", sentence, table, failed)
 
 
 def budget_clause(t: Tables) -> str:

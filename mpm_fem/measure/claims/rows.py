@@ -4,6 +4,7 @@ from the CSVs)."""
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 
 from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED
@@ -78,3 +79,59 @@ def successive_orders(rows: list[dict], key: str) -> list[float]:
         ok = e[k] > 0 and e[k + 1] > 0
         out.append(math.log(e[k] / e[k + 1]) / math.log(h[k] / h[k + 1]) if ok else math.nan)
     return out
+
+
+def failed(rows: list[dict]) -> list[dict]:
+    """The rows of runs that failed: ``ok`` false where the table has an ``ok`` column, else a ``error``
+    that is a message, not a number (``budget/subsets``' ``error`` is the measured error)."""
+    def broke(r: Mapping) -> bool:
+        if "ok" in r:
+            return str(r["ok"]) not in ("True", "true", "1")
+        message = str(r.get("error", "")).strip()
+        return bool(message) and not _is_number(message)
+    return [r for r in rows if broke(r)]
+
+
+def _is_number(value) -> bool:
+    try:
+        float(value)
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+#: the particulars of a run's error message (where and when), removed to leave its cause
+_PARTICULARS = re.compile(r"\([^)]*\)|\b(at step|in particle|at [xt]\s*=)\s*[-+0-9.e]+")
+
+
+def failure_cause(message: str) -> str:
+    """The cause of a failed run, its particulars removed: ``"positivity lost at step 1317 (t=0.06) in
+    particle 180 at x=0.46: ..."`` -> ``"positivity lost"``; ``"particle 0 at x=-1e-06 lies outside the grid
+    [0.0, 1.0] (1 such particles)"`` -> ``"a particle lies outside the grid [0.0, 1.0]"``."""
+    text = re.split(r"[:;]", str(message), maxsplit=1)[0]
+    text = re.sub(r"\bparticle \d+", "a particle", _PARTICULARS.sub("", text))
+    return " ".join(text.split()) or "no message"
+
+
+def failures(rows: list[dict], where: tuple[str, ...] = ("h",), table: str = "") -> tuple[str, ...]:
+    """One line per cause of the failed runs among ``rows`` (:func:`failed`, :func:`failure_cause`) of
+    ``table``: their count, the values of the columns ``where`` they were run at, and the cause, e.g.
+    ``"sod/ppc: 2 of 18 runs failed (ppc = 1; h = 0.0025, 0.000625): positivity lost"``; empty when no run
+    failed."""
+    bad = failed(rows)
+    causes: dict[str, list[dict]] = {}
+    for r in bad:
+        causes.setdefault(failure_cause(r.get("error", "")), []).append(r)
+    out = []
+    for cause, runs in causes.items():
+        at = "; ".join(f"{k} = {', '.join(_ordered(str(r.get(k, '')) for r in runs))}" for k in where
+                       if any(str(r.get(k, "")) for r in runs))
+        out.append((f"{table}: " if table else "") + f"{len(runs)} of {len(rows)} runs failed"
+                   + (f" ({at})" if at else "") + f": {cause}")
+    return tuple(out)
+
+
+def _ordered(values) -> list[str]:
+    """The distinct ``values``, numbers from the largest (meshes from the coarsest), text in the order met."""
+    distinct = list(dict.fromkeys(values))
+    return sorted(distinct, key=lambda v: -float(v)) if all(map(_is_number, distinct)) else distinct

@@ -20,7 +20,16 @@ from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Fin
 from mpm_fem.measure.claims.drift import mechanism
 from mpm_fem.measure.claims.identification import source_matching
 from mpm_fem.measure.claims.mass import MASS_RULE, mass_finding
-from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, count_verdict, num, saturation, select, span
+from mpm_fem.measure.claims.rows import (
+    CONVERGING_ORDER,
+    FLOOR_ORDER,
+    count_verdict,
+    failures,
+    num,
+    saturation,
+    select,
+    span,
+)
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, SATURATION, ppc_claim
 from mpm_fem.measure.claims.stages import SUBSETS
@@ -401,7 +410,10 @@ def _c3_sod(t: Tables) -> Finding:
                                       for x in r["fewest near the smallest"].split(".."))]
     sentence = (f"on Sod the fewest particles per cell within {SATURATION:.0%} of the smallest error lie in the "
                 f"source's {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} on {len(inside)} of {len(table)} meshes and errors")
-    return Finding(verdict, evidence, sentence, tuple(table))
+    failed = (failures(t[SOD_PPC.name], ("ppc", "h"), SOD_PPC.name)
+              + failures(seeds, ("ppc", "cfl", "layout", "h"), SEEDS))
+    evidence += "".join(f"; {line} (left out)" for line in failed)
+    return Finding(verdict, evidence, sentence, tuple(table), failed)
 
 
 @claim("C15", source="one of four error sources", tables=(SUBSETS,), study="sod", problem="sod",
