@@ -3,8 +3,8 @@ manufactured solution given in reference coordinates (``baselines.exact.solids``
 
 The fields are Lagrangian, ``f(X, t)``; a grid node sits at a spatial position, so its exact value
 is that of the material point there: ``X`` solving ``X + u(X, t) = x_i`` (:func:`reference_of`,
-Newton's method with ``F``). The symplectic Euler step's times: the velocity at ``t - dt/2``, the
-acceleration and the stress at ``t``, so
+Newton's method with ``F``, started from the last time's solution). The symplectic Euler step's
+times: the velocity at ``t - dt/2``, the acceleration and the stress at ``t``, so
 
     v*_i = v(X(x_i, t - dt/2), t - dt/2),     a*_i = a(X(x_i, t), t).
 
@@ -38,6 +38,7 @@ from mpm_fem.plane.grid import PlaneGrid
 from mpm_fem.plane.step import consistent_solver, lumped
 
 NEWTON_STEPS = 30
+CONTINUATION = 32  # time steps of the continuation that follows a node's material point when Newton fails
 DT_FD = 1e-6  # the time step of the central difference of F, as a share of the period
 
 
@@ -45,25 +46,44 @@ def _vector(f, X: np.ndarray, t: float) -> np.ndarray:
     return np.ascontiguousarray(np.asarray(f(X[:, 0], X[:, 1], t), dtype=float).T)
 
 
-def reference_of(solution, x: np.ndarray, t: float, tol: float = 1e-13) -> np.ndarray:
-    """The reference positions ``X`` (n, 2) with ``X + u(X, t) = x`` (n, 2), by Newton's method
-    from ``X = x``; raises ``ArithmeticError`` if it does not converge."""
-    X = x.copy()
+def _newton(solution, x: np.ndarray, t: float, X: np.ndarray, tol: float) -> tuple[np.ndarray, float]:
+    """Newton's method for ``X + u(X, t) = x`` from ``X``: the last iterate and its residual."""
     scale = 1.0 + np.abs(x).max()
     for _ in range(NEWTON_STEPS):
         r = X + _vector(solution.displacement, X, t) - x
         if np.abs(r).max() <= tol * scale:
-            return X
+            return X, 0.0
         F = np.asarray(solution.deformation_gradient(X[:, 0], X[:, 1], t), dtype=float).reshape(-1, 2, 2)
         X = X - np.linalg.solve(F, r[:, :, None])[:, :, 0]
-    raise ArithmeticError(f"the reference position of a grid node did not converge at t={t:.6g} "
-                          f"(residual {np.abs(r).max():.3g})")
+    return X, float(np.abs(r).max())
+
+
+def reference_of(solution, x: np.ndarray, t: float, guess: tuple[float, np.ndarray] | None = None,
+                 tol: float = 1e-13) -> np.ndarray:
+    """The reference positions ``X`` (n, 2) with ``X + u(X, t) = x`` (n, 2), by Newton's method from
+    ``guess`` (a time and the positions solved there) or ``X = x``; where that fails (a large
+    rotation), by continuation in time from ``guess`` (or from ``t = 0``) in ``CONTINUATION``
+    steps, each starting from the last. Raises ``ArithmeticError`` if that fails too."""
+    t0, X0 = guess if guess is not None else (0.0, x)
+    X, residual = _newton(solution, x, t, X0.copy(), tol)
+    if residual == 0.0:
+        return X
+    if guess is None:
+        X0, residual = _newton(solution, x, 0.0, x.copy(), tol)
+    for tau in np.linspace(t0, t, CONTINUATION + 1)[1:]:
+        if residual > 0:
+            break
+        X0, residual = _newton(solution, x, tau, X0, tol)
+    if residual > 0:
+        raise ArithmeticError(f"the reference position of a grid node did not converge at t={t:.6g} "
+                              f"(residual {residual:.3g})")
+    return X0
 
 
 def cell_quadrature(grid: PlaneGrid, order: int = 6) -> tuple[np.ndarray, np.ndarray]:
     """scikit-fem's Gauss rule of ``order`` on the mesh cells: points (n_q, 2), weights (n_q,)."""
     sk = SkBasis(grid.mesh, ElementQuad1(), intorder=order)
-    x = np.asarray(sk.global_coordinates().value)
+    x = np.asarray(sk.global_coordinates())
     return np.column_stack((x[0].ravel(), x[1].ravel())), np.asarray(sk.dx).ravel()
 
 
@@ -75,6 +95,13 @@ class ExactStages2:
     solution: object
     points: np.ndarray = field(repr=False)
     weights: np.ndarray = field(repr=False)
+    _last: dict = field(default_factory=dict, compare=False, repr=False)  # the nodes' last (t, X)
+
+    def reference_of_nodes(self, grid: PlaneGrid, t: float) -> np.ndarray:
+        """:func:`reference_of` the nodes at ``t``, started from the last time solved."""
+        X = reference_of(self.solution, grid.nodes, t, self._last.get(grid))
+        self._last[grid] = (t, X)
+        return X
 
     def projection(self, grid: PlaneGrid, basis: str | Basis, t: float, dt: float):
         """``(m*_i, P*_i, f*_i, solver)``: the quadrature's sums, and ``solver(kind)`` giving the
@@ -101,9 +128,9 @@ class ExactStages2:
 
     def nodal(self, grid: PlaneGrid, t: float, dt: float):
         """``(v*_i, a*_i)`` (n_nodes, 2) at the nodes (module docstring)."""
-        s, x = self.solution, grid.nodes
-        half = t - 0.5 * dt
-        return _vector(s.velocity, reference_of(s, x, half), half), _vector(s.acceleration, reference_of(s, x, t), t)
+        s, half = self.solution, t - 0.5 * dt
+        return (_vector(s.velocity, self.reference_of_nodes(grid, half), half),
+                _vector(s.acceleration, self.reference_of_nodes(grid, t), t))
 
     def at_particles(self, X: np.ndarray, t: float, dt: float):
         """``(v(X_p, t - dt/2), a(X_p, t), L(X_p, t + dt/2))``: (n_p, 2), (n_p, 2), (n_p, 2, 2)."""

@@ -41,8 +41,9 @@ class PlaneSettings:
     solution's ``amplitude``, the 1D ``basis`` of the tensor basis, the ``mass`` (``lumped``,
     ``consistent``, ``exact``), ``cfl``, the layout (``regular``, ``jittered``) and its ``seed``,
     ``T`` (None: one period for ``axis``, 1 for ``vortex``), the PIC/FLIP ``flip``, the stage
-    switches ``projection``, ``interpolation``, ``acceleration`` and the time ``refine``, and the
-    order of the exact projection's reference quadrature ``quadrature``."""
+    switches ``projection``, ``interpolation``, ``acceleration`` and the time ``refine``, the
+    order of the exact projection's reference quadrature ``quadrature``, and the ``scheme``
+    (``usl``, or ``musl``: :mod:`mpm_fem.plane.step`)."""
 
     problem: str = "axis"
     h: float = 1 / 16
@@ -60,6 +61,7 @@ class PlaneSettings:
     acceleration: str = "calculated"
     refine: int = 1
     quadrature: int = 6
+    scheme: str = "usl"
 
     def __post_init__(self):
         if self.problem not in PROBLEMS:
@@ -83,7 +85,8 @@ class PlaneSettings:
     @property
     def stages(self) -> Stages:
         return Stages(basis=self.basis, mass=self.mass, flip=self.flip, projection=self.projection,
-                      interpolation=self.interpolation, acceleration=self.acceleration, refine=self.refine)
+                      interpolation=self.interpolation, acceleration=self.acceleration, refine=self.refine,
+                      scheme=self.scheme)
 
 
 @dataclass(frozen=True, eq=False)

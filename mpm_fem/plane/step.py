@@ -12,11 +12,14 @@ The particles carry ``v_p^{n-1/2}`` (the run starts from the exact ``v(X_p, -dt/
     x_p <- x_p + dt sum_i S_ip v_i^+
     F_p <- (I + dt sum_i v_i^+ (x) G_ip) F_p,   V_p = det(F_p) V_p^0,   sigma_p: :mod:`~mpm_fem.plane.model`
 
+MUSL (``scheme="musl"``, as in 1D): the velocity gradient takes ``v_i^+`` re-projected from the new
+particle velocities, ``v_i^+ = sum_p m_p v_p S_ip / m_i`` (or the consistent solve), which keeps a
+node that a particle barely touches (a free surface) from handing its large ``a_i`` to ``L_p``.
 (``S_ip``, ``G_ip``: :mod:`~mpm_fem.plane.bases`). A node without mass gets ``v_i = a_i = 0``.
 The stage switches are the 1D :class:`~mpm_fem.core.step.Stages` (``mass``, ``projection``,
 ``interpolation``, ``acceleration``, ``flip``; ``refine`` is the time loop's), their exact forms
 those of :mod:`mpm_fem.exact_stages.stage` as :mod:`mpm_fem.plane.exact` gives them; the 1D-only
-switches (``scheme``, ``xpic``, ``reconstruct``, ``volume``, ``transfer``, ``volume_rate``) must keep
+switches (``scheme`` USF, ``xpic``, ``reconstruct``, ``volume``, ``transfer``, ``volume_rate``) must keep
 their defaults. The basis is the ``basis`` argument (``stages.basis`` is not read). No Python loop
 runs over particles or nodes.
 """
@@ -38,13 +41,16 @@ from mpm_fem.plane.model import check_orientation, determinant, neo_hookean_stre
 from mpm_fem.plane.state import PlaneParticles
 
 #: the 1D switches the 2D step does not offer, with the value they must keep
-ONE_D_ONLY = {"scheme": "usl", "xpic": 0, "reconstruct": "none", "volume": "carried", "transfer": "flip",
+ONE_D_ONLY = {"xpic": 0, "reconstruct": "none", "volume": "carried", "transfer": "flip",
               "volume_rate": "point"}
+SCHEMES = ("usl", "musl")
 BodyForce = Callable[[np.ndarray, np.ndarray, float], np.ndarray]  # (X, Y, t) -> (2, n) per unit mass
 
 
 def check_stages(stages: Stages) -> None:
     """Raise ``ValueError`` for a switch the 2D step does not take (module docstring)."""
+    if stages.scheme not in SCHEMES:
+        raise ValueError(f"the 2D step runs the schemes {', '.join(SCHEMES)}, got {stages.scheme!r}")
     for name, value in ONE_D_ONLY.items():
         if getattr(stages, name) != value:
             raise ValueError(f"the 2D step runs with {name}={value!r}, got {getattr(stages, name)!r}")
@@ -151,6 +157,9 @@ def step_with_grid(state: PlaneParticles, grid: PlaneGrid, basis: str | Basis, m
         L = shape.gather_gradient(v_new)
     v = stages.flip * (state.v + dt * acceleration) + (1.0 - stages.flip) * moving
     x = state.x + dt * moving
+    if stages.scheme == "musl":  # the velocity gradient from the grid velocity re-projected from the new v_p
+        v_new = np.where(active, solve(shape.scatter(m[:, None] * v)), 0.0)
+        L = shape.gather_gradient(v_new)
     F = update_deformation(state.F, L, dt)
     J = determinant(F)
     check_orientation(J, x)
