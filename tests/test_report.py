@@ -366,3 +366,55 @@ def test_failed_runs_are_named_in_the_claims_section(rendered):
     section = rendered.split('<a id="c3-sod"></a>')[1].split("<a id=")[0]
     assert ("Runs that failed, left out of the verdict: sod/ppc: 2 of 18 runs failed (ppc = 1; h = 0.0025, "
             "0.000625): positivity lost.") in section, section[-600:]
+
+
+# ----------------------------------------------------------------------------- one code version per report
+
+def _restamped(tables, code: str):
+    return {**tables, "versions": [{**r, "code": code} for r in tables["versions"]]}
+
+
+def test_a_deep_tier_of_another_code_version_is_left_out_and_changes_no_verdict(tables):
+    """The committed deep tier (another code version than the record's; E2 confirmed on its tables, differs on
+    the record's) is not shown: one sentence says it exists, how to run it and when it enters; no verdict moves.
+    The same tables stamped with the record's code are shown, and E2's move is said."""
+    from mpm_fem.app.report import code_version
+
+    if not (FIGURES / "deep").is_dir():
+        pytest.skip("no committed deep tier")
+    deep = load_tables(FIGURES / "deep")
+    record = code_version(tables)
+    other = _restamped(deep, "0123456789ab") if code_version(deep) == record else deep
+    text = render(tables, [], current=record, deep=other)
+    assert f"written by code version {code_version(other)}, not this record's {record}, so they are left out of " \
+           "this report and change no verdict; they enter it when `mpm-fem reproduce --deep` regenerates them at " \
+           f"the current code ({record})." in text
+    assert "deep/REPORT.md" not in text and "on the deep tier:" not in text and "moves from" not in text
+    summary = text.split("## 3 Results")[1].split("<a id=")[0]
+    assert summary == render(tables, [], current=record).split("## 3 Results")[1].split("<a id=")[0]
+    shown = render(tables, [], current=record, deep=_restamped(deep, record))
+    assert "E2 (bases: point-mass P1 vs GIMP vs C1 B-spline) moves from *differs* to *confirmed* on the deep tier" \
+        in shown and "[deep/REPORT.md](deep/REPORT.md)" in shown
+
+
+def test_a_table_of_another_code_version_is_left_out_of_the_report_and_the_readme(tables):
+    """One table of the record stamped by another code version: its claim is not measured and says why, the
+    caveats name it, its rows are not shown, and E4 still sees its stamp (other versions: refuted)."""
+    from mpm_fem.app.pages import PAGES
+    from mpm_fem.app.report import code_version, results_in_brief
+
+    record = code_version(tables)
+    mixed = {**tables, "versions": [{**r, "code": "0123456789ab"} if r["table"] == "sod/extrema" else r
+                                    for r in tables["versions"]]}
+    text = render(mixed, PAGES, current=record)
+    c14 = text.split('<a id="c14"></a>')[1].split("<a id=")[0]
+    assert "**not measured**" in c14 and "left out: `sod/extrema.csv` was written by code version 0123456789ab, " \
+        "another than the record's" in c14
+    assert f"**1 of {len(tables['versions'])} tables are left out of this report**: written by another code version " \
+           f"than the record's {record} (sod/extrema;" in text
+    e4 = text.split('<a id="e4"></a>')[1].split("<a id=")[0]
+    assert "**refuted**" in e4 and "sod/extrema" in e4
+    assert "No rows in `sod/extrema.csv`." in text.split('<a id="appendix-sod"></a>')[1]
+    brief = results_in_brief(mixed)
+    assert "| [C14](figures/REPORT.md#c14) | particle density/energy updates create new extrema at cell crossings | " \
+           "**not measured** | left out: `sod/extrema.csv` was written by code version 0123456789ab" in brief

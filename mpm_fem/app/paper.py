@@ -40,7 +40,7 @@ from mpm_fem.measure.claims import (
     select,
     span,
 )
-from mpm_fem.measure.claims.base import DIFFERS, PARTLY, REFUTED
+from mpm_fem.measure.claims.base import DIFFERS, NOT_MEASURED, PARTLY, REFUTED
 from mpm_fem.measure.claims.drift import STUDY, mechanism
 from mpm_fem.measure.claims.rules import RULES, VERDICT_MEANING
 from mpm_fem.measure.tables import Tables
@@ -65,11 +65,21 @@ REPRODUCTION = Page("reproduce", "Reproduction", "Every table carries the versio
                     "command regenerates them all. Each table's stamp is in the appendix.")
 
 
-def judge(tables: Tables) -> Found:
+def judge(tables: Tables, left_out: dict[str, str] | None = None) -> Found:
     """Every registered claim's finding on ``tables``, by label, in the order of :data:`CLAIMS`; a finding
     that names no failed run while a table its claim reads holds some gets them named
-    (:func:`mpm_fem.measure.claims.failures`), so that no failed run is left out silently."""
-    return {c.label: (c, _with_failures(c, c.finding(tables), tables)) for c in CLAIMS}
+    (:func:`mpm_fem.measure.claims.failures`), so that no failed run is left out silently. A claim that
+    reads a table of ``left_out`` (``{table: its code version}``: another version than the record's,
+    :func:`mpm_fem.app.report.of_code`) is not measured, and says why."""
+    left_out = left_out or {}
+    found = {}
+    for c in CLAIMS:
+        left = [name for name in c.tables if name in left_out]
+        f = (Finding(NOT_MEASURED, "left out: " + ", ".join(f"`{name}.csv` was written by code version "
+                                                             f"{left_out[name]}" for name in left)
+                     + ", another than the record's") if left else _with_failures(c, c.finding(tables), tables))
+        found[c.label] = (c, f)
+    return found
 
 
 def _with_failures(c: Claim, f: Finding, tables: Tables) -> Finding:
@@ -429,20 +439,19 @@ def drift_section(tables: Tables, captions: dict) -> list[str]:
     return lines + prose(mechanism(tables))
 
 
-def deep_changes(found: Found, deep_found: Found | None, stale: bool = False) -> list[str]:
-    """One sentence per verdict that moves between the full and the deep tier's tables; ``stale``: the
-    deep tables were written by other code than these (said first: a move is then no finding)."""
+def deep_changes(found: Found, deep_found: Found | None, note: str = "") -> list[str]:
+    """One sentence per verdict that moves between the full and the deep tier's tables (a move to or from
+    ``not measured`` is a table not run or left out, no finding); ``note``: the sentence on a deep tier
+    whose tables were left out (another code version than the record's), said instead."""
     lines = ["### What the deep tier changes", ""]
+    if note:
+        return lines + prose(note)
     if deep_found is None:
         return lines + prose("`deep/` holds no tables: `mpm-fem reproduce --deep` runs the finest meshes and the "
                              "long sweeps into it, and this section then says which verdicts move.")
-    if stale:
-        lines += prose("The deep tier's tables were written by another code version than this record's (its "
-                       "appendix names it), before this round's changes to the criteria and the plans: a verdict "
-                       "that moves below may move because of those changes, not because of the finer meshes, "
-                       "until `mpm-fem reproduce --deep` rewrites them.")
     moves = [(c, f, deep_found[label][1]) for label, (c, f) in found.items()
-             if label in deep_found and deep_found[label][1].verdict != f.verdict]
+             if label in deep_found and deep_found[label][1].verdict != f.verdict
+             and NOT_MEASURED not in (f.verdict, deep_found[label][1].verdict)]
     if not moves:
         return lines + prose("No verdict moves between the full tier's tables and the deep tier's finer meshes "
                              "and longer sweeps ([the deep tier's verdicts](#deep)).")
@@ -452,14 +461,14 @@ def deep_changes(found: Found, deep_found: Found | None, stale: bool = False) ->
 
 
 def discussion(tables: Tables, found: Found, captions: dict, deep_found: Found | None,
-               stale: bool = False) -> list[str]:
+               deep_note: str = "") -> list[str]:
     return ["## Discussion", "", *prose(
         "Each claim whose measured behaviour departs from the source's statement, with what the study measured "
         "about why; then the drift study, which measures the mechanism of the growth of Sod's particle error, the "
         "defect study, which predicts that error from the local defect of each step, and what the deep tier's "
         "finer meshes change."), *discrepancies(found),
         *drift_section(tables, captions.get("drift", {})), *defect_section(tables, captions.get("defect", {})),
-        *deep_changes(found, deep_found, stale)]
+        *deep_changes(found, deep_found, deep_note)]
 
 
 def conclusions(found: Found, tables: Tables | None = None) -> list[str]:

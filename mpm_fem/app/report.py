@@ -46,6 +46,23 @@ def code_version(tables: Tables) -> str:
     return max(set(codes), key=codes.count) if codes else "none"
 
 
+#: The tables built from the JSON beside every table (:func:`mpm_fem.measure.tables.load_tables`): kept
+#: whole, so that E4 sees the stamp of every table, those left out too.
+META = ("versions", "settings")
+
+
+def of_code(tables: Tables, code: str) -> tuple[Tables, dict[str, str]]:
+    """``tables`` without every table whose code stamp is not ``code`` (its settings rows too; the
+    ``versions`` table kept whole), and ``{table: its code}`` of the tables left out: a report shows the
+    tables of one code version only."""
+    stamp = {r["table"]: r["code"] for r in tables.get("versions", [])}
+    left = {name: stamp[name] for name in tables if name not in META and stamp.get(name, code) != code}
+    kept = {name: rows for name, rows in tables.items() if name not in left}
+    if "settings" in kept:
+        kept["settings"] = [r for r in kept["settings"] if r.get("table") not in left]
+    return kept, left
+
+
 def is_quick(tables: Tables) -> bool:
     return any(r.get("tier") == "quick" for r in tables.get("versions", []))
 
@@ -141,9 +158,26 @@ def stamps_appendix(letter: str, tables: Tables) -> list[str]:
                     *markdown_table(rows, ("table", "code", "tier")), ""]
 
 
-def deep_appendix(letter: str, deep: Tables | None, deep_found: Found | None) -> list[str]:
-    """The deep tier's verdict table (``figures/deep/``), or a line saying it holds no tables."""
+def deep_left_out(deep: Tables | None, left: dict[str, str], record: str, current: str | None) -> str:
+    """The one sentence on a deep tier whose tables were all left out (another code version than the
+    record's): that it exists, how to run it, and when its tables enter the report; "" otherwise."""
+    if not deep or not left or any(name not in META and name not in left for name in deep):
+        return ""
+    codes = ", ".join(sorted(set(left.values())))
+    when = (f"at the current code ({record})" if current in (None, record) else
+            f"at the code version of this record's tables ({record}; the record itself lags the current code "
+            f"{current}, so `mpm-fem reproduce --full` first)")
+    return (f"The deep tier exists (`deep/`: {len(left)} tables of the finest meshes and the longest sweeps), but its "
+            f"tables were written by code version {codes}, not this record's {record}, so they are left out of this "
+            f"report and change no verdict; they enter it when `mpm-fem reproduce --deep` regenerates them {when}.")
+
+
+def deep_appendix(letter: str, deep: Tables | None, deep_found: Found | None, note: str = "") -> list[str]:
+    """The deep tier's verdict table (``figures/deep/``, its tables of the record's code version only), or
+    the sentence ``note`` on a deep tier left out, or a line saying it holds no tables."""
     lines = ['<a id="deep"></a>', "", f"## Appendix {letter}: the deep tier's verdicts", ""]
+    if note:
+        return lines + [note, ""]
     if deep_found is None:
         return lines + ["`deep/` holds no tables: `mpm-fem reproduce --deep` runs the finest meshes and the long "
                         "sweeps into it, and this appendix then shows their verdicts.", ""]
@@ -177,16 +211,15 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
     out += not_judged(tables)
     written = code_version(tables)
     rows = tables.get("versions", [])
-    behind = sorted({r["table"].split("/")[0] for r in rows if r["code"] != current})
+    others = [r["table"] for r in rows if r["code"] != written]
     if current is not None and current != written:
         out.append("- " + lag_note(tables, current)[0])
-    elif current is not None and behind:
-        out.append(f"- **Part of the figures lag the code**: {len(rows) - sum(r['code'] != current for r in rows)} "
-                   f"of {len(rows)} tables come from the current code ({current}); the studies "
-                   f"{', '.join(behind)} still hold tables of an older code ([the stamps](#appendix-stamps), E4); "
-                   "`mpm-fem reproduce --full` regenerates them.")
     elif current is not None:
         out.append(f"- The tables were written by the current code ({written}).")
+    if others:
+        out.append(f"- **{len(others)} of {len(rows)} tables are left out of this report**: written by another code "
+                   f"version than the record's {written} ({', '.join(others)}; [the stamps](#appendix-stamps), E4), "
+                   "so the claims that read them are not measured here; `mpm-fem reproduce --full` regenerates them.")
     setting = {r["key"]: r["value"] for r in tables.get("settings", []) if r["table"] == "sod/convergence"}
     if "mpm.ppc" in setting:
         out.append(f"- The studies that run Sod at one setting (the error budget, the bases, the remedies, the drift "
@@ -202,8 +235,14 @@ def render(tables: Tables, pages, captions: dict[str, dict] | None = None, curre
     the figure ``captions`` of each study folder (``{study: {file: caption}}``), the code version now
     (``current``) and the deep tier's tables (``deep``, ``None`` when there are none)."""
     captions = captions or {}
-    found = judge(tables)
-    deep_found = judge(deep) if deep and deep.get("versions") else None
+    record = code_version(tables)
+    everything = tables
+    tables, left = of_code(tables, record)
+    found = judge(tables, left)
+    deep_tables, deep_left = of_code(deep, record) if deep else ({}, {})
+    measured = any(rows for name, rows in deep_tables.items() if name not in META)
+    deep_found = judge(deep_tables, deep_left) if measured else None
+    note = deep_left_out(deep, deep_left, record, current)
     lines = [TITLE, "",
              f"Rendered by `python -m mpm_fem.app.report` from the tables of code version {code_version(tables)}. "
              "Source: L.-T. Tran and M. Berzins, Error Analysis for Material Point Method and a case study from Gas "
@@ -213,16 +252,15 @@ def render(tables: Tables, pages, captions: dict[str, dict] | None = None, curre
         study, file = key.split("/")
         if file in captions.get(study, {}):
             lines += figure(study, file, captions[study])
-    lines += paper.introduction(found) + paper.method(tables, caveats(tables, current))
+    lines += paper.introduction(found) + paper.method(tables, caveats(everything, current))
     lines += paper.results(tables, found, pages, captions, partial(summary, found, ""))
-    stale = bool(deep_found) and code_version(deep) != code_version(tables)
-    lines += paper.discussion(tables, found, captions, deep_found, stale) + paper.conclusions(found, tables)
+    lines += paper.discussion(tables, found, captions, deep_found, note) + paper.conclusions(found, tables)
     lines += rules_appendix(found)
     shown = [page for page in pages if any(t.startswith(page.name + "/") for t in tables)]
     letters = iter("BCDEFGHIJKLMNOPQRSTUVWXYZ")
     for page in shown:
         lines += appendix_section(next(letters), page, tables, captions.get(page.name, {}))
-    lines += stamps_appendix(next(letters), tables) + deep_appendix(next(letters), deep, deep_found)
+    lines += stamps_appendix(next(letters), tables) + deep_appendix(next(letters), deep_tables, deep_found, note)
     return "\n".join(paper.numbered(lines))
 
 
@@ -306,9 +344,10 @@ README_END = "<!-- end of the results in brief -->"
 
 def results_in_brief(tables: Tables, report: str = "figures/REPORT.md") -> str:
     """README's "Results in brief": the summary of the report, its links pointing into ``report``."""
+    kept, left = of_code(tables, code_version(tables))
     return "\n".join([README_BEGIN, f"Verdicts computed from the committed tables (code version "
                       f"{code_version(tables)}); each claim links to its section of `{report}`.", "",
-                      *summary(judge(tables), report), README_END])
+                      *summary(judge(kept, left), report), README_END])
 
 
 def update_readme(readme: Path, tables: Tables) -> None:
