@@ -44,17 +44,22 @@ class PlaneShape:
 
     def scatter_gradient(self, q: np.ndarray) -> np.ndarray:
         """Particles -> grid: ``sum_p q_p^{ab} G_ip^b`` for ``q`` (n_p, d, 2) -> (n_nodes, d)."""
-        flux = np.einsum("pab,pkb->pka", q, self.G)  # (n_p, K, d)
-        return np.column_stack([np.bincount(self.nodes.ravel(), flux[:, :, a].ravel(), self.n_nodes)
-                                for a in range(q.shape[1])])
+        Gx, Gy, nodes = self.G[:, :, 0], self.G[:, :, 1], self.nodes.ravel()
+        return np.column_stack([np.bincount(nodes, (q[:, a, 0, None] * Gx + q[:, a, 1, None] * Gy).ravel(),
+                                            self.n_nodes) for a in range(q.shape[1])])
 
     def gather(self, f: np.ndarray) -> np.ndarray:
         """Grid -> particles: ``sum_i S_ip f_i``, ``f`` (n_nodes, d) -> (n_p, d)."""
-        return np.einsum("pk,pkd->pd", self.S, f[self.nodes])
+        return np.column_stack([np.sum(self.S * f[self.nodes, a], axis=1) for a in range(f.shape[1])])
 
     def gather_gradient(self, f: np.ndarray) -> np.ndarray:
         """Grid -> particles: ``sum_i f_i^a G_ip^b`` (n_p, d, 2), for ``f`` (n_nodes, d): the gradient."""
-        return np.einsum("pka,pkb->pab", f[self.nodes], self.G)
+        out = np.empty((self.nodes.shape[0], f.shape[1], 2))
+        for a in range(f.shape[1]):  # the components: d x 2 row sums
+            fa = f[self.nodes, a]
+            out[:, a, 0] = np.sum(fa * self.G[:, :, 0], axis=1)
+            out[:, a, 1] = np.sum(fa * self.G[:, :, 1], axis=1)
+        return out
 
     def matrix(self) -> sp.csr_matrix:
         """The (n_p x n_nodes) sparse matrix of ``S_ip``; repeated nodes summed."""

@@ -41,15 +41,24 @@ def check_orientation(J: np.ndarray, x: np.ndarray) -> None:
         raise InversionError(p, float(J[p]), x[p])
 
 
+def _product(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """``A B`` of (n_p, 2, 2) stacks, by components (faster than ``einsum`` for 2 x 2)."""
+    out = np.empty_like(A)
+    for a in range(2):
+        for c in range(2):
+            out[:, a, c] = A[:, a, 0] * B[:, 0, c] + A[:, a, 1] * B[:, 1, c]
+    return out
+
+
 def update_deformation(F: np.ndarray, L: np.ndarray, dt: float) -> np.ndarray:
     """``F <- (I + dt L) F`` (n_p, 2, 2)."""
-    return F + dt * np.einsum("pab,pbc->pac", L, F)
+    return F + dt * _product(L, F)
 
 
 def neo_hookean_stress(F: np.ndarray, mu: float, lam: float) -> np.ndarray:
     """``sigma = (mu (F F^T - I) + lambda ln J I) / J`` (n_p, 2, 2); ``J > 0`` is the caller's check."""
     J = determinant(F)
-    B = np.einsum("pab,pcb->pac", F, F)
+    B = _product(F, np.swapaxes(F, 1, 2))
     B[:, 0, 0] -= 1.0
     B[:, 1, 1] -= 1.0
     sigma = mu * B
