@@ -5,7 +5,7 @@ case study from Gas Dynamics" (slides; the claims and the source's tables: ``doc
 
 The notebook entry points, :func:`sod` and :func:`burgers` (:mod:`mpm_fem.app.api`), run one case
 with the command line's defaults: ``mpm_fem.sod(h=0.005, ppc=8).errors``. They are imported on first
-use, so that ``import mpm_fem`` stays cheap.
+use, so that ``import mpm_fem`` stays cheap; so is the 2D package, ``mpm_fem.plane.axis(h=1/16)``.
 """
 
 __version__ = "0.1.0"
@@ -13,6 +13,10 @@ __all__ = ["sod", "burgers", "Run"]
 
 
 def __getattr__(name: str):
+    if name == "plane":  # the 2D package (mpm_fem.plane.axis, .vortex), imported on first use
+        import mpm_fem.plane
+
+        return mpm_fem.plane
     if name in __all__:
         from mpm_fem.app import api
 
