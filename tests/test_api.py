@@ -5,6 +5,7 @@ from __future__ import annotations
 import doctest
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import mpm_fem
@@ -208,3 +209,127 @@ def test_the_convergence_helper_gives_the_orders_of_the_measure_package(tmp_path
     assert set(c.orders) == {"particles_L1", "particles_L2", "nodes_L1", "nodes_L2"}
     again = mpm_fem.sod.convergence(hs=(0.05, 0.025), seeds=(0, 1), T=0.05, jobs=1, progress=False, cache=tmp_path)
     assert again.runs == c.runs and len(list(tmp_path.glob("*.json"))) == 4
+
+
+# --- bad input: one exception family, one line naming the setting and the value ---------------------
+
+@pytest.fixture
+def own_registry(monkeypatch):
+    """Bases and transfers registered by a test go into a copy of the registries."""
+    from mpm_fem.bases import plugins, registry
+    from mpm_fem.core.transfers import plugins as transfer_plugins
+    from mpm_fem.core.transfers import registry as transfer_registry
+
+    monkeypatch.setattr(registry, "_BASES", dict(registry._BASES))
+    monkeypatch.setattr(transfer_registry, "_TRANSFERS", dict(transfer_registry._TRANSFERS))
+    for loader in (plugins.LOADER, transfer_plugins.LOADER):
+        monkeypatch.setattr(loader, "loaded", {})
+        monkeypatch.setattr(loader, "failed", {})
+
+
+REFUSED = [
+    (lambda: mpm_fem.sod(h=0.013), r"^sod\(\): h=0.013 does not divide the domain"),
+    (lambda: mpm_fem.sod(h=float("nan")), r"^sod\(\): cell size h must be positive and finite, got h=nan"),
+    (lambda: mpm_fem.sod(h="0.01"), r"^sod\(\): h must be a number, got '0.01' \(str\)"),
+    (lambda: mpm_fem.sod("study"), r"^sod\(\): h must be a number, got 'study' .*preset='study'"),
+    (lambda: mpm_fem.sod(ppc="4"), r"^sod\(\): ppc must be an integer, got '4'"),
+    (lambda: mpm_fem.sod(ppc=0), r"^sod\(\): particles per cell must be an integer >= 1, got 0"),
+    (lambda: mpm_fem.sod(cfl=True), r"^sod\(\): cfl must be a number, got True"),
+    (lambda: mpm_fem.sod(cfl=0.9), r"^sod\(\): the CFL number must lie in \(0, 0.5\] with lumped mass"),
+    (lambda: mpm_fem.sod(gamma=1.0), r"^sod\(\): the ratio of specific heats gamma must be > 1, got 1.0"),
+    (lambda: mpm_fem.sod(left="abc"), r"^sod\(\): left must be a tuple of numbers, got 'abc'"),
+    (lambda: mpm_fem.sod(layout="grid"), r"^sod\(\): unknown particle layout 'grid'"),
+    (lambda: mpm_fem.sod(mass="heavy"), r"^sod\(\): unknown mass 'heavy'"),
+    (lambda: mpm_fem.sod(basis="nope"), r"^sod\(\): unknown basis 'nope'; choose one of mpm, .*package.module:Name"),
+    (lambda: mpm_fem.sod(basis=3), r"^sod\(\): basis must be a name \(a string\), got 3"),
+    (lambda: mpm_fem.sod(basis="no_such_pkg.bases:Quintic"),
+     r"^sod\(\): the basis no_such_pkg.bases:Quintic cannot be loaded: No module named 'no_such_pkg'"),
+    (lambda: mpm_fem.sod(basis="plugin_bases:Heavy"), r"^sod\(\): the basis plugin_bases:Heavy breaks its contract"),
+    (lambda: mpm_fem.sod(transfer="zzz"), r"^sod\(\): unknown transfer 'zzz'"),
+    (lambda: mpm_fem.sod(flip=2.0), r"^sod\(\): the PIC/FLIP blend must lie in \[0, 1\]"),
+    (lambda: mpm_fem.sod(kernel="c"), r"^sod\(\): unknown kernel 'c'"),
+    (lambda: mpm_fem.sod(preset=0.01), r"^unknown preset 0.01; choose one of"),
+    (lambda: mpm_fem.burgers(solution="zz"), r"^burgers\(\): unknown Burgers solution 'zz'"),
+    (lambda: mpm_fem.sod.settings("paper"), r"^unknown preset 'paper'"),
+    (lambda: mpm_fem.sod.exact([0.5, float("nan")], t=0.2),
+     r"^sod\.exact\(\): the positions x must be finite, got nan at index 1"),
+    (lambda: mpm_fem.sod.exact([float("inf")]), r"^sod\.exact\(\): the positions x must be finite, got inf"),
+    (lambda: mpm_fem.sod.exact(["a"], t=0.2), r"^sod\.exact\(\): x must be numbers"),
+    (lambda: mpm_fem.sod.exact([0.5], t="0.2"), r"^sod\.exact\(\): t must be a finite number, got '0.2'"),
+    (lambda: mpm_fem.sod.exact([0.5], t=-1.0), r"^sod\.exact\(\): the time t must be >= 0, got -1.0"),
+    (lambda: mpm_fem.burgers.exact([float("nan")]), r"^burgers\.exact\(\): the positions x must be finite"),
+    (lambda: mpm_fem.sod.fem(h=0.013), r"^sod\.fem\(\): h=0.013 does not divide the domain"),
+    (lambda: mpm_fem.sod.fem(h="0.1"), r"^sod\.fem\(\): h must be a finite number, got '0.1'"),
+    (lambda: mpm_fem.sod.fem(h=0.1, mass="x"), r"^unknown mass 'x'; choose one of 'lumped', 'consistent'"),
+    (lambda: mpm_fem.sod.fem(h=0.1, cfl="x"), r"^sod\.fem\(\): cfl must be a number, got 'x'"),
+    (lambda: mpm_fem.sod.fv(h=0.1, limiter="zz"), r"^sod\.fv\(\): unknown limiter 'zz'"),
+    (lambda: mpm_fem.burgers.fem(h=0.03), r"^burgers\.fem\(\): h=0.03 does not divide the domain \[0.0, 2.0\]"),
+    (lambda: mpm_fem.burgers.fv(h=0.05), r"^burgers has no finite-volume baseline"),
+    (lambda: mpm_fem.sod.convergence(hs=(0.013, 0.1)), r"^sod\.convergence\(\): h=0.013 does not divide"),
+    (lambda: mpm_fem.sod.convergence(hs="0.1"), r"^sod\.convergence\(\): hs takes a sequence"),
+    (lambda: mpm_fem.sod.convergence(hs=(0.1, "0.05")), r"^sod\.convergence\(\): h of hs must be a finite number"),
+    (lambda: mpm_fem.sod.convergence(hs=(0.1, 0.05), seeds=(-1,)), r"^sod\.convergence\(\): seeds are integers"),
+    (lambda: mpm_fem.sod.convergence(hs=(0.1, 0.05), solver="fem", mass="x"), r"^unknown mass 'x'"),
+    (lambda: mpm_fem.sod.convergence(hs=(0.1, 0.05), solver="pic"), r"^unknown solver of sod 'pic'"),
+    (lambda: mpm_fem.sod(h=1e-7), r"over the limit|pass yes_long=True"),
+]
+
+
+@pytest.mark.parametrize("call, message", REFUSED, ids=[m for _, m in REFUSED])
+def test_every_bad_input_is_one_usage_error_in_one_line_naming_the_setting(call, message, own_registry):
+    with pytest.raises(mpm_fem.UsageError, match=message) as refused:
+        call()
+    assert isinstance(refused.value, ValueError) and "\n" not in str(refused.value), str(refused.value)
+
+
+def test_an_unknown_keyword_is_a_usage_error_and_a_type_error():
+    from mpm_fem.app.guard import UnknownSetting
+
+    for call in (lambda: mpm_fem.sod(ppcc=8), lambda: mpm_fem.sod.fem(h=0.1, ppc=8),
+                 lambda: mpm_fem.burgers.exact([0.5], gama=1.4)):
+        with pytest.raises(UnknownSetting, match="unexpected keyword argument") as refused:
+            call()
+        assert isinstance(refused.value, mpm_fem.UsageError) and isinstance(refused.value, TypeError)
+
+
+def test_h_by_position_is_h_by_name():
+    by_position, by_name = mpm_fem.sod(0.05, T=0.02), mpm_fem.sod(h=0.05, T=0.02)
+    assert by_position.settings == by_name.settings and by_position.settings.h == 0.05
+    assert np.array_equal(by_position.particles.density, by_name.particles.density)
+
+
+def test_p1_is_the_point_mass_basis_stored_under_its_name_mpm():
+    p1, mpm = mpm_fem.sod(0.05, T=0.02, basis="p1"), mpm_fem.sod(0.05, T=0.02, basis="mpm")
+    assert p1.settings == mpm.settings and p1.settings.basis == "mpm"
+    for name in ("x", "density", "velocity", "energy"):
+        assert np.array_equal(getattr(p1.particles, name), getattr(mpm.particles, name)), name
+    assert p1.errors == mpm.errors
+
+
+def test_a_basis_and_a_transfer_by_package_module_name_as_on_the_command_line(own_registry):
+    run = mpm_fem.sod(0.05, T=0.02, ppc=2, basis="plugin_bases:Hats", transfer="plugin_transfers:Flip2")
+    assert run.settings.basis == "hats" and run.result.kernel == "numpy"
+    assert mpm_fem.sod(0.05, T=0.02, ppc=2, basis="hats").settings.basis == "hats"  # registered now
+
+
+def test_an_installed_entry_point_is_found_on_first_use_without_discover(own_registry, monkeypatch):
+    from importlib.metadata import EntryPoint
+
+    from mpm_fem.bases import loader, plugins
+
+    found = [EntryPoint("hats", "plugin_bases:Hats", plugins.ENTRY_POINT_GROUP)]
+    monkeypatch.setattr(loader, "entry_points", lambda group: [e for e in found if e.group == group])
+    run = mpm_fem.sod(0.05, T=0.02, ppc=2, basis="hats")
+    reference = mpm_fem.sod(0.05, T=0.02, ppc=2, kernel="numpy")
+    assert run.settings.basis == "hats" and np.array_equal(run.particles.density, reference.particles.density)
+
+
+def test_p1_on_the_command_line_is_mpm(tmp_path):
+    import json
+
+    from mpm_fem.app.cli import main
+
+    out = tmp_path / "run"
+    assert main(["sod", "--basis", "p1", "--h", "0.1", "--ppc", "2", "--T", "0.01", "--out", str(out),
+                 "--quiet"]) == 0
+    assert json.loads((out / "summary.json").read_text())["settings"]["basis"] == "mpm"

@@ -15,11 +15,15 @@ keyword (the same names and defaults as ``mpm-fem sod`` / ``mpm-fem burgers``, o
 projected from them, the exact solution at both, and the error norms (L1, L2, max over particles and
 over nodes) of :func:`mpm_fem.problems.sod.errors` / :func:`~mpm_fem.problems.burgers.errors`. Their
 methods run a convergence study (:mod:`mpm_fem.app.convergence`), the baselines and the exact solution
-(:mod:`mpm_fem.app.references`). Bad settings raise ``ValueError`` naming the setting, an unknown
-keyword ``TypeError`` naming the closest one; a run too large for the machine, or estimated over the
-command line's time limit, is refused before anything is allocated
-(:class:`~mpm_fem.app.guard.UsageError`, naming ``yes_long=True``). While numba compiles the kernels
-(a first run) one line on stderr says so (:mod:`mpm_fem.app.compiling`).
+(:mod:`mpm_fem.app.references`). Every bad input raises one exception,
+:class:`~mpm_fem.app.guard.UsageError` (``mpm_fem.UsageError``, a ``ValueError``), in one line naming
+the setting and the value (:mod:`mpm_fem.app.inputs`); an unknown keyword is its subclass
+:class:`~mpm_fem.app.guard.UnknownSetting` (also a ``TypeError``), naming the closest one; a run too
+large for the machine, or estimated over the command line's time limit, is refused before anything is
+allocated (naming ``yes_long=True``). ``basis`` and ``transfer`` take what the command line's
+``--basis`` and ``--transfer`` take: a registered name (``p1`` is the point-mass basis ``mpm``), an
+installed entry point's (found on first use) or ``package.module:Name``. While numba compiles the
+kernels (a first run) one line on stderr says so (:mod:`mpm_fem.app.compiling`).
 """
 
 from __future__ import annotations
@@ -29,7 +33,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from mpm_fem.app import presets, references
+from mpm_fem.app import inputs, presets, references
 from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.convergence import FIELDS, SOLVERS, Convergence, measured, summarise
 from mpm_fem.app.guard import LONG_RUN_S, UsageError, check_cost
@@ -89,10 +93,12 @@ def checked_settings(problem: str, preset: str, given: dict, call: str, yes_long
     stability and cost (``yes_long``) before anything is allocated."""
     kind = presets.settings_type(problem)
     presets.check_keywords(given, {f.name for f in fields(kind)}, call)
-    s = kind(**{**presets.changes(problem, preset), **given})
+    s = inputs.settings(kind, {**presets.changes(problem, preset), **given}, call, given)
     module = _module(problem)
-    module.check_stable(s)
-    check_cost(module.cost(s), yes_long, flag=YES_LONG)
+    with inputs.refused(call), np.errstate(all="ignore"):  # extreme settings: a non-finite estimate is refused
+        module.check_stable(s)
+        cost = module.cost(s)
+    check_cost(cost, yes_long, flag=YES_LONG)
     return s
 
 
@@ -162,27 +168,29 @@ def convergence(problem: str, hs, seeds=(0,), preset: str = "defaults", solver: 
     presets.check_name(f"solver of {problem}", solver, SOLVERS[problem])
     field = field or FIELDS[problem]
     presets.check_name(f"field of {problem}", field, MEASURED[problem])
-    seeds = tuple(seeds)
+    call = f"{problem}.convergence"
+    seeds = _sequence("seeds", seeds, call)
     if not seeds or any(isinstance(k, bool) or not isinstance(k, int) or k < 0 for k in seeds):
-        raise ValueError(f"seeds are integers >= 0 (0: the settings' own layout), got seeds={seeds}")
-    hs, seeds = tuple(sorted((float(h) for h in hs), reverse=True)), tuple(sorted(set(seeds)))
+        raise UsageError(f"{call}(): seeds are integers >= 0 (0: the settings' own layout), got seeds={seeds}")
+    hs = tuple(inputs.number("h of hs", h, call) for h in _sequence("hs", hs, call))
+    hs, seeds = tuple(sorted(hs, reverse=True)), tuple(sorted(set(seeds)))
     if len(hs) < 2 or len(set(hs)) < len(hs):
-        raise ValueError(f"a convergence study takes at least two different meshes, got hs={hs}")
+        raise UsageError(f"{call}(): a convergence study takes at least two different meshes, got hs={hs}")
     if solver != "mpm" and seeds != (0,):
-        raise ValueError(f"the {solver} baseline has no particle layout: run it with seeds=(0,), got seeds={seeds}")
+        raise UsageError(f"{call}(): the {solver} baseline has no particle layout: run it with seeds=(0,), "
+                         f"got seeds={seeds}")
     cases, seconds = [], 0.0
     for h in hs:
         for k in seeds:
             if solver == "mpm":
                 layout = {"layout": seeded, "seed": k} if k else {}
-                s = checked_settings(problem, preset, {**settings, "h": h, **layout}, f"{problem}.convergence",
-                                     yes_long=True)
+                s = checked_settings(problem, preset, {**settings, "h": h, **layout}, call, yes_long=True)
                 seconds += _module(problem).cost(s).seconds
                 given = s.as_dict()
             else:
                 given = _baseline_settings(problem, solver, preset, {**settings, "h": h})
                 problem_of = {k: given[k] for k in ("solution", "eps") if k in given}
-                presets.settings_type(problem)(h=h, **problem_of)  # h divides the domain (GridError)
+                inputs.settings(presets.settings_type(problem), {"h": h, **problem_of}, call)  # h divides the domain
             cases.append({"problem": problem, "solver": solver, "field": field, "settings": given})
     if seconds > LONG_RUN_S and not yes_long:
         raise UsageError(f"{len(cases)} runs estimated at {seconds / 3600:.3g} h together: over "
@@ -197,10 +205,19 @@ def convergence(problem: str, hs, seeds=(0,), preset: str = "defaults", solver: 
     return summarise(problem, solver, field, shared, cases, results)
 
 
+def _sequence(name: str, values, call: str) -> tuple:
+    """``values`` as a tuple (a sequence or array of them; not a string), else ``UsageError``."""
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+        raise UsageError(f"{call}(): {name} takes a sequence, e.g. {name}=(0.02, 0.01), got {values!r}")
+    return tuple(values)
+
+
 def _baseline_settings(problem: str, solver: str, preset: str, given: dict) -> dict:
-    """A baseline run's keywords (:mod:`mpm_fem.app.references`), their names checked."""
+    """A baseline run's keywords (:mod:`mpm_fem.app.references`), their names and types checked."""
+    call = f"{problem}.convergence"
     allowed = {"h", *references.keywords(problem, solver, preset)}
-    presets.check_keywords(given, allowed, f"{problem}.convergence")
+    presets.check_keywords(given, allowed, call)
+    references.check_types(problem, solver, preset, {k: v for k, v in given.items() if k != "h"}, call)
     return {**given, "preset": preset}
 
 
@@ -211,12 +228,14 @@ class Entry:
 
     problem: str
 
-    def __call__(self, preset: str = "defaults", progress: bool | None = False, yes_long: bool = False,
-                 **settings) -> Run:
+    def __call__(self, h: float | None = None, preset: str = "defaults", progress: bool | None = False,
+                 yes_long: bool = False, **settings) -> Run:
         """One MPM run with ``preset``'s settings (the command line's by default) and ``settings``.
 
         Parameters
         ----------
+        h : float, optional
+            The cell size (the preset's if not given), the one setting that may be given by position.
         preset : str
             ``"defaults"``, ``"study"`` or ``"source"`` (:mod:`mpm_fem.app.presets`).
         progress : bool, optional
@@ -230,6 +249,8 @@ class Entry:
         -------
         Run
         """
+        if h is not None:
+            settings["h"] = h
         return run(self.problem, preset, progress, yes_long, **settings)
 
     def settings(self, preset: str = "defaults"):
@@ -248,7 +269,7 @@ class Entry:
     def fv(self, h: float, preset: str = "defaults", **settings) -> references.Reference:
         """Sod's finite-volume baseline on the cells of the mesh ``h`` (:func:`~mpm_fem.app.references.sod_fv`)."""
         if self.problem != "sod":
-            raise ValueError(f"{self.problem} has no finite-volume baseline; its baseline is fem()")
+            raise UsageError(f"{self.problem} has no finite-volume baseline; its baseline is fem()")
         return references.sod_fv(h, preset, **settings)
 
     def exact(self, x, t: float | None = None, **settings) -> dict:

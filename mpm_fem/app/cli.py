@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mpm_fem.app import guard, output
+from mpm_fem.app import guard, inputs, output
 from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.guard import UsageError
 from mpm_fem.app.study import add_study_options, add_tier_options, start_study, study_options
@@ -85,20 +85,21 @@ HELP.update(REMEDY_HELP)
 
 
 def basis_option(spec: str) -> str:
-    """The ``--basis`` value: a registered name, an installed entry point's or a ``package.module:Name``
-    checked against the contract (:mod:`mpm_fem.bases.plugins`); a refusal is argparse's one-line error."""
-    return _extension(plugins.resolve, spec)
+    """The ``--basis`` value: a registered name, an alias (``p1``: ``mpm``), an installed entry point's
+    or a ``package.module:Name`` checked against the contract (:func:`mpm_fem.app.inputs.extension`, as
+    the Python API); a refusal is argparse's one-line error."""
+    return _extension("basis", spec)
 
 
 def transfer_option(spec: str) -> str:
     """The ``--transfer`` value, as :func:`basis_option` (:mod:`mpm_fem.core.transfers.plugins`)."""
-    return _extension(transfer_plugins.resolve, spec)
+    return _extension("transfer", spec)
 
 
-def _extension(resolve, spec: str) -> str:
+def _extension(setting: str, spec: str) -> str:
     try:
-        return resolve(spec)
-    except (ValueError, TypeError) as err:
+        return inputs.extension(setting, spec)
+    except UsageError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
 
 
@@ -108,8 +109,9 @@ EXTENSIONS = {"basis": (basis_option, names), "transfer": (transfer_option, tran
 
 def basis_help() -> str:
     """The ``--basis`` help: every registered basis (installed entry points included)."""
+    aliases = {name: alias for alias, name in inputs.ALIASES["basis"].items()}
     return ("particle basis (the registry of mpm_fem.bases, or package.module:Name of one outside it): "
-            + ", ".join(f"{get(b).title} ({b})" for b in names()))
+            + ", ".join(f"{get(b).title} ({b}{' or ' + aliases[b] if b in aliases else ''})" for b in names()))
 
 
 def _add_settings_options(parser: argparse.ArgumentParser, settings_cls, extra_choices=None, extra_help=None) -> None:
@@ -353,15 +355,13 @@ def cmd_method(args) -> dict:
     from mpm_fem.app.study import StudyOptions
 
     study = importlib.import_module("studies.method")  # the top layer, loaded by name (app.study)
-    try:
-        basis = plugins.resolve(args.basis)
-    except (ValueError, TypeError) as err:
-        raise UsageError(str(err)) from None
+    basis = inputs.extension("basis", args.basis)
+    spec = inputs.ALIASES["basis"].get(args.basis, args.basis)  # studies.method resolves it in each worker
     options = StudyOptions(quick=not args.full, jobs=guard.cap_jobs(args.jobs), out=Path(args.out),
                            progress=False if args.quiet else None)
     if not args.quiet:
-        print(f"method {basis}: {study.describe_estimate(basis, args.basis, options)}", file=sys.stderr)
-    return {"line": f"verdicts written to {study.run(args.basis, options)}"}
+        print(f"method {basis}: {study.describe_estimate(basis, spec, options)}", file=sys.stderr)
+    return {"line": f"verdicts written to {study.run(spec, options)}"}
 
 
 COMMANDS = {"sod": cmd_sod, "burgers": cmd_burgers, "study": cmd_study, "reproduce": cmd_reproduce,

@@ -1,6 +1,7 @@
 """Guard rails of the command line, checked before any work starts.
 
-- Bad input is a :class:`UsageError`: one line on stderr, exit status 2.
+- Bad input is a :class:`UsageError` (a ``ValueError``; ``mpm_fem.UsageError`` for Python callers):
+  one line on stderr, exit status 2. An unknown keyword is :class:`UnknownSetting`, also a ``TypeError``.
 - A run whose estimated memory (:class:`mpm_fem.problems.Cost`, from the settings alone) exceeds
   half the available memory is refused; one estimated over an hour needs ``--yes-long``.
 - ``--jobs`` is capped at the number of cores; a scheduler address must parse and answer a TCP
@@ -24,8 +25,13 @@ LONG_RUN_S = 3600.0  # runs estimated longer need --yes-long
 SCHEDULER_TIMEOUT_S = 3.0
 
 
-class UsageError(Exception):
-    """Bad input: reported on one line, exit status 2."""
+class UsageError(ValueError):
+    """Bad input, the one exception of every refused setting or option: reported on one line naming
+    the setting and the value (exit status 2 on the command line)."""
+
+
+class UnknownSetting(UsageError, TypeError):
+    """An unknown keyword: bad input, and a ``TypeError`` as Python's own for an unexpected keyword."""
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -20,6 +20,8 @@ from __future__ import annotations
 import importlib
 from types import MappingProxyType
 
+from mpm_fem.app.guard import UnknownSetting, UsageError
+
 PRESETS = ("defaults", "study", "source")
 PROBLEMS = ("sod", "burgers")
 #: Sod's particles per cell in the ``source`` preset: the lower end of the slides' "1D: 4-8 particles
@@ -28,9 +30,10 @@ SOURCE_PPC = 4
 
 
 def check_name(what: str, value: str, allowed: tuple) -> None:
-    """``ValueError`` naming ``what`` and the choices unless ``value`` is one of ``allowed``."""
-    if value not in allowed:
-        raise ValueError(f"unknown {what} {value!r}; choose one of {', '.join(map(repr, allowed))}")
+    """:class:`~mpm_fem.app.guard.UsageError` naming ``what`` and the choices unless ``value`` is one of
+    ``allowed``."""
+    if not isinstance(value, str) or value not in allowed:
+        raise UsageError(f"unknown {what} {value!r}; choose one of {', '.join(map(repr, allowed))}")
 
 
 def _study(problem: str):
@@ -104,12 +107,12 @@ def baseline_settings(problem: str, solver: str, preset: str = "defaults") -> Ma
 
 
 def check_keywords(given, allowed, call: str) -> None:
-    """``TypeError`` naming the first of ``given`` not in ``allowed`` (the keywords of ``call``), with the
-    closest allowed name when one is close."""
+    """:class:`~mpm_fem.app.guard.UnknownSetting` (a ``TypeError``) naming the first of ``given`` not
+    in ``allowed`` (the keywords of ``call``), with the closest allowed name when one is close."""
     import difflib
 
     for name in given:
         if name not in allowed:
             close = difflib.get_close_matches(name, list(allowed), n=1)
             hint = f"; did you mean {close[0]}?" if close else f"; the settings are {', '.join(sorted(allowed))}"
-            raise TypeError(f"{call}() got an unexpected keyword argument {name!r}{hint}")
+            raise UnknownSetting(f"{call}() got an unexpected keyword argument {name!r}{hint}")

@@ -19,7 +19,9 @@ from types import MappingProxyType
 
 import numpy as np
 
-from mpm_fem.app.presets import baseline_settings, check_keywords, settings_type
+from mpm_fem.app import inputs
+from mpm_fem.app.guard import UsageError
+from mpm_fem.app.presets import baseline_settings, check_keywords, check_name, settings_type
 from mpm_fem.core.grid import uniform_grid
 from mpm_fem.measure.errors import norms
 
@@ -78,12 +80,36 @@ def keywords(problem: str, solver: str, preset: str = "defaults") -> tuple[str, 
     return (*baseline_settings(problem, solver, preset), *EXTRA[(problem, solver)])
 
 
+#: The mass matrices of the FEM baselines.
+MASSES = ("lumped", "consistent")
+
+
+def check_types(problem: str, solver: str, preset: str, given: dict, call: str) -> None:
+    """Each of ``given`` (a baseline's keywords but ``h``) has the type of its default (the preset's,
+    or the MPM settings' for ``T``, ``gamma``, ``solution``, ``eps``); ``mass`` is one of
+    :data:`MASSES`. Raises :class:`~mpm_fem.app.guard.UsageError`."""
+    mpm = {f: v.default for f, v in settings_type(problem).__dataclass_fields__.items()}
+    defaults = {**mpm, **baseline_settings(problem, solver, preset)}
+    inputs.check_types(defaults, {k: v for k, v in given.items() if k != "mass"}, call)
+    if "mass" in given:
+        check_name("mass", given["mass"], MASSES)
+
+
 def _settings(problem: str, solver: str, preset: str, given: dict, extra: dict, call: str) -> dict:
-    """The preset's settings of the baseline with ``given`` applied (unknown names refused);
-    ``extra``: the defaults of the names of :data:`EXTRA` but ``mass``."""
+    """The preset's settings of the baseline with ``given`` applied (unknown names and wrong types
+    refused); ``extra``: the defaults of the names of :data:`EXTRA` but ``mass``."""
     values = {**baseline_settings(problem, solver, preset), **extra}
     check_keywords(given, values, call)
+    check_types(problem, solver, preset, given, call)
     return {**values, **given}
+
+
+def _mesh(h, domain: tuple[float, float], call: str) -> float:
+    """``h`` a finite number dividing ``domain``, else :class:`~mpm_fem.app.guard.UsageError`."""
+    h = inputs.number("h", h, call)
+    with inputs.refused(call):
+        uniform_grid(*domain, h)
+    return h
 
 
 def sod_fem(h: float, mass: str = "lumped", preset: str = "defaults", **settings) -> Reference:
@@ -109,8 +135,11 @@ def sod_fem(h: float, mass: str = "lumped", preset: str = "defaults", **settings
     from mpm_fem.problems.sod import SodSettings
 
     s = _settings("sod", "fem", preset, settings, {"T": SodSettings.T, "gamma": SodSettings.gamma}, "sod.fem")
-    viscosity = fem_euler.Viscosity(s["viscosity_linear"], s["viscosity_quadratic"], s["compression_only"])
-    r = fem_euler.solve(h, T=s["T"], mass=mass, cfl=s["cfl"], gamma=s["gamma"], viscosity=viscosity)
+    check_name("mass", mass, MASSES)
+    h = _mesh(h, (0.0, 1.0), "sod.fem")
+    with inputs.refused("sod.fem"):  # the baseline's checks of its settings (a failed run: ArithmeticError)
+        viscosity = fem_euler.Viscosity(s["viscosity_linear"], s["viscosity_quadratic"], s["compression_only"])
+        r = fem_euler.solve(h, T=s["T"], mass=mass, cfl=s["cfl"], gamma=s["gamma"], viscosity=viscosity)
     fields = {"density": r.rho, "velocity": r.u, "pressure": r.p}
     exact = _sod_exact(r.nodes, r.t, s["gamma"])
     weights = uniform_grid(0.0, 1.0, h).lumped_mass
@@ -139,7 +168,9 @@ def sod_fv(h: float, preset: str = "defaults", **settings) -> Reference:
     from mpm_fem.problems.sod import SodSettings
 
     s = _settings("sod", "fv", preset, settings, {"T": SodSettings.T, "gamma": SodSettings.gamma}, "sod.fv")
-    r = fv_euler.solve(h, T=s["T"], cfl=s["cfl"], gamma=s["gamma"], limiter=s["limiter"])
+    h = _mesh(h, (0.0, 1.0), "sod.fv")
+    with inputs.refused("sod.fv"):  # the baseline's checks of its settings (a failed run: ArithmeticError)
+        r = fv_euler.solve(h, T=s["T"], cfl=s["cfl"], gamma=s["gamma"], limiter=s["limiter"])
     fields = {"density": r.rho, "velocity": r.u, "pressure": r.p}
     exact = _sod_exact(r.centres, r.t, s["gamma"])
     return Reference(r.name, MappingProxyType({"h": h, **s}), r.centres, fields, exact,
@@ -172,8 +203,12 @@ def burgers_fem(h: float, mass: str = "lumped", preset: str = "defaults", **sett
     problem = mpm_settings("burgers", preset)
     s = _settings("burgers", "fem", preset, settings, {k: problem[k] for k in ("solution", "eps", "T")},
                   "burgers.fem")
-    solution = settings_type("burgers")(solution=s["solution"], eps=s["eps"]).exact
-    r = fem_burgers.solve(solution, h, T=s["T"], mass=mass, cfl=s["cfl"], cfl_visc=s["cfl_visc"])
+    check_name("mass", mass, MASSES)
+    solution = inputs.settings(settings_type("burgers"), {"solution": s["solution"], "eps": s["eps"]},
+                               "burgers.fem").exact
+    h = _mesh(h, solution.domain, "burgers.fem")
+    with inputs.refused("burgers.fem"):  # the baseline's checks of its settings (a failed run: ArithmeticError)
+        r = fem_burgers.solve(solution, h, T=s["T"], mass=mass, cfl=s["cfl"], cfl_visc=s["cfl_visc"])
     fields, exact = {"velocity": r.v}, {"velocity": solution.v(r.nodes, r.t)}
     e = fem_burgers.errors(r, solution)
     return Reference(f"FEM P1 {mass}", MappingProxyType({"h": h, "mass": mass, **s}), r.nodes, fields, exact,
@@ -207,11 +242,13 @@ def exact(problem: str, x, t: float | None = None, **settings) -> dict:
     dict of ndarray, shape (n,)
         Sod: ``density``, ``velocity``, ``pressure``; Burgers: ``velocity``.
     """
-    kind = settings_type(problem)
-    check_keywords(settings, {f for f in kind.__dataclass_fields__}, f"{problem}.exact")
-    s = kind(**settings)
-    x = np.asarray(x, dtype=float)
-    t = s.T if t is None else t
+    kind, call = settings_type(problem), f"{problem}.exact"
+    check_keywords(settings, {f for f in kind.__dataclass_fields__}, call)
+    s = inputs.settings(kind, settings, call)
+    x = inputs.points(x, call)
+    t = s.T if t is None else inputs.number("t", t, call)
+    if t < 0:
+        raise UsageError(f"{call}(): the time t must be >= 0, got {t!r}")
     if problem == "sod":
         from mpm_fem.problems import sod
 
