@@ -364,7 +364,7 @@ def test_failed_runs_are_named_in_the_claims_section(rendered):
     """P1 losing positivity at 1 particle per cell (sod/ppc): C3's section names the failed runs, their count
     and their cause, beside the verdict judged on the runs that finished."""
     section = rendered.split('<a id="c3-sod"></a>')[1].split("<a id=")[0]
-    assert ("Runs that failed, left out of the verdict: sod/ppc: 2 of 18 runs failed (ppc = 1; h = 0.0025, "
+    assert ("Runs that failed (count, where they ran, cause): sod/ppc: 2 of 18 runs failed (ppc = 1; h = 0.0025, "
             "0.000625): positivity lost.") in section, section[-600:]
 
 

@@ -340,10 +340,11 @@ def claim_section(c: Claim, f: Finding, figure_lines: list[str] = (), appendix: 
 
 
 def failed_runs(f: Finding) -> list[str]:
-    """The runs of the finding's tables that failed, by cause (count, where, cause), as a paragraph."""
+    """The runs of the finding's tables that failed, by cause (count, where, cause), as a paragraph; how the
+    verdict reads them (left out, or failing every condition they enter) is in the evidence."""
     if not f.failed:
         return []
-    return [f"Runs that failed, left out of the verdict: {'; '.join(f.failed)}.", ""]
+    return [f"Runs that failed (count, where they ran, cause): {'; '.join(f.failed)}.", ""]
 
 
 def claim_figure(c: Claim, page: Page | None, captions: dict) -> list[str]:
