@@ -104,7 +104,8 @@ _add("SATURATION", 0.05,
      _STUDY + ": the slides say '4-8 particles per cell is optimal' without a tolerance", ("C3",))
 _add("LUMPING_BAND", 0.9,
      "C15 (second reading): a consistent/lumped error ratio below this means lumping is a source of error, above "
-     "its inverse that it compensates",
+     "its inverse that it compensates; above its inverse on every mesh where the direct reading is swamped: C15 "
+     "differs",
      _STUDY + ": the slides name FE + mass lumping a source without a size; a 10 % change is well outside the "
      "spread over meshes of the FEM's own ratio (0.996-0.998)", ("C15",))
 _add("SOURCE_SHARE", 0.1,
@@ -136,9 +137,11 @@ _add("SEPARATE", 0.25,
      "E1: the stages separate when the interactions, in total magnitude, are at most this fraction of the gap "
      "|v(all MPM) - v(all exact)|", _STUDY + ": a quarter of the gap leaves each main effect readable", ("E1",))
 _add("ATTRIBUTABLE", 1.0,
-     "E1: a dominant stage is named only where the interactions are at most this multiple of the gap",
+     "E1: a dominant stage is named only where the interactions are at most this multiple of the gap; C15: the "
+     "mass stage's direct reading is separable where its interactions are at most this multiple of its own effect "
+     "(separable nowhere: swamped, and the consistent/lumped reading decides)",
      _STUDY + ": where the interactions exceed the gap itself, any attribution to one stage is an artefact of "
-     "the order of replacement", ("E1",))
+     "the order of replacement", ("E1", "C15"))
 
 # ---------------------------------------------------------------- MPM against the fixed-mesh FEM
 _add("E3_FACTOR", 1.5,
