@@ -226,7 +226,8 @@ def _c3_burgers(t: Tables) -> Finding:
 def _c15_burgers(t: Tables) -> Finding:
     """The direct measurement: the error budget's mass stage, alone and in its interactions with the
     other stages. The second reading compares the same run with the consistent and with the lumped
-    mass, for MPM with the calculated and with the exact acceleration, and for the fixed-mesh FEM beside."""
+    mass, for MPM with the calculated and with the exact acceleration, and for the fixed-mesh FEM beside.
+    Where the interactions swamp the direct measurement on every norm and mesh, the second reading decides."""
     rows = t.get(BURGERS_LUMPING.name) or []
     labels = {"fem_consistent": "FEM", "fem_lumped": "FEM", "mpm_calculated": "MPM calculated a",
               "mpm_exact": "MPM exact a"}
