@@ -20,8 +20,9 @@ import numpy as np
 from mpm_fem.core.grid import Grid, GridError, n_cells_for, uniform_grid
 from mpm_fem.core.shape import Shape, make_shape
 
-#: cells added at each end of the padded grid: wider than the support of every registered basis
-PAD = 3
+#: cells added at each end of the padded grid: a row of a particle in [lo, hi) keeps off the end functions of
+#: every registered basis (the cubic end functions differ from the uniform splines within four cells of an end)
+PAD = 5
 
 
 @dataclass(frozen=True, eq=False)
