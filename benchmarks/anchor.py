@@ -1,4 +1,4 @@
-"""The anchor: a minimal fused 1D MPM loop for Sod's shock tube, written for speed (issue 47, item 1).
+"""The anchor: a minimal fused 1D MPM loop for Sod's shock tube, written for speed (the compiled sweep's yardstick).
 
 It is the bare P1 Sod loop of the slides, with none of the project's switches, checks or second
 particle set, so that ``benchmarks/step_cost.py`` can report the project's fused loop as a fraction
@@ -23,7 +23,7 @@ eps_p)``, and the next step ``dt = CFL h / max_p (c_p + |v_p|)`` over the update
 last step shortened to land on ``T``. It is the project's USL step (``mpm_fem.core.step``,
 ``mpm_fem.core.models.euler``) to round-off: same equations, other summation order, fast-math.
 
-How it is fast (issue 47): one sweep per step over the particles, which stay sorted (in 1D they
+How it is fast: one sweep per step over the particles, which stay sorted (in 1D they
 keep their order while ``1 - L dt > 0``). The sweep takes blocks of ``BLOCK`` particles in three
 loops: a scalar gather of the nodal ``v_i, a_i`` at each particle's cell; a branch-free update over
 contiguous slices, which LLVM vectorises (it also computes the new cell and the particle's

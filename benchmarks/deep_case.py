@@ -1,4 +1,4 @@
-"""The deep tier's longest swept case, run two ways side by side (issue 47).
+"""The deep tier's longest swept case, run two ways side by side (the compiled sweep).
 
 The deep tier's critical path on a cluster is its longest case. Of the cases the swept loop serves
 (USL, the lumped mass, no remedy), the longest by the cost models is Sod's tube at h = 7.8125e-5 with
@@ -6,7 +6,7 @@ The deep tier's critical path on a cluster is its longest case. Of the cases the
 ``studies.sod.run_case`` on it twice at the same time, in two processes, and compares (``--against``):
 
 - ``sweep``: the compiled loop as the studies run it (with the sweep) against ``FusedStep(sweep=False)``
-  (pass 2 and the next pass 1 apart, the loop before issue 47);
+  (pass 2 and the next pass 1 apart, the loop before the sweep of 2026-11-28);
 - ``count``: the new extrema (C14) counted inside the compiled loop, as the studies count them, against
   the same counter as an observer called after every step (the path before: the steps one at a time).
 
@@ -37,7 +37,7 @@ _ORIGINAL = {}  # this process's FusedStep and ExtremaCounter as solve.run and s
 
 
 def run_as(*before: str) -> None:
-    """Make this process's runs take issue 47's kernel except for the changes named in ``before``, which run
+    """Make this process's runs take the sweep kernel except for the changes named in ``before``, which run
     as they did before it: ``"apart"``, pass 2 and the next pass 1 apart (``FusedStep(sweep=False)``, what
     ``solve.run`` builds); ``"per step"``, Sod's extrema counter called after every step (it has no ``tally``,
     so ``solve.run`` steps one at a time instead of counting in the loop). No names: the kernel as it is."""

@@ -1,13 +1,14 @@
-"""What issue 47's kernel saves of a tier, measured in one run: the time ledger, before and after.
+"""What the sweep kernel (2026-11-28/29) saves of a tier, measured in one run: the time ledger, before and after.
 
-The record's CPU time compared across sessions mixes the kernel with the machine (the same code ran a
-third slower on one session's machine than on the last). This script measures the saving on one
-machine in one run. It takes a sample of every study's cases of a tier and runs each sampled case two
-ways at once, in two processes (each kept on a processor of its own), and compares their CPU times:
+The record's CPU time compared across machines mixes the kernel with the machine (the same code ran a
+third slower on the machine of the record at 79c9907f69f3 than on that of 10aaef63d6f2). This script
+measures the saving on one machine in one run. It takes a sample of every study's cases of a tier and
+runs each sampled case two ways at once, in two processes (each kept on a processor of its own), and
+compares their CPU times:
 
 - ``now``: as the studies run it (the compiled loop with the sweep; Sod's new extrema counted inside
   the loop);
-- ``before``: the kernel before issue 47, the loop with pass 2 and the next pass 1 apart
+- ``before``: the kernel before the sweep, the loop with pass 2 and the next pass 1 apart
   (``FusedStep(sweep=False)``) and the extrema counter called after every step, so that those runs
   step one at a time (``benchmarks/deep_case.py``'s two baselines together).
 
@@ -19,7 +20,7 @@ The sample: a study's cases sorted by their estimated cost (the cost models,
 :func:`mpm_fem.app.estimate.tasks`) are cut into ``k`` consecutive groups of equal estimated cost, and
 the case at the middle of each group's cost stands for it (sampling proportional to size). A study's
 ratio ``r`` is its sampled cases' CPU before over their CPU now (sums over the cases and rounds: a case
-too short to time adds nothing), and its CPU before issue 47 is estimated as ``r`` times its estimated CPU now. Neither
+too short to time adds nothing), and its CPU before the sweep is estimated as ``r`` times its estimated CPU now. Neither
 change moves a float or a count, so every pair's results must be equal (every field but the times),
 and the script fails if one differs.
 The numba cache must be warm for a fair timing (the ``before`` variants compile at their first call):
@@ -125,7 +126,7 @@ def main(argv=None) -> None:
         pool.shutdown()
     with measured_block(args.markdown, "ledger"):
         print(f"The {args.tier} tier, {args.per_study} cases per study sampled in proportion to their estimated cost, "
-              f"each run now and before issue 47 at once in two processes, {args.rounds} rounds, the processors "
+              f"each run now and before the sweep at once in two processes, {args.rounds} rounds, the processors "
               "swapped each round:\n")
         print("| study | estimated now, CPU-min | cases sampled | sample now, CPU-s | sample before, CPU-s "
               "| before / now, sums (cases: min ... max) | estimated before, CPU-min |\n"
@@ -139,7 +140,7 @@ def main(argv=None) -> None:
             print(f"| {name} | {estimated / 60:.1f} | {count} | {cpu['now']:.1f} | {cpu['before']:.1f} | "
                   f"{r:.2f} {spread} | {estimated / 60 * r:.1f} |")
         print(f"| all | {now_total:.1f} | | | | {before_total / now_total:.2f} | {before_total:.1f} |")
-        print(f"\nThe kernel of issue 47 saves about {before_total - now_total:.1f} of {before_total:.1f} estimated "
+        print(f"\nThe sweep kernel saves about {before_total - now_total:.1f} of {before_total:.1f} estimated "
               f"CPU-min of the {args.tier} tier ({1 - now_total / before_total:.0%}); "
               f"{'every pair of results equal' if not differ else f'{len(differ)} pairs DIFFER'} "
               "(every field but the times).")

@@ -13,10 +13,10 @@ lumped mass, 4 particles per cell) at n_p = 1e3 ... 1e7:
     element as STREAM does) and the fused step as a fraction of the bound ``bandwidth / (bytes
     moved per particle-step)``;
   * the speed-up of ``threads=2`` over one thread (wall time of the compiled loop, batches alternated);
-  * the anchor (``benchmarks/anchor.py``, the bare P1 Sod loop written for speed, issue 47) at the
+  * the anchor (``benchmarks/anchor.py``, the bare P1 Sod loop written for speed) at the
     same particle counts, and each basis's fused loop as a fraction of it; and the sweep's gain,
     the loop over the same loop with pass 2 and the next pass 1 apart (``FusedStep(sweep=False)``,
-    the loop before issue 47): the three loops' batches alternate (loop, loop apart, anchor, loop,
+    the loop before the sweep of 2026-11-28): the three loops' batches alternate (loop, loop apart, anchor, loop,
     ...) in the same run, the best batch of each is kept, and the ratios, not wall times, are the
     result.
 Times are the best of ``--repeat`` steps, as CPU time of this process (``time.process_time``):
@@ -47,9 +47,9 @@ BASES = names()  # every registered basis
 RATE_TARGETS = {"mpm": 3e7, "gimp": 2e7, "bspline": 2.5e7, "bspline_gimp": 1e7, "cubic": 2e7}
 PPC = 4
 BATCH_MIN = 20  # the fewest steps of a timed loop call
-SWEEP_GAIN_TARGET = 2.0  # issue 47: every basis's loop at least twice as fast as with pass 2 and pass 1 apart
-ANCHOR_TARGET = 0.6  # issue 47: P1's loop at least this fraction of the anchor's rate
-THREADS_TARGET = 1.8  # issue 47: two threads over one
+SWEEP_GAIN_TARGET = 2.0  # the sweep's target: every basis's loop at least twice as fast as with pass 2 and 1 apart
+ANCHOR_TARGET = 0.6  # P1's loop at least this fraction of the anchor's rate
+THREADS_TARGET = 1.8  # two threads over one
 ANCHOR_BYTES = 6 * 8 + 5 * 8  # the anchor reads x, v, rho, eps, s, m and writes all but m
 STATE_FIELDS = ("x", "volume", "mass", "velocity", "density", "energy", "pressure")
 
@@ -235,13 +235,13 @@ def _run(args) -> None:
         held = at["bytes_per_particle"]
         verdicts.append(f"{basis}: {held:.0f} B per particle (target <= 250: {'met' if held <= 250 else 'NOT met'})")
         gain = at["sweep_gain"]
-        verdicts.append(f"{basis}: loop / loop without the sweep {gain:.2f} (issue 47: >= {SWEEP_GAIN_TARGET:g}: "
+        verdicts.append(f"{basis}: loop / loop without the sweep {gain:.2f} (target: >= {SWEEP_GAIN_TARGET:g}: "
                         f"{'met' if gain >= SWEEP_GAIN_TARGET else 'NOT met'})")
         if basis == "mpm":
-            verdicts.append(f"mpm: loop / anchor {at['of_anchor']:.2f} (issue 47: >= {ANCHOR_TARGET:g}: "
+            verdicts.append(f"mpm: loop / anchor {at['of_anchor']:.2f} (target: >= {ANCHOR_TARGET:g}: "
                             f"{'met' if at['of_anchor'] >= ANCHOR_TARGET else 'NOT met'})")
         if not args.no_threads:
-            verdicts.append(f"{basis}: 2 threads / 1 thread {ratio:.2f} (issue 47: >= {THREADS_TARGET:g}: "
+            verdicts.append(f"{basis}: 2 threads / 1 thread {ratio:.2f} (target: >= {THREADS_TARGET:g}: "
                             f"{'met' if ratio >= THREADS_TARGET else 'NOT met'})")
     moved = ANCHOR_BYTES
     print(f"| anchor (benchmarks/anchor.py, P1) | {np.median(anchors):.3g} | | 1.00 | | | | {moved} | "
