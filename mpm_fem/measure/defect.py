@@ -1,4 +1,4 @@
-"""The local defect of the particle update, accumulated over a run (issue 46, item 2).
+"""The local defect of the particle update, accumulated over a run.
 
 Step ``n`` takes the particles from ``t^n`` to ``t^{n+1} = t^n + dt`` (:mod:`mpm_fem.core.step`). With the
 grid functions ``S_ip``, ``G_ip`` at the positions ``x_p^n``, the particle update (FLIP) takes three

@@ -157,9 +157,9 @@ TIME_CROSSING_SUMMARY = Table("time/crossing_summary", (
 
 # ----------------------------------------------------------------------------- budget (E1, E2; E5)
 
-#: The particle setting of a run (issue 42): particles per cell, ``"regular"`` or ``"jittered"``, the seed (0 for the
-#: regular layout). Optional in the budget's and the remedies' tables: those written before it lack them (every row
-#: then has the study's own setting); every row of a table written since has them.
+#: The particle setting of a run (since 2026-11-28): particles per cell, ``"regular"`` or ``"jittered"``, the
+#: seed (0 for the regular layout). Optional in the budget's and the remedies' tables: those written before it
+#: lack them (every row then has the study's own setting); every row of a table written since has them.
 PARTICLE_SETTING = ("ppc", "layout", "seed")
 
 #: v(S), the error with the stages of ``mpm_stages`` (``+``-joined, ``none`` for the empty set) in
@@ -191,7 +191,7 @@ DRIFT = Table("drift/drift", (
     "h", "variant", "layout", "seed", "change", "kernel", "ok", "particles_L1", "nodes_L1", "volume_drift",
     "abs_volume_drift", "particles_vs_study", "order_particles_L1", "order_nodes_L1", "steps"), optional=("error",))
 
-# ----------------------------------------------------------------------------- identification (issue 42, A)
+# ----------------------------------------------------------------------------- identification
 
 #: One row per candidate setting (held fixed over the whole source table) and source row: the misfit
 #: (mean |log(measured/source)|) against the corrected and the raw table, over ``meshes`` (and for
@@ -213,7 +213,7 @@ MECHANISM_GROWTH = Table("mechanism/growth", (
 MECHANISM_SUMMARY = Table("mechanism/summary", (
     "problem", "basis", "ppc", "made_exact", "mpm_stages", "h_coarse", "h_fine", "runs", "order_min", "order_mean",
     "order_max", "order_regular", "mpm_growing", "stops_growth", "converging_where_mpm_grows", "turns_growth"))
-#: One row per run (issue 46, item 2; :mod:`mpm_fem.measure.defect`): the measured particle L1 error and
+#: One row per run (:mod:`mpm_fem.measure.defect`): the measured particle L1 error and
 #: the accumulated defect's (``predicted_L1``), their ratio, the components' norms and the mean per-step
 #: defects; ``error`` when the run failed.
 DEFECT = Table("defect/defect", (

@@ -1,4 +1,4 @@
-"""The source's unstated settings, identified from its own tables (issue 42, part A).
+"""The source's unstated settings, identified from its own tables.
 
 The identification study (``studies/identification.py``) runs, for each of the source's tables, the
 candidates for what the slides leave unsaid (Sod: particles per cell, CFL, nodal or particle density,

@@ -1,5 +1,5 @@
-"""E6a: where the growth of point-mass MPM's particle error under refinement comes from, stage by stage
-(issue 46, item 1), judged from ``mechanism/summary``, which :func:`summary_rows` builds from
+"""E6a: where the growth of point-mass MPM's particle error under refinement comes from, stage by stage,
+judged from ``mechanism/summary``, which :func:`summary_rows` builds from
 ``mechanism/growth`` (both written by ``studies/mechanism.py``).
 
 A *run* is one particle setting (particles per cell, layout, seed: the regular layout is seed 0) and a
@@ -181,6 +181,6 @@ _E6A_RULE = (f"per problem, on the (particles per cell, mesh pair) where all MPM
              "such case -> confirmed; on some -> partly; on none -> refuted; all MPM grows nowhere -> differs. "
              "Read from mechanism/summary")
 for _problem in ("sod", "burgers"):
-    claim("E6a", source="issue 46: is the growth the accumulated error of one stage (the projection study's "
+    claim("E6a", source="E6a's question: is the growth the accumulated error of one stage (the projection study's "
                         "non-converging quadrature)?", tables=(SUMMARY,), study="mechanism", problem=_problem,
           thresholds=_E6A_RULE)(_e6a(_problem))

@@ -1,5 +1,5 @@
-"""E6: a closed-form model of point-mass MPM's particle error, built from the local defect (issue 46,
-items 3-4), fitted on some runs of ``defect/defect`` and checked on the others.
+"""E6: a closed-form model of point-mass MPM's particle error, built from the local defect, fitted on
+some runs of ``defect/defect`` and checked on the others.
 
 The defect study (``studies/defect.py``) measures in every run the mean per-step L1 defect of the
 quantity that drives the measured error (:data:`DRIVER`: Sod's density through the rate ``L_p``,
@@ -316,5 +316,6 @@ _E6_RULE = (f"only out-of-sample rows count: another particle count than the fit
             f"when its least particle order is at least {GROWTH_ORDER:g} -> it agrees; every setting holds and every "
             "remedy agrees -> confirmed; some of either -> partly; none -> refuted. Fitted on h >= MODEL_FIT_H_SOD "
             "(MODEL_FIT_H_BURGERS) at MODEL_FIT_PPC per cell; read from defect/model and remedies/errors")
-claim("E6", source="issue 46: does the accumulated quadrature defect, in closed form, predict the particle error and "
-                   "its growth?", tables=(MODEL.name, MODEL_FIT.name), study="defect", thresholds=_E6_RULE)(_e6)
+claim("E6", source="E6's question: does the accumulated quadrature defect, in closed form, predict the particle "
+                   "error and its growth?", tables=(MODEL.name, MODEL_FIT.name), study="defect",
+      thresholds=_E6_RULE)(_e6)

@@ -170,20 +170,20 @@ _add("SAME_NODES", 1e-3,
 
 _add("MECHANISM_MESHES", 4,
      "E6a: the meshes every run of a particles-per-cell value needs before its growth is decomposed by stage",
-     "issue 46 asks for at least four meshes: three successive orders, so that a growth and what removes it are "
+     "E6a asks for at least four meshes: three successive orders, so that a growth and what removes it are "
      "seen over more than one refinement", ("E6a",))
 _add("PREDICTION_FACTOR", 2.0,
      "E6: the model predicts a run's particle error when model / measured lies in [1/factor, factor]",
-     "issue 46 asks for a factor of 2: a model of the error's size and trend, not of its digits", ("E6",))
+     "E6 asks for a factor of 2: a model of the error's size and trend, not of its digits", ("E6",))
 _add("MODEL_FIT_PPC", 4,
      "E6: the particles per cell of the rows the error model is fitted on (the others are checked)",
-     "issue 46: fitted at one particles-per-cell value, checked on the other", ("E6",))
+     "E6: fitted at one particles-per-cell value, checked on the other", ("E6",))
 _add("MODEL_FIT_H_SOD", 0.0025,
      "E6: on Sod the model is fitted on the meshes h >= this at MODEL_FIT_PPC (the finer meshes are checked)",
-     "issue 46: fitted on h >= 0.0025, checked on the finer meshes", ("E6",))
+     "E6: fitted on h >= 0.0025, checked on the finer meshes", ("E6",))
 _add("MODEL_FIT_H_BURGERS", 0.02,
      "E6: on Burgers the model is fitted on the meshes h >= this at MODEL_FIT_PPC",
-     "issue 46: fitted on h >= 0.02 (Burgers' meshes are eight times coarser than Sod's)", ("E6",))
+     "E6: fitted on h >= 0.02 (Burgers' meshes are eight times coarser than Sod's)", ("E6",))
 _add("MODEL_P_MIN", 0.5,
      "E6: the smallest order p of the model's converging term A h^p tried in the fit",
      _STUDY + ": half order, the L1 order of a smeared contact discontinuity", ("E6",))
@@ -205,7 +205,7 @@ _add("MODEL_MIN_CHECKED", 3,
      _STUDY + ": a trend needs two meshes and a factor more than one row", ("E6",))
 
 
-# ----------------------------------------------------------------------------- identification (issue 42, A)
+# ----------------------------------------------------------------------------- identification
 
 _add("IDENTIFICATION_BAND", 0.05,
      "a candidate setting matches the source when its misfit (mean |log(measured/source)| over the source's "
