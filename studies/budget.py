@@ -36,7 +36,7 @@ measures it: P1's Sod budget runs a second time on the numpy step (the reference
 each Shapley share is given from both with the change in percentage points.
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125.
 
-Particle layouts (issue 42): the budget and E2 above run the study's own particles (Sod 16 per cell,
+Particle layouts: the budget and E2 above run the study's own particles (Sod 16 per cell,
 Burgers 4, the regular layout); beside them both run at 4, 8 and 16 per cell on the regular layout
 and on the Sod study's five jittered ones (seeds 1-5), every row of the tables naming its ``ppc``,
 ``layout`` and ``seed``: the full tier P1's budget on the two coarsest meshes of each problem (Sod
@@ -103,7 +103,7 @@ COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:
 
 # ---------------------------------------------------------------- the plan
 
-#: E1 and E2 over the particle layouts (issue 42): particles per cell, and the Sod study's jittered layouts
+#: E1 and E2 over the particle layouts: particles per cell, and the Sod study's jittered layouts
 #: (``studies.sod.SEEDS``) beside the regular one (seed 0), every particle count with every layout
 LAYOUT_PPC = (4, 8, 16)
 SEEDS = (1, 2, 3, 4, 5)

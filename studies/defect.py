@@ -1,5 +1,4 @@
-"""The local defect of the particle update, accumulated over a run, beside the run's particle error
-(issue 46, item 2).
+"""The local defect of the particle update, accumulated over a run, beside the run's particle error.
 
 Each run of the mechanism study's all-MPM setting (:mod:`studies.mechanism`: the budget's Sod and
 Burgers, :data:`studies.budget.SOD`, :data:`studies.budget.BURGERS`, point-mass MPM, FLIP, USL, lumped
@@ -30,7 +29,7 @@ diffusing it) is counted as new. The first-order accounting is the limit dt -> 0
 mesh (h = 0.08, 4 per cell, regular) the ratio is 2.65 at the study's step, 1.69 at dt / 4 and 1.16 at
 dt / 16, where its diffusive step (CFL 0.5 of h^2 / (2 eps)) changes the error by O(1) in one step.
 
-Measured on the full tier (CHANGES.md, tenth session): on Sod the accumulated defect predicts the density
+Measured on the full tier (CHANGES.md, 2026-11-28): on Sod the accumulated defect predicts the density
 error within 0.81-1.01 of the measured on every run, its growth under refinement with it (4 per cell,
 jittered, h = 0.00125: 0.81-0.83); the particle errors minus the defects keep 0.12-0.39 of the measured
 norm. On Burgers 1.00-1.30 on h = 0.01, 2.3-4.7 on h = 0.08, where the step is the least resolved.

@@ -1,4 +1,4 @@
-"""Identification: the settings the source leaves unsaid, found from its own tables (issue 42, A).
+"""Identification: the settings the source leaves unsaid, found from its own tables.
 
 For each of the source's tables the candidates for what the slides do not state run on the table's
 meshes, each candidate one setting held fixed over the whole table (never a best fit per mesh or per

@@ -1,4 +1,4 @@
-"""Where the growth of MPM's particle error comes from, stage by stage (E6a; issue 46, item 1).
+"""Where the growth of MPM's particle error comes from, stage by stage (E6a).
 
 Point-mass MPM's particle error grows under refinement at a fixed number of particles per cell. The
 error budget's stages (:mod:`studies.budget`: projection, mass (FE + mass lumping), interpolation,

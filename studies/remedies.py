@@ -35,7 +35,7 @@ mesh of both problems. APIC (:mod:`mpm_fem.core.transfers.apic`) runs its compil
 on the fused step's per-step path (not the many-step loop: about 2.3 times FLIP's loop per run), the C2
 cubic B-spline (the basis ``cubic``) in the loop, both on every mesh.
 
-Particle layouts (issue 42): beside the runs above (Sod 16 per cell, Burgers 4, the regular layout)
+Particle layouts: beside the runs above (Sod 16 per cell, Burgers 4, the regular layout)
 plain MPM (the full tier) and every remedy of a point-mass basis (the deep tier; :data:`LAYOUT_REMEDIES`)
 run at 4, 8 and 16 per cell on the regular layout and on the Sod study's five jittered ones (seeds
 1-5): the full tier on the two coarsest meshes of each problem (Sod 0.01, 0.005; Burgers 0.04, 0.02),
@@ -132,7 +132,7 @@ def run_case(case: dict) -> dict:
             "wall_s": time.perf_counter() - start}
 
 
-#: E5 over the particle layouts (issue 42): every remedy at these particles per cell, on the regular layout and
+#: E5 over the particle layouts: every remedy at these particles per cell, on the regular layout and
 #: the Sod study's jittered ones (``studies.sod.SEEDS``; seed 0 the regular layout)
 LAYOUT_PPC = (4, 8, 16)
 SEEDS = (1, 2, 3, 4, 5)
