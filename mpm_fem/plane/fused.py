@@ -2,12 +2,13 @@
 
 :class:`PlaneFused` holds one grid's compiled passes (:mod:`mpm_fem.plane.kernels`) for one basis
 and its buffers; :meth:`PlaneFused.step_with_grid` takes the numpy step's arguments and returns
-what it returns, equal to round-off (the node sums are added in another order). It serves the
-MPM stages with the lumped mass, the PIC/FLIP blend, the body force and the neo-Hookean stress
-(:func:`served` says whether a run's stages and basis are served); the consistent and exact mass
-and the exact projection, interpolation and acceleration stay on the numpy step. Every basis of
-the registry with compiled kernels is served (point mass, GIMP, the B-splines): its 2D row is the
-tensor product of its 1D ``Kernels.row`` per axis, no second copy of its shape functions.
+what it returns, equal to round-off (the node sums are added in another order). It serves USL
+with the MPM stages and the lumped mass, the PIC/FLIP blend, the body force and the neo-Hookean
+stress (:func:`served` says whether a run's stages and basis are served); the consistent and
+exact mass, the exact projection, interpolation and acceleration, and MUSL stay on the numpy step.
+Every basis of the registry with compiled kernels is served (point mass, GIMP, the B-splines):
+its 2D row is the tensor product of its 1D ``Kernels.row`` per axis, no second copy of its shape
+functions.
 
 The body force ``b(X_p, t)`` is the problem's numpy callable, evaluated once per step at the
 reference positions (vectorised); the passes read the array. ``threads`` > 1 runs the parallel
@@ -18,7 +19,8 @@ a position outside a non-periodic axis raises :class:`~mpm_fem.bases.shape.Outsi
 
 Variants: a pass is its code with the globals ``ROW`` (the basis's ``Kernels.row``) and ``K`` (its
 width) replaced by constants, compiled serial or parallel, named by the basis and a digest of the
-sources (as :mod:`mpm_fem.fused.compiler` does, so numba's on-disk caches stay apart).
+sources they compile (the passes and the bases), as :mod:`mpm_fem.fused.compiler` does, so that
+numba's on-disk caches stay apart.
 """
 
 from __future__ import annotations
@@ -46,8 +48,9 @@ from mpm_fem.plane.state import PlaneParticles
 from mpm_fem.plane.step import BodyForce, PlaneGridState, check_stages
 
 #: the stage switches the compiled step serves, with the value they must have
-SERVED = {"mass": "lumped", "projection": "mpm", "interpolation": "mpm", "acceleration": "calculated"}
-SOURCES = [Path(kernels.__file__), Path(__file__)] + sorted(Path(inspect.getsourcefile(bases)).parent.glob("*.py"))
+SERVED = {"scheme": "usl", "mass": "lumped", "projection": "mpm", "interpolation": "mpm",
+          "acceleration": "calculated"}
+SOURCES = [Path(kernels.__file__)] + sorted(Path(inspect.getsourcefile(bases)).parent.glob("*.py"))
 DIGEST = hashlib.sha1(b"".join(path.read_bytes() for path in SOURCES)).hexdigest()[:8]
 _VARIANTS: dict = {}  # (pass, basis name, parallel) -> compiled variant, made on first use
 
