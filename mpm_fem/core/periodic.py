@@ -2,13 +2,15 @@
 
 The periodic grid keeps ``n`` nodes ``x_i = lo + i h``, and a grid function of a 1D basis is the sum
 of its periodic images. The basis (:func:`mpm_fem.core.shape.make_shape`, any registered basis) is
-evaluated on a padded grid (:attr:`PeriodicLine.line`: ``PAD`` extra cells at each end, wider than
-every registered basis's support, so that no particle reaches the padded ends, where the 1D bases
-fold their end functions) at the position folded into ``[lo, hi)``; the padded node ``j`` is node
-``(j - PAD) mod n`` (:attr:`PeriodicLine.wrap`). The rows are then a :class:`~mpm_fem.core.shape.Shape`
-on the ``n`` nodes (a node may repeat in a row: its weights add in every scatter and gather), so the
-transfers of :mod:`mpm_fem.core.transfer` serve a periodic grid unchanged. The same construction as
-one axis of the 2D grid (:mod:`mpm_fem.plane.grid`), in the 1D core.
+evaluated on a padded grid (:attr:`PeriodicLine.line`: ``PAD`` extra cells at each end) at the position
+folded into ``[lo, hi)``; the padded node ``j`` is node ``(j - PAD) mod n`` (:attr:`PeriodicLine.wrap`).
+The padding keeps every row of a particle in ``[lo, hi)`` off the functions the 1D bases change at
+an end of a grid: the cubic's end functions (open knot vector, :mod:`mpm_fem.bases.cubic`) are the
+first four, so its rows need ``PAD >= 5``; then a row is the same in every cell (tested). The rows
+are a :class:`~mpm_fem.core.shape.Shape` on the ``n`` nodes (a node may repeat in a row: its weights
+add in every scatter and gather), so the transfers of :mod:`mpm_fem.core.transfer` serve a periodic
+grid unchanged. The construction of one periodic axis of the 2D grid (:mod:`mpm_fem.plane.grid`), in
+the 1D core.
 """
 
 from __future__ import annotations
