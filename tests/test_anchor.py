@@ -1,4 +1,4 @@
-"""The anchor (benchmarks/anchor.py, issue 47): the bare P1 Sod loop computes the project's scheme."""
+"""The anchor (benchmarks/anchor.py): the bare P1 Sod loop computes the project's scheme."""
 
 import importlib.util
 import sys
@@ -35,8 +35,8 @@ def test_the_anchor_has_the_project_solvers_sod_error(sod_run):
     # Measured on 2026-11-28 at T = 0.2, h = 0.005, 4 per cell, CFL 0.1 (both 968 steps): the
     # project's fused solver (mpm_fem.problems.sod.simulate(SodSettings(h=0.005, ppc=4))) gives the
     # particle density L1 1.7908096763163663e-2, the anchor 1.7908096763190894e-2 (1.5e-12 relative;
-    # the largest particle density difference 4.2e-12; issue 47 quotes 1.80e-2 for its minimal
-    # loop). Same equations, other summation order and fast-math: the band is round-off's, 1e-6.
+    # the largest particle density difference 4.2e-12; the minimal loop the sweep's targets were
+    # set from gave 1.80e-2). Same equations, other summation order and fast-math: the band is round-off's, 1e-6.
     run, _ = sod_run
     assert run.steps == 968 and run.t == pytest.approx(0.2, abs=1e-15)
     assert run.density_l1() == pytest.approx(1.7908096763163663e-2, rel=1e-6)

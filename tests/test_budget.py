@@ -284,7 +284,7 @@ def test_the_roundoff_table_compares_the_two_arithmetics():
     assert _roundoff_text({}, "sod") == "" and _roundoff_text({"budget/roundoff": rows}, "burgers") == ""
 
 
-# ---------------------------------------------------------------- E1, E2 over particle layouts (issue 42)
+# ---------------------------------------------------------------- E1, E2 over particle layouts
 
 def test_the_layout_budgets_cover_every_particle_count_and_seed_on_the_two_coarsest_meshes():
     """Full tier: P1's budget on the two coarsest meshes of each problem and E2's bases on the three coarsest, at

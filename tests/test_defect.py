@@ -1,4 +1,4 @@
-"""The local defect accumulated over a run (issue 46, item 2; :mod:`mpm_fem.measure.defect`,
+"""The local defect accumulated over a run (:mod:`mpm_fem.measure.defect`,
 :mod:`studies.defect`): instrumenting a run changes none of its numbers, the defect vanishes where every
 stage is exact, and the accumulated defect predicts the measured particle error on coarse regular runs."""
 

@@ -1,4 +1,4 @@
-"""The identification of the source's unstated settings (issue 42, A): the misfit, the rank and the
+"""The identification of the source's unstated settings: the misfit, the rank and the
 band on synthetic tables, the sentence that says where the source's table is reproduced, the plan's
 sharing of the Sod and Burgers studies' cases and its cost, and one small real run."""
 

@@ -1,4 +1,4 @@
-"""A method's measurements (issue 45): the projection of any registered basis against the exact integrals
+"""A method's measurements: the projection of any registered basis against the exact integrals
 of its own grid functions, and the pytest plugin that hands them to a researcher's tests."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""``mpm-fem method`` (issue 45, part 2): a researcher's basis measured beside the package's, its verdicts
+"""``mpm-fem method``: a researcher's basis measured beside the package's, its verdicts
 M1-M3 read from its tables (each flipped by a perturbed table), and the command's refusals."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""A basis or a transfer from outside the package (issue 45): loaded by ``module:Name`` or an entry point,
+"""A basis or a transfer from outside the package: loaded by ``module:Name`` or an entry point,
 checked on numbers before any run, and run on the numpy step when it has no compiled kernels (a
 transfer from outside never has)."""
 

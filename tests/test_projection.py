@@ -178,7 +178,7 @@ def test_study_case_and_tables_on_a_tiny_sweep():
 
 @pytest.mark.parametrize("quick", [True, False])
 def test_the_regular_layout_has_rows_of_its_own_in_every_tier(quick):
-    """C5-C10 (issue 42): the regular layout the simulations use (``seed_positions``, sub-cell midpoints) is a
+    """C5-C10: the regular layout the simulations use (``seed_positions``, sub-cell midpoints) is a
     layout of the projection study in every tier, beside the jittered, random and advected ones."""
     from mpm_fem.app.study import StudyOptions
     from studies.projection import cases

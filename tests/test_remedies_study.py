@@ -60,7 +60,7 @@ def test_quick_run_writes_tables_figures_and_the_e5_verdict(tmp_path):
 
 
 def test_the_layout_runs_cover_4_8_16_per_cell_on_the_regular_and_jittered_layouts():
-    """E5 over the particle layouts (issue 42): the full tier runs plain MPM, the deep tier every remedy of a
+    """E5 over the particle layouts: the full tier runs plain MPM, the deep tier every remedy of a
     point-mass basis, at 4, 8 and 16 per cell on the regular layout and the Sod study's five jittered seeds, on the
     two coarsest meshes of each problem (the deep tier one more); the study's own setting is the study's own case
     (run once); the quick tier plain MPM at the study's particles per cell, with the seeds, on its two meshes; no

@@ -27,7 +27,7 @@ TABLES = {
     "projection/errors.csv": (("quantity", "layout", "weights", "basis", "N_p", "h", "norm", "seeds"), ("value",)),
 }
 RTOL = 1e-5
-#: the value of a key column in a table written before the column was (the study's own particle setting, issue 42)
+#: the value of a key column in a table written before the column was (the study's own particle setting)
 MISSING = {"layout": lambda row: "regular", "seed": lambda row: "0",
            "ppc": lambda row: "16" if row["problem"] == "sod" else "4"}
 

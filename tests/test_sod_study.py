@@ -1,4 +1,4 @@
-"""Sod's shock tube study (studies/sod.py, issue 5): FEM baseline conservation and accuracy, MPM
+"""Sod's shock tube study (studies/sod.py): FEM baseline conservation and accuracy, MPM
 against the source's table (C11), the region split (C12), new-extrema counting (C14), and lost
 positivity reported cleanly."""
 
@@ -191,7 +191,7 @@ def read_csv_rows(path):
 
 def _check_quick_outputs(folder, hs, ppc_h, c11_judged=False):
     """Every table and figure of a quick run exists, and the claims judge them from the tables; C11 only
-    where the plan has its five meshes of six runs (``c11_judged``: the quick tier's own plan, issue 43)."""
+    where the plan has its five meshes of six runs (``c11_judged``: the quick tier's own plan)."""
     from mpm_fem.measure.claims import claims_of
     from mpm_fem.measure.tables import load_tables
 

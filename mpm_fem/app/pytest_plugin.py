@@ -11,7 +11,7 @@ name, an installed entry point's or ``package.module:Name``) and two fixtures:
     def test_my_basis_projects_at_second_order(mpm_method):
         assert mpm_method.projection(layout="regular")["E_m"].lo > 1.9
 
-The package is imported inside the fixtures only: a session whose tests use neither pays nothing at
+The package is imported inside the fixtures only: a test session whose tests use neither pays nothing at
 collection (no numba import, no compile).
 """
 
