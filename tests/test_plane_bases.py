@@ -37,6 +37,24 @@ def test_tensor_rows_are_a_partition_of_unity_with_gradients_summing_to_zero(bas
     assert gradient < 1e-13, f"{basis}: h |sum_i G_ip| up to {gradient:.3g}"
 
 
+@pytest.mark.parametrize("basis", names())
+def test_periodic_rows_are_translation_invariant_near_the_domain_ends(basis):
+    """The rows of points in the first and last cells equal those of the same points moved by half the
+    period (their nodes moved by half the nodes): no end function of the padded 1D line reaches them."""
+    grid = plane_grid((0.0, 0.0), (2.0, 2.0), 0.25, (True, True))
+    rng = np.random.default_rng(4)
+    x = np.concatenate((rng.random((50, 2)) * 0.25, 2.0 - rng.random((50, 2)) * 0.25))
+    lengths = np.full_like(x, 0.125)
+    here, there = (plane_shape(grid, basis, y, lengths) for y in (x, x + 1.0))
+    n = grid.shape[1]
+    shifted = ((here.nodes // n + 4) % 8) * n + (here.nodes % n + 4) % 8
+    order_here, order_there = np.argsort(shifted, axis=1), np.argsort(there.nodes, axis=1)
+    same_nodes = np.array_equal(np.take_along_axis(shifted, order_here, 1),
+                                np.take_along_axis(there.nodes, order_there, 1))
+    gap = np.abs(np.take_along_axis(here.S, order_here, 1) - np.take_along_axis(there.S, order_there, 1)).max()
+    assert same_nodes and gap < 1e-13, f"{basis}: rows near the ends differ from their translates by {gap:.3g}"
+
+
 def _skfem_quad1(grid, x):
     """Values and gradients (n_p, n_nodes) of scikit-fem's ElementQuad1 at ``x`` (n_p, 2): the element
     holding each point, its reference coordinates by the mesh mapping, ``lbasis`` there, the

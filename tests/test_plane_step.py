@@ -96,7 +96,7 @@ def _orders(basis, hs):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline"])
+@pytest.mark.parametrize("basis", names())
 def test_displacement_converges_at_second_order_on_the_axis_aligned_solution(basis):
     errors, orders = _orders(basis, (1 / 8, 1 / 16, 1 / 32))
     assert np.all((orders >= 1.8) & (orders <= 2.2)), f"{basis}: L2 {errors}, orders {orders}"

@@ -20,8 +20,10 @@ from skfem import MeshQuad
 
 from mpm_fem.core.grid import Grid, GridError, n_cells_for, uniform_grid
 
-#: cells added at each end of a periodic axis: wider than the support of every registered basis
-PAD = 3
+#: cells added at each end of a periodic axis: more than the support of every registered basis (2.5
+#: cells) plus the reach of the end functions the 1D bases take at the ends of a line (the open knot
+#: vector's: 5 cells for the cubic B-spline), so that every particle of the domain sees the uniform functions
+PAD = 8
 
 
 @dataclass(frozen=True, eq=False)
