@@ -35,7 +35,7 @@ from mpm_fem.bases import get
 from mpm_fem.bases.contract import Basis
 from mpm_fem.plane.bases import plane_shape, tensor_basis
 from mpm_fem.plane.grid import PlaneGrid
-from mpm_fem.plane.step import consistent_solver, lumped
+from mpm_fem.plane.step import Nodal, Projected, consistent_solver, lumped
 
 NEWTON_STEPS = 30
 CONTINUATION = 32  # time steps of the continuation that follows a node's material point when Newton fails
@@ -104,8 +104,8 @@ class ExactStages2:
         return X
 
     def projection(self, grid: PlaneGrid, basis: str | Basis, t: float, dt: float):
-        """``(m*_i, P*_i, f*_i, solver)``: the quadrature's sums, and ``solver(kind)`` giving the
-        lumped (``m*_i``) or consistent (the points' mass matrix) solve of its data."""
+        """:class:`~mpm_fem.plane.step.Projected`: the quadrature's sums, and ``solver(kind)`` giving
+        the lumped (``m*_i``) or consistent (the points' mass matrix) solve of its data."""
         s, X, w = self.solution, self.points, self.weights
         functions = get(tensor_basis(basis).grid_functions)
         x = X + _vector(s.displacement, X, t)
@@ -124,13 +124,13 @@ class ExactStages2:
                 return consistent_solver(shape, mass)
             return lambda rhs: lumped(rhs, m_i)
 
-        return m_i, P_i, f_i, solver
+        return Projected(m_i, P_i, f_i, solver)
 
     def nodal(self, grid: PlaneGrid, t: float, dt: float):
         """``(v*_i, a*_i)`` (n_nodes, 2) at the nodes (module docstring)."""
         s, half = self.solution, t - 0.5 * dt
-        return (_vector(s.velocity, self.reference_of_nodes(grid, half), half),
-                _vector(s.acceleration, self.reference_of_nodes(grid, t), t))
+        return Nodal(_vector(s.velocity, self.reference_of_nodes(grid, half), half),
+                     _vector(s.acceleration, self.reference_of_nodes(grid, t), t))
 
     def at_particles(self, X: np.ndarray, t: float, dt: float):
         """``(v(X_p, t - dt/2), a(X_p, t), L(X_p, t + dt/2))``: (n_p, 2), (n_p, 2), (n_p, 2, 2)."""

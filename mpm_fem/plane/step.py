@@ -27,7 +27,7 @@ runs over particles or nodes.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Protocol
+from typing import Callable, NamedTuple, Protocol
 
 import numpy as np
 import scipy.sparse as sp
@@ -67,12 +67,30 @@ class PlaneGridState:
     new_velocity: np.ndarray
 
 
+class Projected(NamedTuple):
+    """The exact projection's nodal sums ``m*_i`` (n_nodes,), ``P*_i``, ``f*_i`` (n_nodes, 2), and
+    ``solver(kind)``: the lumped or consistent solve of its data."""
+
+    m_i: np.ndarray
+    P_i: np.ndarray
+    f_i: np.ndarray
+    solver: Callable[[str], Callable[[np.ndarray], np.ndarray]]
+
+
+class Nodal(NamedTuple):
+    """The exact nodal velocity ``v*_i`` (at ``t - dt/2``) and acceleration ``a*_i`` (n_nodes, 2)."""
+
+    v: np.ndarray
+    a: np.ndarray
+
+
 class ExactPlane(Protocol):
-    """The exact stages as the step reaches them (:class:`mpm_fem.plane.exact.ExactStages2`)."""
+    """The exact stages as the step reaches them (:class:`mpm_fem.plane.exact.ExactStages2`):
+    :class:`Projected`, :class:`Nodal` and, at the particles, ``(v*_p, a*_p, L*_p)``."""
 
-    def projection(self, grid: PlaneGrid, basis: Basis, t: float, dt: float) -> tuple: ...
+    def projection(self, grid: PlaneGrid, basis: Basis, t: float, dt: float) -> Projected: ...
 
-    def nodal(self, grid: PlaneGrid, t: float, dt: float) -> tuple: ...
+    def nodal(self, grid: PlaneGrid, t: float, dt: float) -> Nodal: ...
 
     def at_particles(self, X: np.ndarray, t: float, dt: float) -> tuple: ...
 
@@ -123,33 +141,18 @@ def step_with_grid(state: PlaneParticles, grid: PlaneGrid, basis: str | Basis, m
     if body_force is not None:
         f_i += shape.scatter(m[:, None] * np.asarray(body_force(state.X[:, 0], state.X[:, 1], t)).T)
 
-    if stages.mass == "consistent":
-        solve = consistent_solver(shape, m)
-    else:
-        solve = lambda rhs: lumped(rhs, m_i)  # noqa: E731
+    solve = consistent_solver(shape, m) if stages.mass == "consistent" else (lambda rhs: lumped(rhs, m_i))
     star = exact.nodal(grid, t, dt) if exact is not None and _needs_nodal(stages) else None
-    if stages.projection == "exact" or stages.mass == "exact":
-        quad = exact.projection(grid, basis, t, dt)  # (m*, P*, f*, solver of the quadrature's mass)
-    if stages.projection == "exact" and stages.mass == "exact":
-        v_i, a_i = star[0].copy(), star[1].copy()
-    elif stages.projection == "exact":
-        solve_q = quad[3](stages.mass)
-        v_i, a_i = solve_q(quad[1]), solve_q(quad[2])
-    elif stages.mass == "exact":  # mpm_fem.exact_stages.stage: v*_i + [solve(MPM data) - solve(exact data)]
-        v_i = star[0] + lumped(P_i, m_i) - lumped(quad[1], quad[0])
-        a_i = star[1] + lumped(f_i, m_i) - lumped(quad[2], quad[0])
-    else:
-        v_i, a_i = solve(P_i), solve(f_i)
-    if stages.acceleration == "exact":
-        a_i = star[1].copy()
+    quad = exact.projection(grid, basis, t, dt) if stages.projection == "exact" or stages.mass == "exact" else None
+    v_i, a_i = _grid_values(stages, solve, m_i, P_i, f_i, quad, star)
     active = (m_i > 0)[:, None]
     v_i, a_i = np.where(active, v_i, 0.0), np.where(active, a_i, 0.0)
     v_new = v_i + dt * a_i
 
     if stages.interpolation == "exact":  # f_p = f*(X_p) + sum_i S_ip (f_i - f*_i)
         v_star, a_star, L_star = exact.at_particles(state.X, t, dt)
-        star_new = star[0] + dt * star[1]
-        acceleration = a_star + shape.gather(a_i - star[1])
+        star_new = star.v + dt * star.a
+        acceleration = a_star + shape.gather(a_i - star.a)
         moving = v_star + dt * a_star + shape.gather(v_new - star_new)
         L = L_star + shape.gather_gradient(v_new - star_new)
     else:
@@ -165,6 +168,26 @@ def step_with_grid(state: PlaneParticles, grid: PlaneGrid, basis: str | Basis, m
     check_orientation(J, x)
     new = state.replace(x=x, v=v, F=F, volume=J * state.volume0)
     return new, PlaneGridState(m_i, v_i, a_i, v_new)
+
+
+def _grid_values(stages: Stages, solve, m_i, P_i, f_i, quad: Projected | None, star: Nodal | None):
+    """``v_i``, ``a_i`` (n_nodes, 2) from the particles' sums, the mass stage's form
+    (:mod:`mpm_fem.exact_stages.stage`): MPM ``solve(P_i)``, ``solve(f_i)``; projection exact the
+    quadrature's data solved; mass exact ``v*_i + P_i/m_i - P*_i/m*_i`` (lumped solves); both exact
+    ``v*_i``, ``a*_i``; the acceleration exact ``a*_i`` whatever the others."""
+    if stages.projection == "exact" and stages.mass == "exact":
+        v_i, a_i = star.v.copy(), star.a.copy()
+    elif stages.projection == "exact":
+        solve_q = quad.solver(stages.mass)
+        v_i, a_i = solve_q(quad.P_i), solve_q(quad.f_i)
+    elif stages.mass == "exact":
+        v_i = star.v + lumped(P_i, m_i) - lumped(quad.P_i, quad.m_i)
+        a_i = star.a + lumped(f_i, m_i) - lumped(quad.f_i, quad.m_i)
+    else:
+        v_i, a_i = solve(P_i), solve(f_i)
+    if stages.acceleration == "exact":
+        a_i = star.a.copy()
+    return v_i, a_i
 
 
 def _needs_nodal(stages: Stages) -> bool:
