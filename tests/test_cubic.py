@@ -46,36 +46,41 @@ def test_the_interior_values_are_the_spline_2_3_1_6_at_a_node_and_23_48_1_48_at_
 def test_partition_of_unity_everywhere_and_gradients_sum_to_zero():
     x = np.concatenate([np.linspace(0.0, 1.0, 2001), GRID.nodes, np.random.default_rng(1).uniform(0, 1, 3000)])
     shape = make_shape(GRID, x, basis="cubic")
-    assert np.abs(shape.S.sum(axis=1) - 1).max() < 4e-16
+    assert np.abs(shape.S.sum(axis=1) - 1).max() < 1e-15  # a few ulps: four terms
     assert np.abs(shape.G.sum(axis=1)).max() < 1e-13 / H
     assert shape.S.min() >= 0.0
-    # at the wall: the end node takes its folded ghost, 2/3 + 1/6, its neighbour 1/6
-    np.testing.assert_allclose(_dense(np.array([0.0]))[0, :2], [5 / 6, 1 / 6], rtol=1e-15)
+    # at the walls only the end node's function is nonzero (the open knot vector): 1 there
+    walls = _dense(np.array([0.0, 1.0]))
+    assert np.array_equal(walls[0], np.eye(GRID.n_nodes)[0]) and np.array_equal(walls[1], np.eye(GRID.n_nodes)[-1])
 
 
-def test_reproduces_linear_and_quadratic_functions_away_from_the_walls():
-    """``sum_i S_ip x_i^k``: 1 and ``x_p`` exactly, ``x_p^2`` with the coefficients ``x_i^2 - h^2/3``
-    (the plain ``x_i^2`` give ``x_p^2 + h^2/3``) and ``x_p^3`` with ``x_i^3 - h^2 x_i``, for every
-    particle at least one cell from a wall (2h in particular); in the end cells the folded ghost
-    is off by ``N_g (f_wall - f_ghost)``."""
+def _blossoms(t):
+    """The B-spline coefficients of 1, x, x^2, x^3 for the cubic splines of the knots ``t`` (Marsden's
+    identity: the symmetric functions of the knots ``t_{i+1}, t_{i+2}, t_{i+3}`` over 1, 3, 3, 1)."""
+    a, b, c = t[1:-3], t[2:-2], t[3:-1]
+    return np.ones_like(a), (a + b + c) / 3, (a * b + a * c + b * c) / 3, a * b * c
+
+
+def test_reproduces_cubics_with_the_knot_vectors_coefficients_and_the_uniform_ones_away_from_the_walls():
+    """``sum_i S_ip x_i^k``: 1 everywhere; away from the walls (``x >= 4h``, where every nonzero
+    function is a uniform spline) ``x_p`` exactly, ``x_p^2`` with the coefficients ``x_i^2 - h^2/3``
+    (the plain ``x_i^2`` give ``x_p^2 + h^2/3``) and ``x_p^3`` with ``x_i^3 - h^2 x_i``; everywhere,
+    the end cells included, 1, x, x^2, x^3 with the open knot vector's coefficients (Marsden's identity)."""
     xi = GRID.nodes
     x = np.linspace(0.0, 1.0, 4001)
     shape = make_shape(GRID, x, basis="cubic")
-    inside = (x >= H) & (x <= 1 - H)
+    inside = (x >= 4 * H) & (x <= 1 - 4 * H)
     for coefficients, want in ((np.ones_like(xi), np.ones_like(x)), (xi, x), (xi**2 - H**2 / 3, x**2),
                                (xi**3 - H**2 * xi, x**3)):
         assert np.abs(shape.gather(coefficients) - want)[inside].max() < 1e-15
     assert np.abs(shape.gather(xi**2) - x**2 - H**2 / 3)[inside].max() < 1e-15
-    far = (x >= 2 * H) & (x <= 1 - 2 * H)
-    assert np.abs(shape.gather(xi**2 - H**2 / 3) - x**2)[far].max() < 1e-15
-    # the end cells: the ghost spline N_g = (1 - t)^3 / 6, t the distance to the wall in cells
-    left, right = x < H, x > 1 - H
-    N_left, N_right = (1 - x[left] / H) ** 3 / 6, (1 - (1 - x[right]) / H) ** 3 / 6
-    np.testing.assert_allclose((shape.gather(xi) - x)[left], H * N_left, atol=1e-15)
-    np.testing.assert_allclose((shape.gather(xi) - x)[right], -H * N_right, atol=1e-15)
-    np.testing.assert_allclose((shape.gather(xi**2 - H**2 / 3) - x**2)[left], -H**2 * N_left, atol=1e-15)
-    np.testing.assert_allclose((shape.gather(xi**2 - H**2 / 3) - x**2)[right], (1 - 1.1**2) * N_right, atol=1e-15)
-    assert abs(shape.gather(xi)[0] - 0.0) == pytest.approx(H / 6, rel=1e-12)  # at the wall: h/6
+    assert np.abs(shape.gather(np.ones_like(xi)) - 1).max() < 1e-15
+    t = np.r_[[0.0] * 4, xi[2:-2], [1.0] * 4]
+    for k, coefficients in enumerate(_blossoms(t)):
+        gap = np.abs(shape.gather(coefficients) - x**k).max()
+        assert gap < 1e-15, f"x^{k}: {gap:.2e}"
+    # the end nodes' coefficients of x are the Greville abscissae 0, 2h/3, 5h/3, 3h
+    np.testing.assert_allclose(_blossoms(t)[1][:5] / H, [0, 2 / 3, 5 / 3, 3, 4], atol=1e-14)
 
 
 def test_c2_across_the_nodes():
@@ -98,10 +103,11 @@ def test_c2_across_the_nodes():
     assert np.abs(fd - _dense(x, True)).max() < 1e-6 / H
 
 
-def test_the_integrals_are_exact_13_24_23_24_then_h():
+def test_the_integrals_are_exact_1_2_3_4_1_5_4_then_h():
+    """``int B_j = (t_{j+4} - t_j)/4``: ``h/2, 3h/4, h, 5h/4`` at the end nodes, ``h`` inside."""
     w = basis_integrals(GRID, "cubic")
-    np.testing.assert_allclose(w[:3] / H, [13 / 24, 23 / 24, 1.0], rtol=1e-14)
-    np.testing.assert_allclose(w[-3:] / H, [1.0, 23 / 24, 13 / 24], rtol=1e-14)
+    np.testing.assert_allclose(w[:5] / H, [1 / 2, 3 / 4, 1.0, 5 / 4, 1.0], rtol=1e-14)
+    np.testing.assert_allclose(w[-5:] / H, [1.0, 5 / 4, 1.0, 3 / 4, 1 / 2], rtol=1e-14)
     assert w.sum() == pytest.approx(1.0, abs=1e-15)
     n = 20000  # midpoint rule: second order, to 1e-9
     x = (np.arange(n) + 0.5) / n
@@ -120,8 +126,9 @@ def _row(kernel, x, inv_spacing, grid=GRID):
 
 def test_the_compiled_kernels_are_the_numpy_rows():
     """``row`` with the node arithmetic (``inv_spacing = 0``) gives the numpy rows bit for bit, with
-    the uniform-grid arithmetic to round-off; ``project`` gives the numpy scatters and ``move`` the
-    numpy gathers to round-off, the end cells (a node twice in a row) included."""
+    the uniform-grid arithmetic to round-off (the end functions at ``y = n - s``, ``s`` to round-off
+    of ``n``: a few 1e-15); ``project`` gives the numpy scatters and ``move`` the numpy gathers to
+    round-off, the end cells included."""
     b = get("cubic")
     rng = np.random.default_rng(3)
     x = np.sort(np.concatenate([rng.uniform(0, 1, 400), GRID.nodes, [1e-12, 1 - 1e-12]]))
@@ -131,7 +138,7 @@ def test_the_compiled_kernels_are_the_numpy_rows():
     assert np.array_equal(S, want.S) and np.array_equal(G, want.G)
     cells, rows, S, G = _row(b.kernels.row, x, 1.0 / H)
     assert np.array_equal(cells, want.cell) and np.array_equal(rows, want.nodes)
-    assert np.abs(S - want.S).max() < 1e-15 and np.abs(G - want.G).max() < 1e-13 / H
+    assert np.abs(S - want.S).max() < 1e-14 and np.abs(G - want.G).max() < 1e-13 / H
     m, v, V, p = rng.uniform(0.5, 2, x.size), rng.normal(size=x.size), rng.uniform(0.5, 2, x.size), rng.uniform(
         0.1, 1, x.size)
     n_p = x.size
@@ -180,13 +187,13 @@ def _projection_error(n_cells, f):
     return np.sqrt(np.sum(weights * (S @ c - f(x)) ** 2))
 
 
-def test_the_l2_projection_converges_at_fourth_order_inside_and_loses_order_at_the_walls():
-    """``f = sin(pi x)^4`` (O(x^4) at the walls, which the end functions' constants take): order 4
-    (4.23, 4.09 from 1/20 to 1/80); ``f = sin x``: the folded end cells do not hold ``x``, an O(h)
-    error on a cell of width h, order 1.5 in L2 (1.49 from 1/20 to 1/80)."""
+def test_the_l2_projection_converges_at_fourth_order_up_to_the_walls():
+    """The open knot vector's splines hold every cubic up to the walls: the L2 projection of ``f =
+    sin(pi x)^4`` and of ``f = sin x`` (not zero at the walls) converge at order 4 (measured from
+    1/20 to 1/80: 4.16, 4.36 and 4.44, 4.43; the folded ghosts gave ``sin x`` order 1.5)."""
     flat = [_projection_error(n, lambda x: np.sin(np.pi * x) ** 4) for n in (20, 40, 80)]
     orders = np.log2(np.array(flat[:-1]) / np.array(flat[1:]))
-    np.testing.assert_allclose(orders, [4.23, 4.09], atol=0.01)
-    assert flat[-1] == pytest.approx(5.26e-8, rel=1e-2)
+    assert np.all((orders > 3.9) & (orders < 4.5)), orders
     general = [_projection_error(n, np.sin) for n in (20, 40, 80)]
-    np.testing.assert_allclose(np.log2(np.array(general[:-1]) / np.array(general[1:])), [1.494, 1.497], atol=0.002)
+    orders = np.log2(np.array(general[:-1]) / np.array(general[1:]))
+    assert np.all((orders > 3.9) & (orders < 4.6)), orders
