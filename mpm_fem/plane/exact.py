@@ -9,7 +9,7 @@ times: the velocity at ``t - dt/2``, the acceleration and the stress at ``t``, s
     v*_i = v(X(x_i, t - dt/2), t - dt/2),     a*_i = a(X(x_i, t), t).
 
 Projection exact: the integrals over the current body by a quadrature in the reference one,
-points ``X_q`` and weights ``w_q`` (scikit-fem's Gauss rule of order ``order`` on the mesh cells,
+points ``X_q`` and weights ``w_q`` (scikit-fem's Gauss rule of order ``order`` on the half cells,
 or the caller's), whose points act as particles at ``x_q = X_q + u(X_q, t)``:
 
     m*_i = sum_q w_q rho_0 S_i(x_q),    P*_i = sum_q w_q rho_0 v(X_q, t - dt/2) S_i(x_q),
@@ -80,9 +80,11 @@ def reference_of(solution, x: np.ndarray, t: float, guess: tuple[float, np.ndarr
     return X0
 
 
-def cell_quadrature(grid: PlaneGrid, order: int = 6) -> tuple[np.ndarray, np.ndarray]:
-    """scikit-fem's Gauss rule of ``order`` on the mesh cells: points (n_q, 2), weights (n_q,)."""
-    sk = SkBasis(grid.mesh, ElementQuad1(), intorder=order)
+def cell_quadrature(grid: PlaneGrid, order: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """scikit-fem's Gauss rule of ``order`` on the half cells (the mesh refined once, so that the
+    quadratic B-splines' knots at the half cells are piece edges too, as in 1D): points (n_q, 2),
+    weights (n_q,)."""
+    sk = SkBasis(grid.mesh.refined(), ElementQuad1(), intorder=order)
     x = np.asarray(sk.global_coordinates())
     return np.column_stack((x[0].ravel(), x[1].ravel())), np.asarray(sk.dx).ravel()
 

@@ -60,7 +60,7 @@ class PlaneSettings:
     interpolation: str = "mpm"
     acceleration: str = "calculated"
     refine: int = 1
-    quadrature: int = 6
+    quadrature: int = 4
     scheme: str = "usl"
 
     def __post_init__(self):
