@@ -80,10 +80,11 @@ def anchor(claim: Claim) -> str:
     return anchor_of(claim.label)
 
 
-def summary(found: Found, link: str = "", kind: str = "") -> list[str]:
+def summary(found: Found, link: str = "", kind: str = "", brief: bool = False) -> list[str]:
     """The verdict table: every claim, its verdict, key number (the finding's sentence, or its evidence's
-    first clause, whole) and section (``link`` prefixes the anchors, e.g. ``figures/REPORT.md`` from the
-    README); ``kind`` ``"C"`` (the source's claims) or ``"E"`` (the extensions) keeps those only."""
+    first clause, whole; ``brief``: its short form, at most ``KEY_CHARS`` characters, where it has one) and
+    section (``link`` prefixes the anchors, e.g. ``figures/REPORT.md`` from the README); ``kind`` ``"C"``
+    (the source's claims) or ``"E"`` (the extensions) keeps those only."""
     lines = ["| claim | statement | verdict | key number |", "|---|---|---|---|"]
     for cid, statement in STATEMENTS.items():
         if not cid.startswith(kind):
@@ -93,7 +94,7 @@ def summary(found: Found, link: str = "", kind: str = "") -> list[str]:
             lines.append(f"| {cid} | {statement} | not measured | no criterion registered |")
         for c, f in listed:
             lines.append(f"| [{c.label}]({link}#{anchor(c)}) | {cell(statement)} | **{f.verdict}** | "
-                         f"{cell(key_text(f))} |")
+                         f"{cell(key_text(f, brief))} |")
     return lines
 
 
@@ -343,11 +344,12 @@ README_END = "<!-- end of the results in brief -->"
 
 
 def results_in_brief(tables: Tables, report: str = "figures/REPORT.md") -> str:
-    """README's "Results in brief": the summary of the report, its links pointing into ``report``."""
+    """README's "Results in brief": the summary of the report with the short key numbers, its links
+    pointing into ``report``."""
     kept, left = of_code(tables, code_version(tables))
     return "\n".join([README_BEGIN, f"Verdicts computed from the committed tables (code version "
                       f"{code_version(tables)}); each claim links to its section of `{report}`.", "",
-                      *summary(judge(kept, left), report), README_END])
+                      *summary(judge(kept, left), report, brief=True), README_END])
 
 
 def update_readme(readme: Path, tables: Tables) -> None:
