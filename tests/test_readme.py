@@ -39,3 +39,15 @@ def test_no_key_number_of_the_readme_is_cut():
     block = README.split(README_BEGIN, 1)[1].split(README_END, 1)[0]
     rows = [r for r in block.splitlines() if r.startswith("| [")]
     assert rows and not [r for r in rows if "..." in r.rstrip(" |").split(" | ")[-1]]
+
+
+def test_every_key_number_of_the_readme_fits_its_cell():
+    """The README's key numbers are the findings' sentences or their short forms (``Finding.key``), at most
+    ``KEY_CHARS`` characters: no cell runs over, and none is cut."""
+    from mpm_fem.app.paper import KEY_CHARS
+
+    block = README.split(README_BEGIN, 1)[1].split(README_END, 1)[0]
+    cells = [r.rstrip(" |").split(" | ")[-1] for r in block.splitlines() if r.startswith("| [")]
+    long = [f"{len(c)}: {c}" for c in cells if len(c) > KEY_CHARS]
+    assert len(cells) > 20 and not long, "key numbers over the cell's length:\n" + "\n".join(long)
+    assert not [c for c in cells if c.endswith(("...", ",", ";", " the", " of", " and"))], cells

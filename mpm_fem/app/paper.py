@@ -94,9 +94,19 @@ def first_clause(f: Finding) -> str:
     return split_outside(f.evidence)[0].rstrip(".") if f.evidence.strip() else ""
 
 
-def key_text(f: Finding) -> str:
-    """The summary's key number: the finding's sentence, or its evidence's first clause."""
-    return readable(f.sentence.strip() or first_clause(f))
+#: The longest key number of the README's verdict table, in characters
+KEY_CHARS = 120
+
+
+def key_text(f: Finding, brief: bool = False) -> str:
+    """The summary's key number: the finding's sentence, or its evidence's first clause; ``brief``: the
+    first of its short forms (:attr:`~mpm_fem.measure.claims.base.Finding.key`) that fits
+    :data:`KEY_CHARS` as printed, else its tersest (the README's)."""
+    text = readable(f.sentence.strip() or first_clause(f))
+    if not brief or len(text) <= KEY_CHARS or not f.key:
+        return text
+    forms = [readable(k.strip()) for k in f.key]
+    return next((k for k in forms if len(k) <= KEY_CHARS), forms[-1])
 
 
 def said(c: Claim, f: Finding, link: bool = False) -> str:

@@ -19,6 +19,12 @@ from dataclasses import dataclass
 VERDICTS = ("confirmed", "partly", "differs", "refuted", "not measured")
 #: The verdicts by name, so that a criterion returns a name, never a typed word
 CONFIRMED, PARTLY, DIFFERS, REFUTED, NOT_MEASURED = VERDICTS
+
+
+def short(*candidates: str) -> tuple[str, ...]:
+    """A :attr:`Finding.key`: the short forms of a key number, from the fullest to the tersest (empty
+    ones dropped)."""
+    return tuple(text for text in candidates if text)
 Tables = Mapping[str, list[dict]]
 Criterion = Callable[[Tables], "tuple[str, str] | Finding"]
 
@@ -60,13 +66,16 @@ class Finding:
     verdict word pasted in; empty when the criterion has none) and a small evidence ``table`` (rows
     of ``{column: value}``, e.g. one row per setting and one column per quantity; empty when none) and the
     runs of its tables that ``failed`` (one line per cause: count, where, cause; :func:`.rows.failures`),
-    left out of the verdict and named beside it, never silently."""
+    left out of the verdict and named beside it, never silently; and the ``key`` number's short forms for
+    the README's verdict table, whole sentences from the same numbers, the fullest first: the table takes
+    the first that fits its cell (empty: the sentence, or the evidence's first clause, serves)."""
 
     verdict: str
     evidence: str
     sentence: str = ""
     table: tuple[dict, ...] = ()
     failed: tuple[str, ...] = ()
+    key: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

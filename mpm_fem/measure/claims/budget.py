@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Criterion, Finding, Tables, claim, short
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, failures, num, select, span, successive_orders
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.claims.stages import STEP_ORDER, SUBSETS, decomposition, run_label, runs, values
@@ -131,6 +131,15 @@ def e1_sentence(problem: str, r: dict) -> str:
             f"{ratios} times the gap)" + (f"; {', '.join(r['stages'])} dominates where they do" if r["stages"] else ""))
 
 
+def e1_key(problem: str, r: dict) -> str:
+    """E1's key number on one problem from :func:`e1_result`, at most ``KEY_CHARS`` characters."""
+    ratios = f"{min(r['ratios']):.2g} to {max(r['ratios']):.2g}"
+    if r["separate"] == 0:
+        return short(f"on {problem.capitalize()} the stages do not separate: their interactions are {ratios} times the "
+                     "gap between all-MPM and all-exact")
+    return short(e1_sentence(problem, r), e1_sentence(problem, r).split("; ")[0])
+
+
 def _e1(problem: str) -> Criterion:
     def criterion(t: Tables) -> Finding:
         """The sixteen combinations of the four stages in MPM or exact form are the raw measurements.
@@ -149,7 +158,7 @@ def _e1(problem: str) -> Criterion:
                        "separate": str(series[-1][1]["separate"]), "dominant": series[-1][1]["dominant"] or "none"}
                       for (basis, norm, run), series in r["found"].items())
         return Finding(r["verdict"], _e1_text(r["found"]) + _roundoff_text(t, problem), e1_sentence(problem, r),
-                       table)
+                       table, key=e1_key(problem, r))
     return criterion
 
 
@@ -236,7 +245,13 @@ def _e2(t: Tables) -> Finding:
                              + "; nodes " + "; ".join(f"{r['basis']} {r['nodal density orders']}" for r in table)
                              + f"; plateau std(v_p) at h = {finest}: "
                              + ", ".join(f"{b} {v}" for b, v in noise.items()) + failed_text),
-                   sentence, table, failed)
+                   sentence, table, failed, short(
+                       sentence, f"over the last {FLOOR_STEPS} refinements the particle density order is "
+                       + ", ".join(f"{', '.join(f'{o.mean:.2f}' for o in v['particles_L1'])} with "
+                                   f"{_BASIS_NAMES.get(b, b)}" for b, v in tails.items()),
+                       f"particle density orders, last {FLOOR_STEPS} refinements: "
+                       + ", ".join(f"{', '.join(f'{o.mean:.2f}' for o in v['particles_L1'])} "
+                                   f"({_BASIS_NAMES.get(b, b).removeprefix('the ')})" for b, v in tails.items())))
 
 
 _BASIS_NAMES = {"mpm": "P1", "gimp": "GIMP", "bspline": "the C1 B-spline",

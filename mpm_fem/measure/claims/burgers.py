@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, Finding, Tables, claim, short
 from mpm_fem.measure.claims.identification import source_matching
 from mpm_fem.measure.claims.mass import MASS_RULE, mass_finding
 from mpm_fem.measure.claims.rows import FIRST_ORDER, FLOOR_ORDER, GROWTH_ORDER, num, saturation, select, span
@@ -170,8 +170,13 @@ def _c13(t: Tables) -> Finding:
                 f"{calc_shown['norm']} norm) is {calc_order['mean']:.2f} ({calc_order['lo']:.2f} to "
                 f"{calc_order['hi']:.2f}) with the calculated acceleration at {calc_shown['ppc']} per cell and "
                 f"{exact_order['mean']:.2f} with the exact acceleration ({exact_shown['solution']})")
+    key = short(f"Burgers' velocity order in h ({calc_shown['solution']}, {calc_shown['norm']}): "
+                f"{calc_order['mean']:.2f} ({calc_order['lo']:.2f} to {calc_order['hi']:.2f}) calculated acceleration, "
+                f"{exact_order['mean']:.2f} exact ({exact_shown['solution']})",
+                f"Burgers' velocity order in h: {calc_order['mean']:.2f} with the calculated acceleration, "
+                f"{exact_order['mean']:.2f} with the exact")
     return Finding(verdict, "; ".join(lines + ([diagnosis_text(diagnosis)] if diagnosis else [])), sentence,
-                   _solutions_table(t, judged))
+                   _solutions_table(t, judged), key=key)
 
 
 def _behaviour(orders: list[float]) -> str:
@@ -217,7 +222,9 @@ def _c3_burgers(t: Tables) -> Finding:
     inside = sum(OPTIMAL_PPC[0] <= r["fewest near the smallest"] <= OPTIMAL_PPC[1] for r in table)
     sentence = (f"on Burgers the fewest particles per cell within {SATURATION:.0%} of the smallest error lie in the "
                 f"source's {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} on {inside} of {len(table)} methods and meshes")
-    return Finding(verdict, evidence, sentence, table)
+    key = short(sentence, f"on Burgers the fewest particles per cell within {SATURATION:.0%} of the smallest error lie "
+                          f"in {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} on {inside} of {len(table)} methods and meshes")
+    return Finding(verdict, evidence, sentence, table, key=key)
 
 
 @claim("C15", source="one of four error sources", tables=(SUBSETS,), study="burgers", problem="burgers",

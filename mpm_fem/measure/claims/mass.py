@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, short
 from mpm_fem.measure.claims.rows import select
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.claims.shared import LUMPING_BAND, consistent_raises, lumping_claim
@@ -111,19 +111,24 @@ def mass_finding(t: Tables, problem: str, ratios: dict[str, dict[str, float]] | 
                     f"times on {raised.meshes} of {raised.total} meshes: lumping compensates; in the error budget "
                     f"the lumped-mass FE stage's own effect ({lo:.0%} to {hi:.0%} of MPM's error) is swamped by "
                     f"its interactions with the other stages ({t_lo} to {t_hi} times that effect)")
-        return Finding(verdict, evidence, sentence, table)
+        key = short(f"on {sentence_name} the consistent mass raises MPM's error {raised.lo:.2f} to {raised.hi:.2f} "
+                    f"times on {raised.meshes} of {raised.total} meshes: lumping compensates")
+        return Finding(verdict, evidence, sentence, table, key=key)
     evidence = f"{direct}. {second_text}"
     if hits:
         sentence = (f"on {sentence_name} the lumped-mass FE stage alone adds {lo:.0%} to {hi:.0%} of MPM's error to "
                     f"the error with every stage exact, but its interactions with the other stages are {t_lo} "
                     f"to {t_hi} times that effect")
+        key = short(f"on {sentence_name} the lumped-mass FE stage alone adds {lo:.0%} to {hi:.0%} of MPM's error; its "
+                    f"interactions are {t_lo} to {t_hi} times that", sentence.split(", but ")[0])
     else:
         sentence = (f"on {sentence_name} the lumped-mass FE stage alone changes the all-exact error by {lo:.0%} to "
                     f"{hi:.0%} of MPM's error")
+        key = short(sentence)
     sentence += "; " + _SECOND_READING.get(second_verdict, "consistent against lumped mass not measured")
     if raised.meshes and second_verdict == PARTLY:
         sentence += f" (on {raised.meshes} of {raised.total} meshes the consistent mass raises MPM's error)"
-    return Finding(verdict, evidence, sentence, table)
+    return Finding(verdict, evidence, sentence, table, key=key)
 
 
 def _times(x: float) -> str:

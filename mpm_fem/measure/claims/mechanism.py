@@ -30,7 +30,7 @@ import math
 from collections.abc import Iterable
 from typing import NamedTuple
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim, short
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, GROWTH_ORDER, num, select, span
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import MECHANISM_SUMMARY
@@ -170,7 +170,15 @@ def _e6a(problem: str):
                        f"making one stage exact turns {sum(bool(named[c]) for c in growth)} of them into "
                        "convergence on every layout" if some else
                        "no single stage made exact turns it into convergence on every layout"))
-        return Finding(verdict, f"{head}; {per_case}", sentence, table)
+        grows = (f"on {problem.capitalize()} P1's particle error grows on {len(growth)} of {len(found['judged'])} "
+                 "refinements")
+        turned = sum(bool(named[c]) for c in growth)
+        key = short(sentence, grows + (f"; the {' or the '.join(every)} stage made exact makes every one converge"
+                                       if every else f"; one stage made exact makes {turned} of them converge" if some
+                                       else "; no single stage made exact makes it converge"),
+                    grows + (f"; exact {' or '.join(every)}: every one converges" if every else
+                             f"; one exact stage: {turned} converge" if some else "; no exact stage stops it"))
+        return Finding(verdict, f"{head}; {per_case}", sentence, table, key=key)
     return criterion
 
 

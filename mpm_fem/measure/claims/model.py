@@ -49,7 +49,7 @@ import numpy as np
 from scipy.optimize import nnls
 
 from mpm_fem.bases import get as get_basis
-from mpm_fem.measure.claims.base import CONFIRMED, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, NOT_MEASURED, PARTLY, REFUTED, Finding, Tables, claim, short
 from mpm_fem.measure.claims.remedies import REMEDY_ERRORS, remedy_assessment, remedy_series
 from mpm_fem.measure.claims.rows import GROWTH_ORDER, failures, num, select, span
 from mpm_fem.measure.claims.rules import rule
@@ -289,7 +289,9 @@ def _e6(t: Tables) -> Finding:
                 f"{FACTOR:g}x, with the measured trend, on {sum(held)} of {len(held)} settings"
                 + (f" ({'; '.join(good)})" if good and bad else "")
                 + (f"; it says which remedies stop the growth on {len(agree)} of {len(remedies)}" if remedies else ""))
-    return Finding(verdict, evidence, sentence, tuple(table), failed)
+    key = short(sentence, f"out of sample the defect model predicts the particle error within {FACTOR:g}x with the "
+                          f"measured trend on {sum(held)} of {len(held)} settings")
+    return Finding(verdict, evidence, sentence, tuple(table), failed, key)
 
 
 def _near(settings: dict, out: set) -> str:

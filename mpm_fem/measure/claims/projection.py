@@ -3,7 +3,7 @@ errors (``projection/orders``, ``projection/bounds``, ``projection/d2_constant``
 
 from __future__ import annotations
 
-from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Finding, Tables, claim, short
 from mpm_fem.measure.claims.rows import ORDER_TOLERANCE, count_verdict, in_band, num, select, span
 from mpm_fem.measure.schema import PROJECTION_BOUNDS, PROJECTION_D2_CONSTANT, PROJECTION_ORDERS
 from mpm_fem.measure.source import D2_C, PROJECTION_BANDS, band_text
@@ -72,9 +72,13 @@ def _band_finding(quantity: str, t: Tables, extra: str = "", target: str = "") -
     where = ", ".join(every) if every else "no layout"
     sentence = (f"the {NAMES[quantity]} projection error's order is {target} on {where}"
                 + (f"; not on {', '.join(others)}" if others else ""))
+    missed = [r["layout"] for r in table if r["holds"] != "True"]
     return Finding(count_verdict(hits, total),
                    f"{hits} of {total} orders inside {band_text(quantity)}, {_holds(per_layout)}: "
-                   f"{_by_layout(t, quantity)}{extra}", sentence, table)
+                   f"{_by_layout(t, quantity)}{extra}", sentence, table, key=short(
+                       sentence, sentence.replace(" projection error's order is", " order is"),
+                       f"the {NAMES[quantity]} order is {target} on {where}"
+                       + (f"; not on {', '.join(missed)}" if missed else "")))
 
 
 _BAND_RULE = (f"least-squares L1 order over all meshes, point mass with the slides' weights, for every N_p of the "
@@ -102,7 +106,9 @@ def _c4(t: Tables) -> Finding:
     sentence = (f"Hickernell's bound holds with the smallest bound over error {ratio:.3g}; the fitted constant C is "
                 f"{span(cs, '.3g')} against the source's {D2_C[0]:.3g}-{D2_C[1]:.3g}")
     return Finding(verdict, (f"smallest bound/error {ratio:.3g}; fitted C (jittered, random) {span(cs, '.3g')}, "
-                             f"source [{D2_C[0]:.3g}, {D2_C[1]:.3g}]"), sentence, table)
+                             f"source [{D2_C[0]:.3g}, {D2_C[1]:.3g}]"), sentence, table, key=short(
+        sentence, f"Hickernell's bound over error at least {ratio:.3g}; fitted C {span(cs, '.3g')} against the "
+                  f"source's {D2_C[0]:.3g}-{D2_C[1]:.3g}"))
 
 
 @claim("C5", source=band_text("E_m"), tables=(ORDERS,), study="projection", thresholds=_BAND_RULE)

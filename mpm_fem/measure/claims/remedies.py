@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Finding, Tables, claim, short
 from mpm_fem.measure.claims.budget import SUBSETS, e1_result
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, failures, num, select, span, successive_orders
 from mpm_fem.measure.claims.rules import rule
@@ -197,15 +197,19 @@ def _e5(t: Tables) -> Finding:
                 f"{max(s[f'max_fv_ratio_{m}'] for m in REMEDY_MEASURES):.2f}x the finite-volume error"
                 if s["removes_plateau"] else f"no remedy keeps Sod's density error converging on every mesh of "
                 f"{over}; the closest is {name}")
+    fv_ratio = max(s[f"max_fv_ratio_{m}"] for m in REMEDY_MEASURES)
+    key = short(sentence, f"{name} keeps Sod's density error converging on {over}, within {fv_ratio:.2f}x the "
+                          "finite-volume error", f"{name} keeps Sod's density error converging on {over} within "
+                          f"{fv_ratio:.2f}x the FV error") if s["removes_plateau"] else short(sentence)
     failed = failures(rows, ("problem", "remedy", "h"), REMEDY_ERRORS)
     why += "".join(f"; {line} (a failed run fails every condition it enters)" for line in failed)
     if s["removes_plateau"] and fv and b_ok:
-        return Finding(CONFIRMED, "meets the goal: " + text + f"; {why}", sentence, table, failed)
+        return Finding(CONFIRMED, "meets the goal: " + text + f"; {why}", sentence, table, failed, key)
     if removers:
         return Finding(PARTLY, text + f"; the Sod plateau is removed by {', '.join(removers)}; {why}", sentence,
-                       table, failed)
+                       table, failed, key)
     return Finding(REFUTED, f"closest: {text}; no remedy converges as the FV reference does on every Sod mesh; "
-                            f"{why}", sentence, table, failed)
+                            f"{why}", sentence, table, failed, key)
 
 
 def budget_clause(t: Tables) -> str:

@@ -6,7 +6,7 @@ registered claim reads."""
 from __future__ import annotations
 
 from mpm_fem.measure import version
-from mpm_fem.measure.claims.base import CLAIMS, CONFIRMED, PARTLY, REFUTED, Tables, claim
+from mpm_fem.measure.claims.base import CLAIMS, CONFIRMED, PARTLY, REFUTED, Finding, Tables, claim, short
 from mpm_fem.measure.schema import BUILT, VERSIONS
 
 
@@ -29,7 +29,7 @@ def _most(values: list[str]) -> str:
                   "claim reads exists -> confirmed; one version that is not the current code's (the figures lag "
                   "the code) or a table missing -> partly; tables from several code versions or of several tiers "
                   "(not the output of one command) -> refuted")
-def _e4(t: Tables) -> tuple[str, str]:
+def _e4(t: Tables) -> Finding:
     """The stamp of each table is the version of all the code that wrote it (the case cache is keyed by
     the narrower version of the code a case runs through, :func:`mpm_fem.measure.version.case_version`);
     a change to a docstring, a comment, the report or the plots leaves it. The tier is read as
@@ -48,6 +48,7 @@ def _e4(t: Tables) -> tuple[str, str]:
     head = (f"{len(rows) - len(other)} of {len(rows)} tables from code {main}, the current code"
             if main == current else lag_text(main, current) + f" ({len(rows) - len(other)} of {len(rows)} tables)")
     head += f", {len(rows) - len(mixed)} of the {tier} tier"
-    return verdict, (head + (f"; other versions: {', '.join(other)}" if other else "")
-                     + (f"; other tiers: {', '.join(mixed)}" if mixed else "")
-                     + (f"; missing: {', '.join(missing)}" if missing else ""))
+    return Finding(verdict, (head + (f"; other versions: {', '.join(other)}" if other else "")
+                             + (f"; other tiers: {', '.join(mixed)}" if mixed else "")
+                             + (f"; missing: {', '.join(missing)}" if missing else "")),
+                   key=short(head, lag_text(main, current)) if main != current else ())

@@ -16,7 +16,7 @@ from typing import NamedTuple
 
 import mpm_fem.measure.claims.shape as shape
 from baselines.exact.riemann import wave_positions
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Finding, Tables, claim, short
 from mpm_fem.measure.claims.drift import mechanism
 from mpm_fem.measure.claims.identification import source_matching
 from mpm_fem.measure.claims.mass import MASS_RULE, mass_finding
@@ -259,7 +259,8 @@ def _c11(t: Tables) -> Finding:
                 + (", ".join(f"{_label(*k)} ({v})" for k, v in matching.items()) or "none")
                 + (f"; {reproduction}" if reproduction else "")
                 + f". Mechanism ({DRIFT.name}): {mechanism(t)}")
-    return Finding(headline(verdicts), evidence, _c11_sentence(rows, verdicts, reproduction), tuple(table))
+    sentence = _c11_sentence(rows, verdicts, reproduction)
+    return Finding(headline(verdicts), evidence, sentence, tuple(table), key=short(sentence, sentence.split("; ")[0]))
 
 
 def region_lengths(t: Tables) -> dict[int, float] | None:
@@ -319,10 +320,13 @@ def _c12(t: Tables) -> Finding:
     head = [r for r, k in zip(table, verdicts, strict=True) if _prescribed(k.ppc)]
     sentence = ("the error per unit length at the waves is " + ", ".join(
         f"{r['waves / smooth per unit length']} ({r['setting']})" for r in head) + " times the smooth region's")
+    waves = [float(x) for r in head for x in r["waves / smooth per unit length"].split("..") if x != "-"]
+    key = short(sentence, f"the error per unit length at the waves is {span(waves, '.1f')} times the smooth region's "
+                          f"at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell" if waves else sentence)
     return Finding(headline(verdicts), "the waves' error per unit length over the smooth region's at "
                    f"{OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell: " + ", ".join(
                        f"{r['waves / smooth per unit length']} ({r['setting']})" for r in head)
-                   + "; " + _settings_text(verdicts, lines), sentence, tuple(table))
+                   + "; " + _settings_text(verdicts, lines), sentence, tuple(table), key=key)
 
 
 @claim("C14", source="new extrema appear where particles cross cells", tables=(SOD_EXTREMA.name,), study="sod",
@@ -344,6 +348,12 @@ def _c14(t: Tables) -> Finding:
                 f"{span([num(r, 'density_moving_ratio') for r in rows], '.1f')} times as often as a moving particle "
                 f"that does not cross, at least {EXTREMA_RATIO:g} times on {hits} of {len(rows)} settings and meshes "
                 "(regular layout)")
+    key = short(sentence, f"a particle crossing a node becomes a new density extremum "
+                          f"{span([num(r, 'density_moving_ratio') for r in rows], '.1f')} times as often as a moving "
+                          f"one that does not, at least {EXTREMA_RATIO:g}x on {hits} of {len(rows)}",
+                f"crossing a node makes a particle a new density extremum "
+                f"{span([num(r, 'density_moving_ratio') for r in rows], '.1f')} times as often as moving ones that "
+                "do not")
     per_setting = "; ".join(
         f"{_label(n, cfl)}: density {span([num(r, 'density_moving_ratio') for r in mine], '.1f')}, energy "
         f"{span([num(r, 'energy_moving_ratio') for r in mine], '.1f')}"
@@ -355,7 +365,7 @@ def _c14(t: Tables) -> Finding:
         f"density {span([num(r, 'density_rate_ratio') for r in rows], '.0f')}; moving particles "
         f"{span([num(r, 'moving_share') for r in rows], '.0%')} of the non-crossing particle-steps (|v_p| > "
         f"{num(rows[0], 'moving_speed'):.3g}); the regular layout only (sod/extrema holds no seeds)"),
-        sentence, table)
+        sentence, table, key=key)
 
 
 def _seeded_saturation(rows: list[dict], key: str) -> dict[float, list[int]]:
@@ -410,10 +420,12 @@ def _c3_sod(t: Tables) -> Finding:
                                       for x in r["fewest near the smallest"].split(".."))]
     sentence = (f"on Sod the fewest particles per cell within {SATURATION:.0%} of the smallest error lie in the "
                 f"source's {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} on {len(inside)} of {len(table)} meshes and errors")
+    key = short(sentence, f"on Sod the fewest particles per cell within {SATURATION:.0%} of the smallest error lie in "
+                          f"{OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} on {len(inside)} of {len(table)} meshes and errors")
     failed = (failures(t[SOD_PPC.name], ("ppc", "h"), SOD_PPC.name)
               + failures(seeds, ("ppc", "cfl", "layout", "h"), SEEDS))
     evidence += "".join(f"; {line} (left out)" for line in failed)
-    return Finding(verdict, evidence, sentence, tuple(table), failed)
+    return Finding(verdict, evidence, sentence, tuple(table), failed, key)
 
 
 @claim("C15", source="one of four error sources", tables=(SUBSETS,), study="sod", problem="sod",
@@ -508,4 +520,8 @@ def _e3(t: Tables) -> Finding:
         + _settings_text(verdicts, lines)
         + f"; density L1 at h = {last['h']} ({_label(int(num(last, 'ppc')), num(last, 'cfl'))}, regular): "
         + ", ".join(f"{m} {num(last, c):.3g}" for m, c in SIDE_BY_SIDE.items()) + f"; FV: {fv}; {fem}"),
-        sentence, tuple(table))
+        sentence, tuple(table), key=short(
+            f"MPM's particle density error over the fixed-mesh FEM's changes by a factor "
+            f"{span([g.mean for g in growth.values()], '.1f')}{where} at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell",
+            f"MPM's particle density error over the fixed-mesh FEM's changes by a factor "
+            f"{span([g.mean for g in growth.values()], '.1f')} at {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell"))

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, PARTLY, REFUTED, Finding, Tables, claim, short
 from mpm_fem.measure.claims.rows import ORDER_TOLERANCE, count_verdict, num, select, span
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.schema import TIME_CROSSING_SUMMARY, TIME_LOCAL_ERROR, TIME_ORDER
@@ -44,7 +44,8 @@ def _c1(t: Tables) -> Finding:
     return Finding(count_verdict(total - len(off), total), (
         f"global order in dt {span(fits.values())}, local order of x_p {span(local.values())} over "
         f"{len(fits)} global and {len(local)} local fits" + (f"; outside the band: {', '.join(off)}" if off else "")),
-        sentence, table)
+        sentence, table, key=short(sentence, f"order in dt {span(fits.values())} (global error), "
+                                             f"{span(local.values())} (local position error)"))
 
 
 def _second_half(t: Tables) -> tuple[bool | None, str, tuple[dict, ...]]:
@@ -113,4 +114,9 @@ def _c2(t: Tables) -> Finding:
     return Finding(verdict, (
         f"P1, exact acceleration: measured/predicted median {num(p1[0], 'median_ratio'):.3f}, worst deviation "
         f"{num(p1[0], 'max_ratio_error'):.3f} over {p1[0]['crossings']} crossings; C1 bases |measured|/P1 formula "
-        + ", ".join(f"{b} {v:.3f}" for b, v in smooth.items()) + f"; {text}"), sentence, table)
+        + ", ".join(f"{b} {v:.3f}" for b, v in smooth.items()) + f"; {text}"), sentence, table,
+        key=short(f"P1's jump of d^3 x_p/dt^3 at a node crossing within {num(p1[0], 'max_ratio_error'):.1%} of the "
+                  f"slides' formula over {p1[0]['crossings']} crossings; smooth bases below "
+                  f"{max(smooth.values(), default=math.nan):.1%}",
+                  f"P1's jump at a node crossing within {num(p1[0], 'max_ratio_error'):.1%} of the slides' formula; "
+                  f"smooth bases below {max(smooth.values(), default=math.nan):.1%} of it"))
