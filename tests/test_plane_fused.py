@@ -139,3 +139,38 @@ def test_the_stages_it_does_not_serve_are_refused(change):
     name = next(iter(change))
     with pytest.raises(ValueError, match=f"compiled 2D step runs with {name}="):
         PlaneFused(grid, "mpm").step_with_grid(_converging(grid), MATERIAL, 1e-4, 0.0, None, stages)
+
+
+def test_the_compiled_body_force_equals_the_solution_s_to_round_off():
+    from mpm_fem.plane.forces import compiled_force
+
+    solution = solids.AxisAligned(amplitude=0.05)
+    force = compiled_force(solution)
+    rng = np.random.default_rng(3)
+    for X in (2 * rng.random((500, 2)), 2 * rng.random((300, 2))):  # a second X: its own factors
+        for t in (0.0, 0.0013, 0.0071):
+            want = solution.body_force(X[:, 0], X[:, 1], t)
+            gap = np.abs(force(X[:, 0], X[:, 1], t) - want).max() / np.abs(want).max()
+            assert gap < 1e-14, f"t = {t}: compiled body force - numpy over scale {gap:.3g}"
+            out = force.into(X, t, np.empty_like(X))
+            assert np.abs(out.T - want).max() / np.abs(want).max() < 1e-14
+    assert compiled_force(solids.GeneralizedVortex()) is None
+
+
+def test_reused_arrays_and_the_compiled_force_give_the_numpy_force_s_steps():
+    from mpm_fem.plane.forces import compiled_force
+
+    s = PlaneSettings(h=0.125, ppc=2, amplitude=0.05, layout="jittered")
+    solution, grid, (X, V0, lengths), _ = setup(s)
+    dt = s.cfl * min(grid.h) / solution.material.c
+    a = b = start(solution, X, V0, lengths, dt)
+    plain, reused = PlaneFused(grid, "mpm"), PlaneFused(grid, "mpm", reuse=True)
+    force = compiled_force(solution)
+    kept = []
+    for n in range(6):
+        a = plain.step(a, solution.material, dt, n * dt, solution.body_force)
+        b = reused.step(b, solution.material, dt, n * dt, force)
+        kept.append(b.x)
+    gaps = _gaps(a, b)
+    assert max(gaps.values()) < ROUND_OFF, f"reused arrays, compiled force - plain, numpy force: {gaps}"
+    assert kept[-1] is kept[-3] and kept[-1] is not kept[-2]  # two sets written in turn

@@ -11,7 +11,8 @@ its 2D row is the tensor product of its 1D ``Kernels.row`` per axis, no second c
 functions.
 
 The body force ``b(X_p, t)`` is the problem's numpy callable, evaluated once per step at the
-reference positions (vectorised); the passes read the array. ``threads`` > 1 runs the parallel
+reference positions (vectorised), or a compiled one (:mod:`mpm_fem.plane.forces`, which writes the
+array itself); the passes read the array. ``threads`` > 1 runs the parallel
 variants with one chunk of particles per thread (:mod:`mpm_fem.plane.kernels`: per-chunk node
 buffers); the result depends on the number of threads only. A particle with ``J <= 0`` raises
 :class:`~mpm_fem.plane.model.InversionError` naming the first such particle, as the numpy step;
@@ -90,9 +91,12 @@ def _cloud(p: PlaneParticles) -> Cloud:
 
 class PlaneFused:
     """The compiled step on ``grid`` with the 1D basis ``basis`` (module docstring), on ``threads``
-    threads; the node buffers are allocated once and reused by every step."""
+    threads; the node buffers are allocated once and reused by every step. With ``reuse`` the
+    particles and the grid state a step returns live in two sets of arrays the object holds,
+    written in turn: a step's result is overwritten two steps later (a time loop that keeps only
+    the last state; no page of new arrays is touched per step); without, every step returns new arrays."""
 
-    def __init__(self, grid: PlaneGrid, basis: str | Basis, threads: int = 1):
+    def __init__(self, grid: PlaneGrid, basis: str | Basis, threads: int = 1, reuse: bool = False):
         self.basis = get(basis)
         if self.basis.kernels is None:
             raise ValueError(f"the basis {self.basis.name!r} has no compiled kernels; run it on the numpy step")
@@ -111,6 +115,24 @@ class PlaneFused:
         n = grid.n_nodes
         self.buf = np.zeros((self.threads, n, NSUM))
         self.flags = np.full((self.threads, 3), -1, dtype=np.int64)
+        self.reuse = bool(reuse)
+        self._sets, self._turn = [None, None], 0
+
+    def _outputs(self, old: Cloud):
+        """The arrays a step writes: the particles' ``x, v, F, volume`` and the body force, nodal
+        ``mass, velocity, nodal`` (new ones, or the next of the two sets that are not ``old``'s)."""
+        n, n_nodes = old.x.shape[0], self.grid.n_nodes
+        fresh = lambda: (np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 2, 2)), np.empty(n),  # noqa: E731
+                         np.empty((n, 2)), np.empty(n_nodes), np.empty((n_nodes, 2)), np.empty((n_nodes, 4)))
+        if not self.reuse:
+            return fresh()
+        k = self._turn
+        if self._sets[k] is not None and self._sets[k][0] is old.x:  # stepping an older state: take the other
+            k = 1 - k
+        if self._sets[k] is None or self._sets[k][0].shape[0] != n:
+            self._sets[k] = fresh()
+        self._turn = 1 - k
+        return self._sets[k]
 
     def step_with_grid(self, state: PlaneParticles, material, dt: float, t: float, body_force: BodyForce | None,
                        stages: Stages = Stages()) -> tuple[PlaneParticles, PlaneGridState]:
@@ -122,11 +144,13 @@ class PlaneFused:
                 raise ValueError(f"the compiled 2D step runs with {name}={value!r}, got {getattr(stages, name)!r}; "
                                  "use the numpy step (compiled=False)")
         old = _cloud(state)
-        n = state.n
+        x, v, F, volume, b, mass, velocity, nodal = self._outputs(old)
         if body_force is None:
-            b = np.zeros((n, 2))
+            b[:] = 0.0
+        elif hasattr(body_force, "into"):  # a compiled body force (mpm_fem.plane.forces) writes b itself
+            body_force.into(state.X, t, b)
         else:
-            b = np.ascontiguousarray(np.asarray(body_force(state.X[:, 0], state.X[:, 1], t), dtype=float).T)
+            b[:] = np.asarray(body_force(state.X[:, 0], state.X[:, 1], t), dtype=float).T
         consts = np.zeros(4)
         consts[IMU], consts[ILAM], consts[IDT], consts[IFLIP] = material.mu, material.lam, dt, stages.flip
         ax, ay = self.axes
@@ -146,12 +170,8 @@ class PlaneFused:
             self.buf[:] = 0.0
             raise ValueError(f"a {self.basis.name} row needs {need} nodes per axis, more than the compiled "
                              f"{self.basis.width}: a particle domain longer than a cell; use the numpy step")
-        mass = np.empty(self.grid.n_nodes)
-        velocity = np.empty((self.grid.n_nodes, 2))
-        nodal = np.empty((self.grid.n_nodes, 4))
         self._solve(self.buf, dt, mass, velocity, nodal)
-        new = Cloud(np.empty_like(old.x), np.empty_like(old.v), np.empty_like(old.F), np.empty_like(old.volume),
-                    old.volume0, old.mass, old.lengths)
+        new = Cloud(x, v, F, volume, old.volume0, old.mass, old.lengths)
         self._move(ax, ay, n_y, old, new, nodal, consts, chunks, flags)
         bad = flags[:, IBAD][flags[:, IBAD] >= 0]
         if bad.size:

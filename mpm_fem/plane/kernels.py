@@ -73,10 +73,11 @@ class Cloud(NamedTuple):
 
 
 @njit(cache=True, inline="always")
-def _fold(x, lo, length, periodic):
-    """:meth:`mpm_fem.plane.grid.Axis.fold` of one coordinate (``%`` is ``np.mod``'s)."""
+def _fold(x, lo, length, inv_length, periodic):
+    """:meth:`mpm_fem.plane.grid.Axis.fold` of one coordinate to round-off, ``x - L floor((x - lo)/L)``
+    (no ``fmod``): it may land a round-off outside ``[lo, hi)``, inside the padded line."""
     if periodic:
-        return lo + (x - lo) % length
+        return x - length * np.floor((x - lo) * inv_length)
     return x
 
 
@@ -100,6 +101,7 @@ def _project(ax, ay, n_y, old, b, consts, chunks, buf, flags):
     x_lo = ax.lo
     x_len = ax.length
     x_per = ax.periodic
+    x_inv_len = 1.0 / x_len
     y_nodes = ay.nodes
     y_h = ay.h
     y_inv = ay.inv_spacing
@@ -107,6 +109,7 @@ def _project(ax, ay, n_y, old, b, consts, chunks, buf, flags):
     y_lo = ay.lo
     y_len = ay.length
     y_per = ay.periodic
+    y_inv_len = 1.0 / y_len
     x = old.x
     v = old.v
     F = old.F
@@ -124,8 +127,8 @@ def _project(ax, ay, n_y, old, b, consts, chunks, buf, flags):
         outside, need = -1, 0
         lo, hi = _chunk(n, chunks, k)
         for q in range(lo, hi):
-            px = _fold(x[q, 0], x_lo, x_len, x_per)
-            py = _fold(x[q, 1], y_lo, y_len, y_per)
+            px = _fold(x[q, 0], x_lo, x_len, x_inv_len, x_per)
+            py = _fold(x[q, 1], y_lo, y_len, y_inv_len, y_per)
             if not (px >= xa and px <= xb and py >= ya and py <= yb):  # NaN too
                 if outside < 0:
                     outside = q
@@ -188,6 +191,7 @@ def _move(ax, ay, n_y, old, new, nodal, consts, chunks, flags):
     x_lo = ax.lo
     x_len = ax.length
     x_per = ax.periodic
+    x_inv_len = 1.0 / x_len
     y_nodes = ay.nodes
     y_h = ay.h
     y_inv = ay.inv_spacing
@@ -195,6 +199,7 @@ def _move(ax, ay, n_y, old, new, nodal, consts, chunks, flags):
     y_lo = ay.lo
     y_len = ay.length
     y_per = ay.periodic
+    y_inv_len = 1.0 / y_len
     x = old.x
     v = old.v
     F = old.F
@@ -213,8 +218,8 @@ def _move(ax, ay, n_y, old, new, nodal, consts, chunks, flags):
         bad = -1
         lo, hi = _chunk(n, chunks, k)
         for q in range(lo, hi):
-            px = _fold(x[q, 0], x_lo, x_len, x_per)
-            py = _fold(x[q, 1], y_lo, y_len, y_per)
+            px = _fold(x[q, 0], x_lo, x_len, x_inv_len, x_per)
+            py = _fold(x[q, 1], y_lo, y_len, y_inv_len, y_per)
             ROW(x_nodes, x_h, x_inv, px, lengths[q, 0], rx, Sx, Gx)
             ROW(y_nodes, y_h, y_inv, py, lengths[q, 1], ry, Sy, Gy)
             acc_x = acc_y = vel_x = vel_y = L00 = L01 = L10 = L11 = 0.0
