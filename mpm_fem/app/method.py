@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from mpm_fem.app.api import convergence
 from mpm_fem.app.convergence import Convergence
+from mpm_fem.app.inputs import ALIASES
 from mpm_fem.bases import plugins
 from mpm_fem.measure.method import Order, projection_orders
 
@@ -26,10 +27,10 @@ __all__ = ["Method", "Order"]
 
 
 class Method:
-    """One basis, by name or ``module:Name`` (resolved and checked on construction)."""
+    """One basis, by name, alias (``p1``) or ``module:Name`` (resolved and checked on construction)."""
 
     def __init__(self, basis: str):
-        self.basis = plugins.resolve(basis)
+        self.basis = plugins.resolve(ALIASES["basis"].get(basis, basis))
 
     def __repr__(self) -> str:
         return f"Method({self.basis!r})"
