@@ -241,3 +241,69 @@ def test_stress_refuses_an_inverted_deformation_gradient():
     for stress in (first_piola, cauchy_stress):
         with pytest.raises(ValueError, match="det F must be > 0"):
             stress(F, Material(1.0, 0.3, 1.0))
+
+
+@pytest.mark.parametrize("solution", [AxisAligned(amplitude=0.05), AxisAligned(amplitude=0.05, amplitude_y=0.02),
+                                      GeneralizedVortex(), GeneralizedVortex(amplitude=0.3)],
+                         ids=["axis_aligned", "axis_aligned_two_amplitudes", "vortex", "vortex_small"])
+@pytest.mark.parametrize("phase", [0.0, 0.3, 0.5])
+def test_velocity_gradient_is_the_differenced_rate_of_F_times_its_inverse(solution, phase):
+    # Central differences of F in time, step dt = 1e-6 / c: relative truncation (c pi dt)^2 / 6 ~ 2e-12,
+    # round-off ~ 1e-16 / dt ~ 1e-10 relative; so agreement to 1e-7 of the largest |L| (phase 0.5:
+    # alpha_t = 0, L is the shear rate alone).
+    X, Y = _points(solution, seed=7, margin=0.01)
+    t = phase * solution.period
+    dt = 1e-6 / solution.material.c
+    F = solution.deformation_gradient
+    L_fd = (F(X, Y, t + dt) - F(X, Y, t - dt)) / (2 * dt) @ np.linalg.inv(F(X, Y, t))
+    L = solution.velocity_gradient(X, Y, t)
+    scale = np.max(np.abs(L_fd))
+    assert L.shape == (N, 2, 2) and scale > 0
+    worst = np.max(np.abs(L - L_fd)) / scale
+    assert worst < 1e-7, f"|L - L_fd| / max|L_fd| = {worst:.3g}"
+
+
+def test_velocity_gradient_of_the_vortex_has_the_trace_of_an_isochoric_motion_and_vanishes_outside():
+    solution = GeneralizedVortex()
+    X, Y = _points(solution, seed=8)
+    L = solution.velocity_gradient(X, Y, 0.3)
+    trace = np.abs(L[:, 0, 0] + L[:, 1, 1]).max()
+    assert trace < 1e-12 * np.abs(L).max(), f"tr L = {trace:.3g} (d J / dt = J tr L = 0)"
+    outside = solution.velocity_gradient(np.array([0.0, 0.5, 1.4]), np.array([0.0, 0.0, 0.0]), 0.3)
+    assert np.all(outside == 0.0), outside
+
+
+def test_axis_aligned_y_amplitude_sets_the_y_part_alone_and_zero_turns_it_off():
+    both, x_only, bar = AxisAligned(amplitude=0.05), AxisAligned(amplitude=0.05, amplitude_y=0.0), AxisAligned1D(0.05)
+    other = AxisAligned(amplitude=0.05, amplitude_y=0.01)
+    X, Y = _points(both, seed=9)
+    t = 0.3 * both.period
+    assert np.all(x_only.displacement(X, Y, t)[1] == 0.0) and np.all(x_only.body_force(X, Y, t)[1] == 0.0)
+    assert np.allclose(x_only.displacement(X, Y, t)[0], bar.displacement(X, t), rtol=1e-14, atol=0)
+    assert np.allclose(x_only.body_force(X, Y, t)[0], bar.body_force(X, t), rtol=1e-12, atol=1e-15)
+    assert np.array_equal(other.displacement(X, Y, t)[0], both.displacement(X, Y, t)[0])
+    ratio = other.displacement(X, Y, t)[1] / both.displacement(X, Y, t)[1]
+    assert np.allclose(ratio, 0.2, rtol=1e-12), ratio[:3]
+    assert AxisAligned(amplitude=0.05, amplitude_y=None).amplitudes == (0.05, 0.05)
+
+
+@pytest.mark.parametrize("h", [1e-2, 2.5e-3])
+def test_axis_aligned_body_force_with_two_amplitudes_equals_the_differenced_balance(h):
+    # As for one amplitude (the linear-wave truncation kappa (pi h)^2 of each component), O(A) besides.
+    solution = AxisAligned(amplitude=1e-4, amplitude_y=3e-5)
+    m = solution.material
+    k = (m.lam + 2 * m.mu) / m.E
+    predicted = (k / 3 - 1 / 12) / abs(1 - k) * (np.pi * h) ** 2
+    X, Y = _points(solution, seed=10)
+    b = solution.body_force(X, Y, 0.3 * solution.period)
+    fd = _body_force_fd(solution, X, Y, 0.3 * solution.period, h)
+    for c in range(2):
+        measured = np.max(np.abs(fd[c] - b[c])) / np.max(np.abs(b[c]))
+        assert 0.97 <= measured / predicted <= 1.03, f"component {c}: {measured:.4e}, predicted {predicted:.4e}"
+
+
+def test_a_y_amplitude_that_inverts_F_is_refused():
+    with pytest.raises(ValueError, match=r"A_y pi < 1"):
+        AxisAligned(amplitude_y=0.4)
+    with pytest.raises(ValueError, match=r"A_y pi < 1"):
+        AxisAligned(amplitude_y=-0.01)

@@ -138,10 +138,16 @@ class AxisAligned:
     displacement; the same body force (in 3D, with a third component) is Uintah's manufactured-solution
     code ``MMS::computeExternalForceForMMS``, case ``AxisAligned`` (E = 1e4, nu = 0.3, rho0 = 1,
     the defaults here). ``A pi < 1`` keeps ``J > 0``.
+
+    ``amplitude_y`` is the amplitude ``A_y`` of the y part (``v = A_y sin(pi Y) ...``; ``None``: equal
+    to ``amplitude``); ``A_y = 0`` turns the y part off (the x part is then the 1D bar of
+    :class:`AxisAligned1D`). Every formula above holds with ``A_y`` in the y components, ``A_y pi < 1``.
+    The velocity gradient is ``L = dF/dt F^-1 = diag(dF_x/dt / F_x, dF_y/dt / F_y)``.
     """
 
     amplitude: float = 1e-4
     material: Material = Material(1e4, 0.3, 1.0)
+    amplitude_y: float | None = None
 
     domain: ClassVar[tuple[tuple[float, float], tuple[float, float]]] = ((0.0, 2.0), (0.0, 2.0))
     periodic: ClassVar[bool] = True
@@ -150,6 +156,15 @@ class AxisAligned:
         if not (np.isfinite(self.amplitude) and 0.0 <= self.amplitude * np.pi < 1.0):
             raise ValueError(f"AxisAligned: the amplitude must satisfy 0 <= A pi < 1 (det F > 0), "
                              f"got A = {self.amplitude}")
+        if self.amplitude_y is not None and not (np.isfinite(self.amplitude_y)
+                                                 and 0.0 <= self.amplitude_y * np.pi < 1.0):
+            raise ValueError(f"AxisAligned: the y amplitude must satisfy 0 <= A_y pi < 1 (det F > 0), "
+                             f"got A_y = {self.amplitude_y}")
+
+    @property
+    def amplitudes(self) -> tuple[float, float]:
+        """``(A, A_y)``: the amplitudes of the x and the y part."""
+        return self.amplitude, self.amplitude if self.amplitude_y is None else self.amplitude_y
 
     @property
     def period(self) -> float:
@@ -162,26 +177,36 @@ class AxisAligned:
     def displacement(self, X, Y, t):
         X, Y = _coordinates(X, Y)
         px, py = self._phases(t)
-        A = self.amplitude
-        return np.stack([A * np.sin(np.pi * X) * np.sin(px), A * np.sin(np.pi * Y) * np.sin(py)])
+        A, A_y = self.amplitudes
+        return np.stack([A * np.sin(np.pi * X) * np.sin(px), A_y * np.sin(np.pi * Y) * np.sin(py)])
 
     def velocity(self, X, Y, t):
         X, Y = _coordinates(X, Y)
         px, py = self._phases(t)
-        w = self.amplitude * np.pi * self.material.c
-        return np.stack([w * np.sin(np.pi * X) * np.cos(px), w * np.sin(np.pi * Y) * np.cos(py)])
+        w = np.pi * self.material.c
+        A, A_y = self.amplitudes
+        return np.stack([w * A * np.sin(np.pi * X) * np.cos(px), w * A_y * np.sin(np.pi * Y) * np.cos(py)])
 
     def acceleration(self, X, Y, t):
         return -((np.pi * self.material.c) ** 2) * self.displacement(X, Y, t)
 
     def _stretches(self, X, Y, t):
         px, py = self._phases(t)
-        A = self.amplitude
-        return 1.0 + A * np.pi * np.cos(np.pi * X) * np.sin(px), 1.0 + A * np.pi * np.cos(np.pi * Y) * np.sin(py)
+        A, A_y = self.amplitudes
+        return 1.0 + A * np.pi * np.cos(np.pi * X) * np.sin(px), 1.0 + A_y * np.pi * np.cos(np.pi * Y) * np.sin(py)
 
     def deformation_gradient(self, X, Y, t):
         X, Y = _coordinates(X, Y)
         return _diagonal(*self._stretches(X, Y, t))
+
+    def velocity_gradient(self, X, Y, t):
+        """``L = dF/dt F^-1`` ``(n, 2, 2)``, diagonal (class docstring)."""
+        X, Y = _coordinates(X, Y)
+        px, py = self._phases(t)
+        A, A_y = self.amplitudes
+        w = np.pi * np.pi * self.material.c
+        Fx, Fy = self._stretches(X, Y, t)
+        return _diagonal(w * A * np.cos(np.pi * X) * np.cos(px) / Fx, w * A_y * np.cos(np.pi * Y) * np.cos(py) / Fy)
 
     def first_piola(self, X, Y, t):
         return first_piola(self.deformation_gradient(X, Y, t), self.material)
@@ -216,7 +241,10 @@ class GeneralizedVortex:
 
     In the frames ``(e_r, e_theta)`` at the current angle ``beta = Theta + alpha`` and
     ``(E_R, E_Theta)`` at ``Theta``, with ``g = R alpha_R``, ``F = [[1, 0], [g, 1]]``: ``J = 1``
-    (the motion is isochoric, the ``lam`` term vanishes) and
+    (the motion is isochoric, the ``lam`` term vanishes), the velocity gradient is
+    ``L = dF/dt F^-1 = alpha_t W + R alpha_Rt e_theta (x) e_r`` (``W = [[0, -1], [1, 0]]``, the spin of
+    the ring; ``alpha_Rt = A c pi cos(c pi t) h_R``; ``(E_Theta (x) E_R)^2 = 0`` makes the inverse
+    of the shear ``I - g E_Theta (x) E_R``) and
 
         P = mu g (e_r (x) E_Theta + e_theta (x) E_R),     sigma = mu [[0, g], [g, g^2]],
         Div P = mu (-R alpha_R^2 e_r + (3 alpha_R + R alpha_RR) e_theta),
@@ -321,6 +349,20 @@ class GeneralizedVortex:
         G = np.eye(2) + shear
         rot = np.stack([np.stack([ca, -sa], -1), np.stack([sa, ca], -1)], -2)
         return np.einsum("...ik,...kj->...ij", rot, G)
+
+    def velocity_gradient(self, X, Y, t):
+        """``L = dF/dt F^-1 = alpha_t W + R alpha_Rt e_theta (x) e_r`` ``(n, 2, 2)`` (class docstring); 0
+        outside the annulus."""
+        dX, dY, R, alpha, (_, _, a_t, _) = self._fields(X, Y, t)
+        omega = np.pi * self.material.c
+        h_R = np.where(self._inside(R), self._profile(R)[1], 0.0)
+        # R alpha_Rt e_theta (x) e_r = k (W r) (x) r with r = Rot(alpha) (dX, dY), k = alpha_Rt / R
+        with np.errstate(invalid="ignore", divide="ignore"):
+            k = np.where(R > 0, self.amplitude * omega * np.cos(omega * t) * h_R / R, 0.0)
+        ca, sa = np.cos(alpha), np.sin(alpha)
+        rx, ry = ca * dX - sa * dY, sa * dX + ca * dY
+        return np.stack([np.stack([-k * ry * rx, -k * ry * ry - a_t], -1),
+                         np.stack([k * rx * rx + a_t, k * rx * ry], -1)], -2)
 
     def first_piola(self, X, Y, t):
         return first_piola(self.deformation_gradient(X, Y, t), self.material)
