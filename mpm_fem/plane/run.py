@@ -45,8 +45,9 @@ class PlaneSettings:
     ``consistent``, ``exact``), ``cfl``, the layout (``regular``, ``jittered``) and its ``seed``,
     ``T`` (None: one period for ``axis``, 1 for ``vortex``), the PIC/FLIP ``flip``, the stage
     switches ``projection``, ``interpolation``, ``acceleration`` and the time ``refine``, the
-    order of the exact projection's reference quadrature ``quadrature``, and the ``scheme``
-    (``usl``, or ``musl``: :mod:`mpm_fem.plane.step`)."""
+    order of the exact projection's reference quadrature ``quadrature``, the ``scheme``
+    (``usl``, or ``musl``: :mod:`mpm_fem.plane.step`), and ``amplitude_y`` the axis-aligned
+    solution's y amplitude (None: ``amplitude``; 0: the y part off; ``axis`` only)."""
 
     problem: str = "axis"
     h: float = 1 / 16
@@ -65,6 +66,7 @@ class PlaneSettings:
     refine: int = 1
     quadrature: int = 4
     scheme: str = "usl"
+    amplitude_y: float | None = None
 
     def __post_init__(self):
         if self.problem not in PROBLEMS:
@@ -82,6 +84,8 @@ class PlaneSettings:
             raise ValueError(f"the quadrature order must be an integer >= 1, got {self.quadrature!r}")
         if isinstance(self.ppc, bool) or not isinstance(self.ppc, (int, np.integer)) or self.ppc < 1:
             raise ValueError(f"particles per cell per axis must be an integer >= 1, got {self.ppc!r}")
+        if self.amplitude_y is not None and self.problem != "axis":
+            raise ValueError(f"amplitude_y is the axis-aligned solution's y amplitude; {self.problem} has none")
         tensor_basis(self.basis)
         check_stages(self.stages)
 
@@ -120,7 +124,8 @@ def solution_of(s: PlaneSettings):
     from baselines.exact.solids import AxisAligned, GeneralizedVortex
 
     if s.problem == "axis":
-        return AxisAligned() if s.amplitude is None else AxisAligned(amplitude=s.amplitude)
+        given = {"amplitude": s.amplitude, "amplitude_y": s.amplitude_y}
+        return AxisAligned(**{k: v for k, v in given.items() if v is not None})
     return GeneralizedVortex() if s.amplitude is None else GeneralizedVortex(amplitude=s.amplitude)
 
 
