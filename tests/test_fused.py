@@ -328,10 +328,12 @@ def test_particle_domain_bspline_row_is_the_formula_float_for_float():
     """The uniform-grid row of the particle-domain B-spline evaluates ``M`` and ``N`` only in the
     pieces that do not vanish (``_pieces``): the same floats as the formula of
     ``mpm_fem.bases.bspline_gimp`` (``bspline_integral``, ``quadratic_bspline``) at every node of the
-    row, on domain ends placed at random, on nodes, half-way between nodes and at the grid's ends."""
+    row (the end functions' columns at the walls from ``mpm_fem.bases.ends``), on domain ends placed at
+    random, on nodes, half-way between nodes and at the grid's ends."""
     from mpm_fem.bases.bspline import quadratic_bspline as _quadratic_bspline
     from mpm_fem.bases.bspline_gimp import _row as _bspline_domain_row
     from mpm_fem.bases.bspline_gimp import bspline_integral as _bspline_integral
+    from mpm_fem.bases.ends import clamp_antiderivatives
 
     nodes = np.linspace(0.0, 1.0, 41)
     n_cells = nodes.size - 1
@@ -349,9 +351,13 @@ def test_particle_domain_bspline_row_is_the_formula_float_for_float():
     c_lo = np.minimum(s_lo.astype(int), n_cells - 1)
     j = c_lo[:, None] - 1 + np.arange(S.shape[1])
     inv_w = (1.0 / (s_hi - s_lo))[:, None]
-    S_formula = (_bspline_integral(s_hi[:, None] - j) - _bspline_integral(s_lo[:, None] - j)) * inv_w
-    G_formula = ((_quadratic_bspline(s_hi[:, None] - j)[0] - _quadratic_bspline(s_lo[:, None] - j)[0])
-                 * (inv_w * inv_spacing))
+    # the end functions of the open knot vector at the walls (mpm_fem.bases.ends), the same floats
+    M_hi, N_hi = clamp_antiderivatives(j, s_hi[:, None], n_cells, _bspline_integral(s_hi[:, None] - j),
+                                       _quadratic_bspline(s_hi[:, None] - j)[0])
+    M_lo, N_lo = clamp_antiderivatives(j, s_lo[:, None], n_cells, _bspline_integral(s_lo[:, None] - j),
+                                       _quadratic_bspline(s_lo[:, None] - j)[0])
+    S_formula = (M_hi - M_lo) * inv_w
+    G_formula = (N_hi - N_lo) * (inv_w * inv_spacing)
     assert np.array_equal(rows, np.clip(j, 0, n_cells))
     assert np.array_equal(S, S_formula), f"S differs by {np.abs(S - S_formula).max():.3g}"
     assert np.array_equal(G, G_formula), f"G differs by {np.abs(G - G_formula).max():.3g}"
@@ -361,9 +367,9 @@ def test_particle_domain_bspline_row_is_the_formula_float_for_float():
 def test_the_five_column_bspline_row_is_the_column_rows_float_for_float():
     """Pass 1's five-column row of the particle-domain B-spline (``_five_columns``: each end's
     three pieces placed by selects, ``_five``) gives ``_column``'s floats at every column, for
-    domains within two cells placed at random, on nodes and at the grid's ends; ``_five`` is
-    ``_piece`` at every start it is used for."""
-    from mpm_fem.bases.bspline_gimp import _column, _five, _five_columns, _piece, _scalars
+    domains within two cells placed at random and on nodes, away from the end functions (pass 1
+    takes ``_column`` for a row holding one); ``_five`` is ``_piece`` at every start it is used for."""
+    from mpm_fem.bases.bspline_gimp import _column, _end_node, _five, _five_columns, _piece, _scalars
 
     for d in range(3):
         assert _five(d, 7.0, 1.0, 2.0, 3.0) == tuple(_piece(k - d, 7.0, 1.0, 2.0, 3.0) for k in range(5))
@@ -376,6 +382,8 @@ def test_the_five_column_bspline_row_is_the_column_rows_float_for_float():
     for xq, Vq in zip(x, V, strict=False):
         D = _scalars(0.0, 1.0, n_cells - 1, inv_spacing, xq, Vq)
         assert D[1] <= 5
+        if _end_node(D[2] - 1, n_cells) or _end_node(D[2] + 3, n_cells):
+            continue
         starts.add(D[14] + D[3] - D[2])
         columns = [_column(k, inv_spacing, n_cells, D) for k in range(5)]
         S, G = np.array(_five_columns(inv_spacing, D)).reshape(2, 5)
