@@ -245,9 +245,10 @@ def test_function_local_and_relative_imports_enter_the_closure(tree):
     files = {p.relative_to(tree.resolve()).as_posix() for p in version.case_files(tree / "studies/local.py",
                                                                                    "run_case", tree)}
     # the registry's package runs first and registers every basis: the bases enter through it
-    assert {"mpm_fem/__init__.py", "mpm_fem/core/__init__.py", "mpm_fem/core/relative.py", "mpm_fem/core/grid.py",
+    assert {"mpm_fem/core/__init__.py", "mpm_fem/core/relative.py", "mpm_fem/core/grid.py",
             "mpm_fem/bases/__init__.py", "mpm_fem/bases/registry.py", "mpm_fem/bases/cubic.py"} <= files, sorted(files)
     assert "mpm_fem/core/transfers/apic.py" not in files and "mpm_fem/fused/step.py" not in files, sorted(files)
+    assert "mpm_fem/__init__.py" not in files, "the root package's front door is outside the model"
     before = _case_version(tree, "local")
     grid = tree / "mpm_fem/core/grid.py"
     grid.write_text(grid.read_text() + "\n_UNUSED = 1\n")
@@ -279,3 +280,15 @@ def test_a_sod_case_runs_through_fewer_files_than_the_model():
     names = {p.relative_to(ROOT).as_posix() for p in files}
     assert "mpm_fem/problems/burgers.py" not in names and "baselines/fem_burgers.py" not in names, sorted(names)
     assert {"mpm_fem/bases/cubic.py", "mpm_fem/core/transfers/apic.py", "mpm_fem/fused/step.py"} <= names
+
+
+def test_an_edit_of_the_root_package_front_door_leaves_the_case_versions(tree):
+    """``mpm_fem/__init__.py`` holds the lazily loaded entry points and computes nothing: a new entry
+    point there recomputes no case, while the same edit in the model (core/step.py) recomputes them."""
+    before = _versions(tree)
+    path = tree / "mpm_fem/__init__.py"
+    path.write_text(path.read_text() + "\n\ndef _entry():\n    return 1\n")
+    assert _versions(tree) == before
+    step = tree / "mpm_fem/core/step.py"
+    step.write_text(step.read_text() + "\n\ndef _entry():\n    return 1\n")
+    assert all(v != before[c] for c, v in _versions(tree).items())
