@@ -115,8 +115,8 @@ def test_saved_fields_read_back_with_meshio_match_the_run(tmp_path):
 
 MISTYPED = [
     (["sod", "--ppcc", "8"], "unrecognized arguments: --ppcc 8; did you mean --ppc? (see mpm-fem sod --help)"),
-    (["sood", "--h", "0.01"], "invalid choice: 'sood' (choose from 'sod', 'burgers', 'study', 'reproduce', 'method'); "
-                              "did you mean 'sod'? (see mpm-fem sod --help)"),
+    (["sood", "--h", "0.01"], "invalid choice: 'sood' (choose from 'sod', 'burgers', 'study', 'reproduce', 'method', "
+                              "'plane'); did you mean 'sod'? (see mpm-fem sod --help)"),
     (["study", "sood"], "did you mean 'sod'? (see mpm-fem study --help)"),
     (["sod", "--mass", "lumpd"], "did you mean 'lumped'? (see mpm-fem sod --help)"),
     (["burgers", "--solutoin=front"], "did you mean --solution? (see mpm-fem burgers --help)"),

@@ -2,6 +2,7 @@
 
     mpm-fem sod      [--h 0.01] [--ppc 4] [--T 0.2] [--cfl C] [--mass lumped|consistent] [--basis p1|gimp] ...
     mpm-fem burgers  [--h 0.01] [--eps 0.045] [--acceleration exact|calculated] [--solution NAME] ...
+    mpm-fem plane    axis|vortex [--h 0.0625] [--ppc 2] [--basis p1] [--vtu] ...   (:mod:`mpm_fem.app.plane_cli`)
 
 Each option's default is the field default of the problem's settings dataclass (one place).
 Before a run allocates anything its cost is estimated from the settings and checked
@@ -21,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mpm_fem.app import guard, inputs, output
+from mpm_fem.app import guard, inputs, output, plane_cli
 from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.guard import UsageError
 from mpm_fem.app.study import add_study_options, add_tier_options, start_study, study_options
@@ -195,6 +196,7 @@ def build_parser() -> argparse.ArgumentParser:
     method.add_argument("--quiet", action="store_true", help="no estimate or progress output")
     add_study_options(reproduce, quick_flag=False,
                        out_help="figures folder (default: figures/quick, figures or figures/deep by tier)")
+    plane_cli.add_parser(sub)
     return parser
 
 
@@ -365,7 +367,7 @@ def cmd_method(args) -> dict:
 
 
 COMMANDS = {"sod": cmd_sod, "burgers": cmd_burgers, "study": cmd_study, "reproduce": cmd_reproduce,
-            "method": cmd_method}
+            "method": cmd_method, "plane": plane_cli.command}
 
 
 def main(argv=None) -> int:

@@ -1,0 +1,69 @@
+"""The stable time step of the 2D explicit step: the CFL limit a run is refused above.
+
+The linearised step (the neo-Hookean tangent at ``F = I``: the Lame constants ``lambda``, ``mu``) is
+the central-difference scheme ``M a = -K u`` on the grid, stable for ``dt omega_max <= 2`` with
+``omega_max^2`` the largest eigenvalue of ``K u = omega^2 M u``,
+
+    K = sum_p V_p B_p^T C B_p,       M = lumped (diag of sum_p m_p S_ip S_jp rows) or consistent,
+
+``B_p`` the strain-displacement rows of ``G_ip`` (:func:`linearised_cfl`). In the run's CFL number
+``cfl = dt c / h`` (``c = sqrt(E / rho0)``) the limit is ``2 c / (h omega_max)``. For the lumped
+mass and the point-mass or GIMP basis this is the textbook ``dt <= h / c_p``, the P-wave speed
+``c_p = sqrt((lambda + 2 mu) / rho0)``, on every regular layout (1 to 4 particles per cell per axis,
+to round-off; 0.99 of it on a jittered one): ``cfl <= c / c_p`` (0.862 for ``nu = 0.3``). The
+B-splines' limit is higher (1.7 and 1.9 times, the quadratic and the cubic), above the CFL numbers a
+run takes (``<= 1``). The consistent mass's limit depends on the particles per cell (0.44 c / c_p
+for the point-mass basis at 2 x 2 particles per cell; singular at 1 x 1) and is not a refusal: such
+a run stops at the step where a particle inverts. The factors of ``c / c_p``: :data:`LUMPED`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg as sl
+import scipy.sparse as sp
+
+from mpm_fem.plane.bases import plane_shape
+
+#: the lumped-mass CFL limit in units of ``c / c_p`` by basis (:func:`linearised_cfl`, 2 x 2 regular, h = 1/8)
+LUMPED = {"mpm": 1.0, "gimp": 1.0, "bspline": 1.69, "bspline_gimp": 1.73, "cubic": 1.91}
+
+
+def p_wave_ratio(material) -> float:
+    """``c / c_p = sqrt(E / (lambda + 2 mu))`` of ``material`` (``E``, ``lam``, ``mu``)."""
+    return math.sqrt(material.E / (material.lam + 2.0 * material.mu))
+
+
+def cfl_limit(basis: str, mass: str, material) -> float | None:
+    """The CFL number (``dt c / h``) above which the linearised step is unstable, where it is
+    known: the lumped mass with a basis of :data:`LUMPED`; else ``None`` (module docstring)."""
+    if mass != "lumped" or basis not in LUMPED:
+        return None
+    return LUMPED[basis] * p_wave_ratio(material)
+
+
+def linearised_cfl(grid, basis: str, mass: str, material, X: np.ndarray, volume: np.ndarray,
+                   lengths: np.ndarray) -> float:
+    """``2 c / (h omega_max)`` of the linearised step at the reference particles ``X`` (n_p, 2) with
+    volumes (n_p,) and lengths (n_p, 2) on ``grid`` (module docstring); a dense eigenproblem of
+    ``2 n_nodes`` unknowns: small grids only."""
+    shape = plane_shape(grid, basis, X, lengths)
+    n_p, k = shape.nodes.shape
+    rows = np.repeat(np.arange(n_p), k)
+    Gx, Gy = (sp.csr_matrix((shape.G[:, :, a].ravel(), (rows, shape.nodes.ravel())), shape=(n_p, grid.n_nodes))
+              for a in range(2))
+    lam, mu = material.lam, material.mu
+    V = sp.diags(volume)
+    xx, yy, xy, yx = (Gx.T @ V @ Gx), (Gy.T @ V @ Gy), (Gx.T @ V @ Gy), (Gy.T @ V @ Gx)
+    K = sp.bmat([[(lam + 2 * mu) * xx + mu * yy, lam * xy + mu * yx],
+                 [lam * yx + mu * xy, (lam + 2 * mu) * yy + mu * xx]]).toarray()
+    S = shape.matrix()
+    M = (S.T @ sp.diags(material.rho0 * volume) @ S).toarray()
+    if mass == "lumped":
+        M = np.diag(M.sum(axis=1))
+    M = sl.block_diag(M, M)
+    keep = np.diag(M) > 0
+    omega2 = sl.eigh(K[np.ix_(keep, keep)], M[np.ix_(keep, keep)], eigvals_only=True)[-1]
+    return 2.0 * material.c / (math.sqrt(omega2) * min(grid.h))
