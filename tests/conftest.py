@@ -1,8 +1,36 @@
-"""Fixtures shared by the test modules."""
+"""Fixtures shared by the test modules, and numba's on-disk cache of the test run.
 
-import pytest
+numba's cache: one folder in the system's temporary directory (``mpm-fem-numba-<user>``), set here as
+``NUMBA_CACHE_DIR`` before the package is imported, so that every xdist worker and every process a
+test starts (they inherit the environment) load the kernels another one compiled, later runs start
+warm, and a run writes no cache file into the repository. A ``NUMBA_CACHE_DIR`` set beforehand wins
+(a fresh one measures a cold run).
+"""
 
-import mpm_fem.fused.step as fused_module
+import getpass
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+
+def _user() -> str:
+    try:
+        return getpass.getuser()
+    except (KeyError, OSError):  # no login name (a container without one)
+        return "user"
+
+
+if not os.environ.get("NUMBA_CACHE_DIR"):
+    os.environ["NUMBA_CACHE_DIR"] = str(Path(tempfile.gettempdir()) / f"mpm-fem-numba-{_user()}")
+if "numba" in sys.modules:  # imported by a plugin before this file: numba reads its settings again
+    from numba.core import config
+
+    config.reload_config()
+
+import pytest  # noqa: E402
+
+import mpm_fem.fused.step as fused_module  # noqa: E402
 
 
 @pytest.fixture

@@ -115,8 +115,12 @@ def test_a_swept_burgers_loop_equals_the_per_step_path_over_several_blocks(basis
     assert_same_run(burgers.simulate(settings, progress=False), swept)
 
 
-@pytest.mark.parametrize(("basis", "threads"), [("mpm", 1), ("bspline_gimp", 1), ("mpm", 2), ("gimp", 2),
-                                                 ("bspline_gimp", 2), ("cubic", 3)])
+# fast: one point basis and one stored-row basis on one thread, the point basis on two threads (each loop
+# without the sweep is a variant no other test compiles: 1-3 min of numba each on a cold cache); slow: the rest
+@pytest.mark.parametrize(("basis", "threads"), [("mpm", 1), ("bspline_gimp", 1), ("mpm", 2),
+                                                 pytest.param("gimp", 2, marks=pytest.mark.slow),
+                                                 pytest.param("bspline_gimp", 2, marks=pytest.mark.slow),
+                                                 pytest.param("cubic", 3, marks=pytest.mark.slow)])
 def test_the_loop_with_and_without_the_sweep_takes_the_same_steps_bit_for_bit(basis, threads):
     """``FusedStep(sweep=False)`` (the benchmarks' baseline) keeps pass 2 and pass 1 apart: the
     same particles after 40 steps as the swept loop, on one thread and on several (each chunk's
@@ -137,7 +141,8 @@ def test_the_loop_with_and_without_the_sweep_takes_the_same_steps_bit_for_bit(ba
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
 
 
-@pytest.mark.parametrize("kind", ["sod", "burgers"])
+# fast: Sod (the stored rows on two threads); slow: Burgers (the point masses, a threaded variant of its own)
+@pytest.mark.parametrize("kind", ["sod", pytest.param("burgers", marks=pytest.mark.slow)])
 def test_the_threaded_swept_loop_equals_the_threaded_per_step_path(kind, loop_steps, one_at_a_time):
     """Two threads: the swept loop's run equals the per-step path's on two threads bit for bit (Sod
     with the particle-domain B-spline's stored rows, Burgers with the point masses)."""
