@@ -54,10 +54,11 @@ YES_LONG = "yes_long=True"
 # (tracemalloc) is 530 B per particle with the point-mass basis and 1220 B with the 3 x 3 and 4 x 4
 # rows of GIMP and the B-splines (grid included); a step costs 1.2e-6 to 2e-6 s per particle (point
 # mass, lumped) and 4.4e-6 to 5.4e-6 s (the wider rows, or the consistent mass's solve). The compiled
-# step's constant is the 1D compiled loop's (3e-8 s) over the 2D step's target ratio to it (0.2).
+# step (mpm_fem.plane.fused, one thread, the problem's numpy body force, h = 1/32: 16384 particles)
+# costs 1.6e-7 s per particle (point mass) and 3.2e-7 s (the quadratic B-spline).
 BYTES_PER_PARTICLE = {"narrow": 600, "wide": 1300}
 BYTES_PER_NODE = 400
-SECONDS_PER_PARTICLE_STEP = {"numpy": {"narrow": 2e-6, "wide": 6e-6}, "fused": {"narrow": 1.5e-7, "wide": 4e-7}}
+SECONDS_PER_PARTICLE_STEP = {"numpy": {"narrow": 2e-6, "wide": 6e-6}, "fused": {"narrow": 2e-7, "wide": 4e-7}}
 SECONDS_PER_STEP = 2e-3
 
 
@@ -66,8 +67,9 @@ class PlaneCost:
     """The estimated size of a 2D run (the fields :func:`mpm_fem.app.guard.describe` and
     :func:`~mpm_fem.app.guard.check_cost` read): ``particles``, grid ``nodes``, time ``steps``, the
     ``kernel`` that takes them (``numpy`` or ``fused``) and the ``rows`` (``narrow``: the point-mass
-    basis with the lumped mass; ``wide`` otherwise). ``bytes = b_p particles + 400 nodes``,
-    ``seconds = steps (a particles + 2e-3)``."""
+    basis with the lumped mass; ``wide`` otherwise). ``bytes = b_p particles + 400 nodes`` (``b_p``
+    600 or 1300 B), ``seconds = steps (a particles + 2e-3)`` (``a``: numpy 2e-6 or 6e-6 s, compiled
+    2e-7 or 4e-7 s)."""
 
     particles: int
     nodes: int

@@ -72,10 +72,14 @@ def add_parser(sub) -> argparse.ArgumentParser:
     for f in dataclasses.fields(PlaneSettings):
         if f.name == "problem":
             continue
+        option, helps = f"--{f.name.replace('_', '-')}", f"{HELP.get(f.name, f.name)} (default: %(default)s)"
+        if isinstance(f.default, bool):
+            plane.add_argument(option, dest=f.name, action=argparse.BooleanOptionalAction, default=f.default,
+                               help=helps)
+            continue
         kind = {int: int, str: str}.get(type(f.default), float)  # a float, or None by default
-        plane.add_argument(f"--{f.name.replace('_', '-')}", dest=f.name, type=kind, default=f.default,
-                           choices=CHOICES.get(f.name), metavar=None if f.name in CHOICES else f.name.upper(),
-                           help=f"{HELP[f.name]} (default: %(default)s)")
+        plane.add_argument(option, dest=f.name, type=kind, default=f.default, choices=CHOICES.get(f.name),
+                           metavar=None if f.name in CHOICES else f.name.upper(), help=helps)
     plane.add_argument("--out", default=None, help="write summary.json (and the VTU files of --vtu) into this folder")
     plane.add_argument("--vtu", type=int, nargs="?", const=0, default=None, metavar="EVERY",
                        help="write the particles and the grid as VTU files for ParaView (with .pvd series) at T, "
