@@ -84,7 +84,7 @@ def test_bad_input_is_refused_in_one_line_before_any_work(monkeypatch, entry, se
         getattr(mpm_fem.plane, entry)(**{"h": 1 / 4, **settings})
     message = str(refused.value)
     assert "\n" not in message and message.startswith(f"{entry}()"), message
-    assert time.perf_counter() - t0 < 2.0, "refused after work"
+    assert time.perf_counter() - t0 < 5.0, "refused after work"
 
 
 def test_an_unknown_keyword_is_an_unknown_setting_with_the_closest_name():
