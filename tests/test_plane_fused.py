@@ -78,16 +78,30 @@ def test_the_compiled_b_spline_steps_equal_the_numpy_step_to_round_off(basis, la
     _check_equal(basis, layout)
 
 
-def test_the_compiled_step_equals_the_numpy_step_with_the_blend_and_on_the_vortex_grid():
+def test_the_compiled_step_equals_the_numpy_step_with_the_pic_flip_blend():
     blend = PlaneSettings(h=0.125, ppc=2, amplitude=0.05, layout="jittered", flip=0.5)
     (a, _), (b, _), _, _ = _both(blend)
     gaps = _gaps(a, b)
     assert max(gaps.values()) < ROUND_OFF, f"flip 0.5: compiled - numpy over scale {gaps}"
-    vortex = PlaneSettings(problem="vortex", h=0.125, ppc=2)  # jittered: its free surface inverts
+
+
+def _check_vortex(basis):
+    vortex = PlaneSettings(problem="vortex", h=0.125, ppc=2, basis=basis)  # jittered: its free surface inverts
     (a, _), (b, _), state, grid = _both(vortex, steps=5)
     assert not any(grid.periodic)
     gaps = _gaps(a, b)
-    assert max(gaps.values()) < ROUND_OFF, f"vortex: compiled - numpy over scale {gaps}"
+    assert max(gaps.values()) < ROUND_OFF, f"{basis}, vortex: compiled - numpy over scale {gaps}"
+
+
+@pytest.mark.parametrize("basis", FAST)
+def test_the_compiled_step_equals_the_numpy_step_on_the_vortex_s_walled_grid(basis):
+    _check_vortex(basis)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("basis", SLOW)
+def test_the_compiled_b_spline_steps_equal_the_numpy_step_on_the_vortex_s_walled_grid(basis):
+    _check_vortex(basis)
 
 
 def test_two_threads_equal_one_thread_to_round_off():

@@ -57,10 +57,10 @@ _VARIANTS: dict = {}  # (pass, basis name, parallel) -> compiled variant, made o
 
 
 def served(basis: str | Basis, stages: Stages = Stages()) -> bool:
-    """Whether the compiled step takes ``basis`` (a registered basis with compiled kernels) with
+    """Whether the compiled step takes ``basis`` (a registered tensor basis with compiled kernels) with
     ``stages`` (the switches of :data:`SERVED` at their values)."""
     b = get(basis)
-    return b.kernels is not None and all(getattr(stages, k) == v for k, v in SERVED.items())
+    return b.kernels is not None and getattr(b, "tensor", False) and all(getattr(stages, k) == v for k, v in SERVED.items())
 
 
 def variant(fn, basis: Basis | None, parallel: bool):
