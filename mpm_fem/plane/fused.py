@@ -60,7 +60,8 @@ def served(basis: str | Basis, stages: Stages = Stages()) -> bool:
     """Whether the compiled step takes ``basis`` (a registered tensor basis with compiled kernels) with
     ``stages`` (the switches of :data:`SERVED` at their values)."""
     b = get(basis)
-    return b.kernels is not None and getattr(b, "tensor", False) and all(getattr(stages, k) == v for k, v in SERVED.items())
+    stages_served = all(getattr(stages, k) == v for k, v in SERVED.items())
+    return b.kernels is not None and getattr(b, "tensor", False) and stages_served
 
 
 def variant(fn, basis: Basis | None, parallel: bool):
