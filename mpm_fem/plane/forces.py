@@ -12,7 +12,7 @@ recomputed when it differs), so a run's particles pay for them once.
 The axis-aligned solution (:class:`baselines.exact.solids.AxisAligned`; its docstring holds the
 source): with ``s_x = sin(c pi t)``, ``s_y = sin(pi (2/3 + c t))``,
 
-    u_x = A sin(pi X) s_x,   F_x = 1 + A pi cos(pi X) s_x   (y alike),   K = ln(F_x F_y),
+    u_x = A sin(pi X) s_x,   F_x = 1 + A pi cos(pi X) s_x   (y alike, with A_y),   K = ln(F_x F_y),
     b_x = pi^2 u_x (mu/rho0 - c^2 - (lam (K - 1) - mu) / (rho0 F_x^2)),   b_y alike,
 
 the factors ``sin(pi X), cos(pi X), sin(pi Y), cos(pi Y)`` (n, 4).
@@ -25,15 +25,15 @@ from numba import njit
 
 
 @njit(cache=True)
-def _axis_force(factors, A, s_x, s_y, common, lam, mu, rho0, out):
+def _axis_force(factors, A, A_y, s_x, s_y, common, lam, mu, rho0, out):
     """The axis-aligned body force (module docstring) into ``out`` (n, 2) from ``factors`` (n, 4)."""
     pi2 = np.pi * np.pi
     for p in range(factors.shape[0]):
         Fx = 1.0 + A * np.pi * factors[p, 1] * s_x
-        Fy = 1.0 + A * np.pi * factors[p, 3] * s_y
+        Fy = 1.0 + A_y * np.pi * factors[p, 3] * s_y
         stiff = (lam * (np.log(Fx * Fy) - 1.0) - mu) / rho0
         out[p, 0] = pi2 * (A * factors[p, 0] * s_x) * (common - stiff / (Fx * Fx))
-        out[p, 1] = pi2 * (A * factors[p, 2] * s_y) * (common - stiff / (Fy * Fy))
+        out[p, 1] = pi2 * (A_y * factors[p, 2] * s_y) * (common - stiff / (Fy * Fy))
 
 
 class AxisForce:
@@ -59,8 +59,9 @@ class AxisForce:
         m = self.solution.material
         c = m.c
         s_x, s_y = np.sin(np.pi * c * t), np.sin(np.pi * (2.0 / 3.0 + c * t))
-        _axis_force(self._factors_of(X), float(self.solution.amplitude), s_x, s_y, m.mu / m.rho0 - c**2,
-                    m.lam, m.mu, m.rho0, out)
+        A, A_y = self.solution.amplitudes
+        _axis_force(self._factors_of(X), float(A), float(A_y), s_x, s_y, m.mu / m.rho0 - c**2, m.lam, m.mu, m.rho0,
+                    out)
         return out
 
     def __call__(self, X, Y, t: float) -> np.ndarray:

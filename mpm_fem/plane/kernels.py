@@ -82,14 +82,16 @@ def _fold(x, lo, length, inv_length, periodic):
 
 
 @njit(cache=True, inline="always")
-def _stress(F00, F01, F10, F11, mu, lam):
-    """:func:`mpm_fem.plane.model.neo_hookean_stress` of one particle: ``sigma_00, sigma_01, sigma_11``."""
+def _stress(F00, F01, F10, F11, mu, lam, V):
+    """``V sigma`` of one particle (:func:`mpm_fem.plane.model.neo_hookean_stress` times the volume ``V``,
+    one division): ``V sigma_00, V sigma_01, V sigma_11``."""
     J = F00 * F11 - F01 * F10
     log_J = lam * np.log(J)
+    w = V / J
     B00 = F00 * F00 + F01 * F01 - 1.0
     B01 = F00 * F10 + F01 * F11
     B11 = F10 * F10 + F11 * F11 - 1.0
-    return (mu * B00 + log_J) / J, (mu * B01) / J, (mu * B11 + log_J) / J
+    return w * (mu * B00 + log_J), w * (mu * B01), w * (mu * B11 + log_J)
 
 
 def _project(ax, ay, n_y, old, b, consts, chunks, buf, flags):
@@ -136,9 +138,7 @@ def _project(ax, ay, n_y, old, b, consts, chunks, buf, flags):
             _, need_x = ROW(x_nodes, x_h, x_inv, px, lengths[q, 0], rx, Sx, Gx)
             _, need_y = ROW(y_nodes, y_h, y_inv, py, lengths[q, 1], ry, Sy, Gy)
             need = max(need, need_x, need_y)
-            s00, s01, s11 = _stress(F[q, 0, 0], F[q, 0, 1], F[q, 1, 0], F[q, 1, 1], mu, lam)
-            w = vol[q]
-            s00, s01, s11 = w * s00, w * s01, w * s11
+            s00, s01, s11 = _stress(F[q, 0, 0], F[q, 0, 1], F[q, 1, 0], F[q, 1, 1], mu, lam, vol[q])
             mq = m[q]
             mvx, mvy = mq * v[q, 0], mq * v[q, 1]
             mbx, mby = mq * b[q, 0], mq * b[q, 1]
