@@ -84,8 +84,11 @@ def plan(basis: str, spec: str | None, tier: str) -> list[dict]:
 
 def describe_estimate(basis: str, spec: str, options: StudyOptions) -> str:
     """One line: the cases and their estimated CPU time (the runs' cost models; the numpy step for a
-    basis without compiled kernels)."""
+    basis without compiled kernels; numba's compiles of the variants its cache lacks,
+    :func:`mpm_fem.app.estimate.compile_seconds`)."""
     from mpm_fem.app.api import checked_settings
+    from mpm_fem.app.estimate import compile_seconds
+    from mpm_fem.app.sweep import Task
     from mpm_fem.bases import compiled
 
     cases = plan(basis, spec if ":" in spec else None, "quick" if options.quick else "full")
@@ -95,8 +98,10 @@ def describe_estimate(basis: str, spec: str, options: StudyOptions) -> str:
             s = checked_settings(c["problem"], "study", {"h": c["h"], "basis": c["basis"]}, "mpm-fem method",
                                  yes_long=True)
             seconds += importlib.import_module(f"mpm_fem.problems.{c['problem']}").cost(s).seconds
+    building = compile_seconds([Task(run_case, c) for c in cases])
     step = "the compiled step" if compiled(basis) else "the numpy step (no compiled kernels: slower)"
-    return f"{len(cases)} cases, estimated {seconds / 60:.1f} CPU-min, {basis} on {step}"
+    build = f" ({building / 60:.1f} of them compiling the kernels numba's cache lacks)" if building else ""
+    return f"{len(cases)} cases, estimated {(seconds + building) / 60:.1f} CPU-min{build}, {basis} on {step}"
 
 
 def budget_seconds(case: dict) -> float:

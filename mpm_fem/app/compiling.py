@@ -7,12 +7,24 @@ entry for the function (a cache hit sends none), so a listener of that event kno
 guess, that the compiler runs. :func:`compile_notice` prints :data:`LINE` at the first such event
 within its block; :func:`notice_once` does so for the rest of a worker process's life, once for all
 the workers that share a flag.
+
+What compiling costs before a run (:mod:`mpm_fem.app.estimate` adds it to a study's estimate): a
+*variant* is one cached numba function, named ``"SOURCE::STEM"`` (``SOURCE`` its file relative to the
+project's root, ``STEM`` numba's cache name ``module.qualname`` without the line number, ``{digest}``
+in place of :data:`mpm_fem.fused.compiler.DIGEST`). numba keeps a variant in its cache folder as an
+index file ``STEM-LINE.pyXY.nbi`` holding numba's version and a stamp of the source file (in numba
+0.68, the sha256 of its bytes); :func:`cached` reads that index without compiling or importing the
+variant, and :func:`uncached_seconds` sums the measured compile seconds
+(:mod:`mpm_fem.app.compile_times`) of the variants whose index is missing or stale.
 """
 
 from __future__ import annotations
 
+import hashlib
+import pickle
 import sys
 from contextlib import contextmanager
+from pathlib import Path
 
 from numba.core import event
 
@@ -64,3 +76,68 @@ def notice_once(shared) -> None:
     """For the rest of this process (a sweep's worker), print :data:`LINE` at numba's first compile
     unless another process holding the same flag ``shared`` (a ``multiprocessing.Value``) printed it."""
     event.register(COMPILE_EVENT, _Notice(None, shared))
+
+
+#: The folder the project's sources lie in (the parent of the ``mpm_fem`` package): variants' sources are named from it.
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def cache_folder(source: Path) -> Path:
+    """numba's cache folder of the functions of ``source``: under ``NUMBA_CACHE_DIR`` numba's own sub-path
+    for the file, else ``__pycache__`` beside it. numba's settings are read again from the environment
+    first, as numba does before each compile."""
+    from numba.core import config
+    from numba.core.caching import _CacheLocator
+
+    config.reload_config()
+    if config.CACHE_DIR:
+        return Path(config.CACHE_DIR) / _CacheLocator.get_suitable_cache_subpath(str(source))
+    return Path(source).parent / "__pycache__"
+
+
+def _digest() -> str:
+    from mpm_fem.fused.compiler import DIGEST
+
+    return DIGEST
+
+
+def _stamps(source: Path) -> tuple:
+    """The stamps numba may have written for ``source``: the sha256 of its bytes (numba >= 0.61) or its
+    ``(mtime, size)`` (older)."""
+    stat = source.stat()
+    return hashlib.sha256(source.read_bytes()).digest(), (stat.st_mtime, stat.st_size)
+
+
+def cached(variant: str) -> bool:
+    """Whether numba's cache holds ``variant`` (``"SOURCE::STEM"``, module docstring) for the source as it
+    is now and this numba: an index file of its name with this numba's version and the source's stamp."""
+    import numba
+
+    source_name, _, stem = variant.partition("::")
+    source = ROOT / source_name
+    if not source.is_file():
+        return False
+    stem = stem.replace("{digest}", _digest())
+    tag = f".py{sys.version_info[0]}{sys.version_info[1]}{getattr(sys, 'abiflags', '')}.nbi"
+    stamps = _stamps(source)
+    for index in cache_folder(source).glob(f"{stem}-*{tag}"):
+        if not index.name[len(stem) + 1:-len(tag)].isdigit():
+            continue  # another variant whose name starts with this one's
+        try:
+            with open(index, "rb") as f:
+                if pickle.load(f) != numba.__version__:
+                    continue
+                stamp = pickle.loads(f.read())[0]
+        except (OSError, pickle.UnpicklingError, EOFError, ValueError, IndexError, TypeError):
+            continue
+        if stamp in stamps:
+            return True
+    return False
+
+
+def uncached_seconds(variants) -> float:
+    """The measured compile CPU seconds (:data:`mpm_fem.app.compile_times.SECONDS`) of the ``variants`` that
+    numba's cache lacks (:func:`cached`), each counted once."""
+    from mpm_fem.app.compile_times import SECONDS
+
+    return sum(SECONDS.get(v, 0.0) for v in set(variants) if not cached(v))

@@ -216,9 +216,11 @@ def run_tasks(
     (a study's tables and figures once its last case is in): a worker of the pool runs it ahead of the
     cases not yet started; without a pool (one job) or on a Dask cluster (whose workers need not share
     this file system) this process runs it at once.
-    ``costs`` (one per task, e.g. the cost models' CPU seconds) weigh the progress's time left: the
-    time so far times the cost still to run over the cost run so far; without them each case weighs
-    the same."""
+    ``costs`` (one per task: the cost models' CPU seconds, numba's compiles included) weigh the progress's
+    time left and are its model: the model's time left (the cost still to run over the workers) blended
+    with the measured rate's (the time so far times the cost still to run over the cost run so far) by
+    the share of the cost run (:func:`time_left`); without them each case weighs the same and the time
+    left is the measured rate's."""
     if jobs is not None and jobs < 1:
         raise ValueError(f"jobs must be >= 1, got {jobs}")
     jobs = jobs or default_jobs()
@@ -242,8 +244,8 @@ def run_tasks(
     if len(weights) != len(tasks):
         raise ValueError(f"costs: {len(weights)} for {len(tasks)} tasks")
     waiting = len(todo) + sum(len(js) for js in twins.values())  # a twin is done when its first is
-    reporter = _Progress(len(tasks), len(tasks) - waiting, desc, progress,
-                         to_run=sum(weights[k] for k, _ in todo))
+    reporter = _Progress(len(tasks), len(tasks) - waiting, desc, progress, to_run=sum(weights[k] for k, _ in todo),
+                         workers=None if costs is None else max(1, min(jobs, len(todo))))
 
     def follow(k: int):
         """``done(k)``'s follow-up, for the pool to run; run here when there is no pool."""
@@ -324,10 +326,12 @@ class _Progress:
     """A tqdm bar on a terminal (elapsed and left); on other streams a plain line every ~10 % of the
     cases or every :data:`PLAIN_EVERY` seconds, whichever comes first, with the time left at the
     rate of the cases run so far, each weighed by its cost (:func:`time_left`; ``to_run``: the cost
-    of every case to run)."""
+    of every case to run), blended with the model's when the costs are CPU seconds run on ``workers``."""
 
-    def __init__(self, total: int, done: int, desc: str, progress: bool | None, to_run: float | None = None):
+    def __init__(self, total: int, done: int, desc: str, progress: bool | None, to_run: float | None = None,
+                 workers: int | None = None):
         self.total, self.done, self.desc, self.cached = total, done, desc, done
+        self.workers = workers
         self.to_run = float(total - done) if to_run is None else float(to_run)
         self.ran = 0.0
         self.start = self.last = time.perf_counter()
@@ -348,8 +352,9 @@ class _Progress:
             now = time.perf_counter()
             if self.done % self.step == 0 or self.done == self.total or now - self.last >= PLAIN_EVERY:
                 self.last = now
-                left = time_left(now - self.start, self.ran, self.to_run - self.ran) if self.done < self.total \
-                    else "done"
+                rest = self.to_run - self.ran
+                model = None if self.workers is None else rest / self.workers
+                left = time_left(now - self.start, self.ran, rest, model) if self.done < self.total else "done"
                 print(f"[{self.desc}] {self.done}/{self.total} done, {now - self.start:.0f} s, {left}", file=sys.stderr,
                       flush=True)
 
@@ -358,19 +363,29 @@ class _Progress:
             self.bar.close()
 
 
-#: The share of the cost a run must have done before its progress says the time left: before it, the
-#: time so far is mostly numba compiling the kernels and starting the workers (a cold quick tier said
-#: "about 46 min left" after its first tenth of the cases, and took 80 s).
+#: The share of the cost a run must have done before its progress says the time left by the measured rate
+#: alone (no cost model): before it, the time so far is mostly numba compiling the kernels and starting
+#: the workers (a cold quick tier said "about 46 min left" after its first tenth of the cases, and took 80 s).
 RATE_AFTER = 0.1
 
 
-def time_left(elapsed: float, run: float, left: float) -> str:
-    """``"about N s left"``: ``elapsed * left / run``, the cost ``left`` to run at the rate of the cost
-    ``run`` so far (costs in any unit: cases, or the cost models' seconds), ``"done"`` when none is left,
-    ``"time left unknown"`` before :data:`RATE_AFTER` of the cost has run."""
+def time_left(elapsed: float, run: float, left: float, model: float | None = None) -> str:
+    """``"about N s left"`` for the cost ``left`` still to run (costs in any unit: cases, or the cost models'
+    seconds), ``"done"`` when none is left. Without ``model``: ``elapsed * left / run``, at the rate of the
+    cost ``run`` so far, and ``"time left unknown"`` before :data:`RATE_AFTER` of the cost has run. With
+    ``model`` (the cost model's seconds left):
+
+        f = run / (run + left),   seconds = f * elapsed * left / run + (1 - f) * model
+
+    the model's guess at the start, the measured rate's at the end: an early rate that is mostly
+    compiling, or a case far off the model, moves the line by its share of the work only."""
     if left <= 0:
         return "done"
-    if run <= 0 or run < RATE_AFTER * (run + left):
-        return "time left unknown"
-    seconds = elapsed / run * left
+    if model is None:
+        if run <= 0 or run < RATE_AFTER * (run + left):
+            return "time left unknown"
+        seconds = elapsed / run * left
+    else:
+        share = max(run, 0.0) / (max(run, 0.0) + left)
+        seconds = (share * elapsed / run * left if run > 0 else 0.0) + (1 - share) * model
     return f"about {seconds:.0f} s left" if seconds < 120 else f"about {seconds / 60:.0f} min left"
