@@ -129,16 +129,18 @@ def defect_section(tables: Tables, captions: dict) -> list[str]:
         "order one in a step) the first-order accounting overshoots.")
     if "defect.png" in captions:
         lines += figure("defect", "defect.png", captions)
-    return lines + model_paragraph(tables, captions)
+    return lines + model_paragraph(tables, captions, brief=True)
 
 
 #: the meshes at which the model's particles per cell needed are stated
 NEEDED_AT = (0.000625, 0.0003125)
 
 
-def model_paragraph(tables: Tables, captions: dict) -> list[str]:
+def model_paragraph(tables: Tables, captions: dict, brief: bool = False) -> list[str]:
     """The closed-form defect model (E6): its constants, its checked rows' ratios and the particles per
-    cell it says keep the error converging, each number from ``defect/model`` and ``defect/model_fit``."""
+    cell it says keep the error converging, each number from ``defect/model`` and ``defect/model_fit``;
+    ``brief``: without the constants and the counts per problem (the appendix's
+    :func:`model_appendix` has them)."""
     model, fit = tables.get("defect/model", []), tables.get("defect/model_fit", [])
     if not model or not fit:
         return []
@@ -165,7 +167,8 @@ def model_paragraph(tables: Tables, captions: dict) -> list[str]:
         "(a defect, not an error), and the particle error as a converging term plus the accumulated defect, "
         "E = A h^p + B d, on the coarse meshes at 4 per cell only; 8 per cell and the meshes two refinements or "
         "more beyond the fit are predicted out of sample, and only those count (`defect/model.csv`, E6). "
-        + " ".join(parts) + " The defect falls slowly with the particles per cell "
+        + (" ".join(parts) if not brief else "Its constants, checks and counts per problem: "
+           "[the appendix](APPENDIX.md#defect-model).") + " The defect falls slowly with the particles per cell "
         "(r below one) and grows under refinement (q below zero), so the particles needed to keep converging "
         "grow faster than 1/h: the model says point-mass MPM cannot be kept converging by adding particles at "
         "any practical count on these layouts. Those counts are extrapolations far beyond the 4 and 8 per cell "
@@ -173,9 +176,18 @@ def model_paragraph(tables: Tables, captions: dict) -> list[str]:
         "orders tried (`MODEL_P_MIN` to `MODEL_P_MAX` in the rule book; on a bound, a bound): read them as orders of "
         "magnitude. "
         + _remedy_sentence(tables))
-    if "model.png" in captions:
+    if "model.png" in captions and not brief:
         lines += figure("defect", "model.png", captions)
     return lines
+
+
+def model_appendix(tables: Tables, captions: dict) -> list[str]:
+    """The closed-form defect model in full, as an appendix of its own (nothing without its tables)."""
+    body = model_paragraph(tables, captions)
+    if not body:
+        return []
+    return ['<a id="defect-model"></a>', "", "## Appendix: the closed-form defect model (E6)", "",
+            *[line for line in body if not line.startswith("####")][2:]]
 
 
 def _remedy_sentence(tables: Tables) -> str:

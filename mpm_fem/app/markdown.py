@@ -19,12 +19,13 @@ _SENTENCE_END = re.compile(r"(?<=[.!?])\s+(?=[A-Z(`*])")
 
 
 def cell(value) -> str:
-    """One table cell: numbers to four significant digits, text with its pipes escaped."""
+    """One table cell: numbers to four significant digits, text with its pipes escaped, a number that is not
+    one (``nan``, empty for a whole cell) written ``-`` inside a text."""
     text = str(value).strip()
     try:
         number = float(text)
     except ValueError:
-        return text.replace("|", "\\|").replace("\n", " ")
+        return _NAN.sub("-", text).replace("|", "\\|").replace("\n", " ")
     if not math.isfinite(number):
         return ""
     if text.lstrip("-").isdigit():
@@ -136,6 +137,7 @@ def headings_without_content(markdown: str) -> list[str]:
             and (k + 1 == len(lines) or lines[k + 1].startswith("#"))]
 
 
+_NAN = re.compile(r"(?<![\w.])nan(?![\w.])", re.IGNORECASE)
 _RANGE = re.compile(r"(?<![\w.])(-?\d+(?:\.\d+)?)\.\.(-?\d+(?:\.\d+)?)(?![\w.])")
 _EXPONENT = re.compile(r"(?<![\w.])(\d(?:\.\d+)?)e\+0*(\d+)(?![\w.])")
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from dataclasses import replace
 from functools import partial
@@ -23,10 +24,11 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from mpm_fem.app import paper
-from mpm_fem.app.markdown import anchor_of, bullets, cell, figure, markdown_table  # noqa: F401  (cell: interface)
+from mpm_fem.app.discussion import model_appendix
+from mpm_fem.app.markdown import anchor_of, bullets, cell, figure, markdown_table, prose  # noqa: F401  (cell: interface)
 from mpm_fem.app.output import write_atomic
 from mpm_fem.app.pages import PAGES, Page, View  # noqa: F401  (View: part of this module's interface)
-from mpm_fem.app.paper import Found, judge, key_text
+from mpm_fem.app.paper import Found, judge, key_text, verdict_text
 from mpm_fem.app.plots import CAPTIONS
 from mpm_fem.app.study import NOT_JUDGED, QUICK_LEAVES_OUT
 from mpm_fem.measure.claims import STATEMENTS, Claim, select
@@ -80,11 +82,12 @@ def anchor(claim: Claim) -> str:
     return anchor_of(claim.label)
 
 
-def summary(found: Found, link: str = "", kind: str = "", brief: bool = False) -> list[str]:
+def summary(found: Found, link: str = "", kind: str = "", brief: bool = False, statements: bool = True) -> list[str]:
     """The verdict table: every claim, its verdict, key number (the finding's sentence, or its evidence's
     first clause, whole; ``brief``: its short form, at most ``KEY_CHARS`` characters, where it has one) and
     section (``link`` prefixes the anchors, e.g. ``figures/REPORT.md`` from the README); ``kind`` ``"C"``
-    (the source's claims) or ``"E"`` (the extensions) keeps those only."""
+    (the source's claims) or ``"E"`` (the extensions) keeps those only; ``statements``: with each claim's
+    statement (the report's results give it in each claim's heading instead)."""
     lines = ["| claim | statement | verdict | key number |", "|---|---|---|---|"]
     for cid, statement in STATEMENTS.items():
         if not cid.startswith(kind):
@@ -93,8 +96,11 @@ def summary(found: Found, link: str = "", kind: str = "", brief: bool = False) -
         if not listed:
             lines.append(f"| {cid} | {statement} | not measured | no criterion registered |")
         for c, f in listed:
-            lines.append(f"| [{c.label}]({link}#{anchor(c)}) | {cell(statement)} | **{f.verdict}** | "
+            lines.append(f"| [{c.label}]({link}#{anchor(c)}) | {cell(statement)} | **{verdict_text(f)}** | "
                          f"{cell(key_text(f, brief))} |")
+    if not statements:
+        return [lines[0].replace(" statement |", ""), "|---|---|---|"] + [
+            " | ".join(cells for k, cells in enumerate(line.split(" | ")) if k != 1) for line in lines[2:]]
     return lines
 
 
@@ -122,7 +128,8 @@ def view_section(page: Page, v: View, tables: Tables, captions: dict) -> list[st
 def appendix_section(letter: str, page: Page, tables: Tables, captions: dict) -> list[str]:
     """A study's tables and every figure it drew."""
     lines = [f'<a id="appendix-{page.name}"></a>', "", f"## Appendix {letter}: {page.title}", "",
-             f"The tables and figures of the study `{page.name}`, with the settings of each in the JSON beside it.", ""]
+             *prose(page.caption), f"The tables and figures of the study `{page.name}`, with the settings of each in "
+             "the JSON beside it.", ""]
     for v in page.views:
         lines += view_section(page, v, tables, captions)
     shown = {v.figure for v in page.views}
@@ -145,6 +152,7 @@ def rules_appendix(found: Found) -> list[str]:
         items += [f"Why: {c.explanation}"] if c.explanation else []
         # the results show a finding's small table; its whole evidence line stays readable here
         items += [f"The evidence in full: {f.evidence}."] if f.table else []
+        items += [f"In the report: [{c.label}](REPORT.md#{anchor(c)}); its evidence: [table](#evidence-{anchor(c)})."]
         lines += [f'<a id="rule-{anchor(c)}"></a>', "", f"#### {c.label}: {c.statement}", "", *bullets(items)]
     return lines
 
@@ -186,8 +194,7 @@ def deep_appendix(letter: str, deep: Tables | None, deep_found: Found | None, no
                     f"[deep/REPORT.md](deep/REPORT.md)):", "", *summary(deep_found, "deep/REPORT.md"), ""]
 
 
-#: The two figures that carry the study, shown on the first screen when the report's folder has them.
-KEY_FIGURES = ("sod/convergence.png", "burgers/convergence.png")
+KEY_FIGURES = paper.KEY_FIGURES
 
 
 def lag_note(tables: Tables, current: str | None) -> list[str]:
@@ -206,8 +213,10 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
     quick = ("- These tables come from `mpm-fem reproduce --quick`: a subset of the meshes of each study. A "
              "verdict judged on the finest mesh a study has can differ from the full record's "
              "(`mpm-fem reproduce --full`), which reaches finer meshes. The quick tier leaves out the studies "
-             f"{', '.join(QUICK_LEAVES_OUT)}: the first two ask about the plateau of Sod's particle error, below "
-             "its meshes; the budget's exact-stage kernels take about a minute to compile.")
+             f"{', '.join(QUICK_LEAVES_OUT)}: they ask about the plateau of Sod's particle error, below its meshes, "
+             "and the budget's fused exact-stage kernels take about a minute to compile; the mechanism study runs a "
+             "small stage-exact set (two meshes a problem, each stage alone exact and every stage exact) on the "
+             "numpy step.")
     out.append(quick if is_quick(tables) else "- These tables come from `mpm-fem reproduce --full`.")
     out += not_judged(tables)
     written = code_version(tables)
@@ -219,7 +228,8 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
         out.append(f"- The tables were written by the current code ({written}).")
     if others:
         out.append(f"- **{len(others)} of {len(rows)} tables are left out of this report**: written by another code "
-                   f"version than the record's {written} ({', '.join(others)}; [the stamps](#appendix-stamps), E4), "
+                   f"version than the record's {written} ({', '.join(others)}; "
+                   "[the stamps](APPENDIX.md#appendix-stamps), E4), "
                    "so the claims that read them are not measured here; `mpm-fem reproduce --full` regenerates them.")
     setting = {r["key"]: r["value"] for r in tables.get("settings", []) if r["table"] == "sod/convergence"}
     if "mpm.ppc" in setting:
@@ -230,10 +240,29 @@ def caveats(tables: Tables, current: str | None) -> list[str]:
     return out
 
 
-def render(tables: Tables, pages, captions: dict[str, dict] | None = None, current: str | None = None,
-           deep: Tables | None = None) -> str:
-    """The whole report, from ``tables`` (:func:`mpm_fem.measure.tables.load_tables`), the study ``pages``,
-    the figure ``captions`` of each study folder (``{study: {file: caption}}``), the code version now
+def lettered(lines: list[str]) -> list[str]:
+    """``lines`` with every ``## Appendix ...`` heading lettered in order: A, B, C..."""
+    letters = iter("ABCDEFGHIJKLMNOPQRSTUVWXYZ")
+    return [f"## Appendix {next(letters)}: {APPENDIX_HEADING.match(line).group(1)}" if APPENDIX_HEADING.match(line)
+            else line for line in lines]
+
+
+APPENDIX_HEADING = re.compile(r"^## Appendix(?: [A-Z]?)?: (.*)$")
+#: The file of the appendices, beside ``REPORT.md``.
+APPENDIX = "APPENDIX.md"
+
+
+class Rendered(NamedTuple):
+    """The report's main text (``REPORT.md``) and its appendices (``APPENDIX.md``)."""
+
+    report: str
+    appendix: str
+
+
+def render_both(tables: Tables, pages, captions: dict[str, dict] | None = None, current: str | None = None,
+                deep: Tables | None = None) -> Rendered:
+    """The report and its appendices, from ``tables`` (:func:`mpm_fem.measure.tables.load_tables`), the study
+    ``pages``, the figure ``captions`` of each study folder (``{study: {file: caption}}``), the code version now
     (``current``) and the deep tier's tables (``deep``, ``None`` when there are none)."""
     captions = captions or {}
     record = code_version(tables)
@@ -248,21 +277,33 @@ def render(tables: Tables, pages, captions: dict[str, dict] | None = None, curre
              f"Rendered by `python -m mpm_fem.app.report` from the tables of code version {code_version(tables)}. "
              "Source: L.-T. Tran and M. Berzins, Error Analysis for Material Point Method and a case study from Gas "
              "Dynamics (slides; the claims, the source's tables and the corrections made to them: `docs/claims.md` "
-             "of the repository).", "", *lag_note(tables, current), *paper.abstract(tables, found)]
+             f"of the repository). The tables, the evidence and the rule book: [{APPENDIX}]({APPENDIX}).", "",
+             *lag_note(tables, current), *paper.abstract(tables, found)]
     for key in KEY_FIGURES:
         study, file = key.split("/")
         if file in captions.get(study, {}):
             lines += figure(study, file, captions[study])
     lines += paper.introduction(found) + paper.method(tables, caveats(everything, current))
-    lines += paper.results(tables, found, pages, captions, partial(summary, found, ""))
+    lines += paper.results(tables, found, pages, captions, partial(summary, found, "", brief=True, statements=False))
     lines += paper.discussion(tables, found, captions, deep_found, note) + paper.conclusions(found, tables)
-    lines += rules_appendix(found)
+    extra = [TITLE.replace("?", "? Appendix"), "",
+             f"The appendix of [REPORT.md](REPORT.md), rendered with it from the tables of code version "
+             f"{code_version(tables)}: each claim's verdict rule and evidence, the rule book, the source-matching "
+             "settings, every study's tables and figures, the code version of each table and the deep tier.", ""]
+    extra += rules_appendix(found) + paper.rule_book() + paper.evidence_appendix(found)
+    extra += paper.identification_appendix(tables) + model_appendix(tables, captions.get("defect", {}))
     shown = [page for page in pages if any(t.startswith(page.name + "/") for t in tables)]
-    letters = iter("BCDEFGHIJKLMNOPQRSTUVWXYZ")
     for page in shown:
-        lines += appendix_section(next(letters), page, tables, captions.get(page.name, {}))
-    lines += stamps_appendix(next(letters), tables) + deep_appendix(next(letters), deep_tables, deep_found, note)
-    return "\n".join(paper.numbered(lines))
+        extra += appendix_section("", page, tables, captions.get(page.name, {}))
+    extra += paper.deep_tier_appendix() + stamps_appendix("", tables) + deep_appendix("", deep_tables, deep_found,
+                                                                                        note)
+    return Rendered("\n".join(paper.numbered(lines)), "\n".join(lettered(extra)))
+
+
+def render(tables: Tables, pages, captions: dict[str, dict] | None = None, current: str | None = None,
+           deep: Tables | None = None) -> str:
+    """The report's main text (:func:`render_both`)."""
+    return render_both(tables, pages, captions, current, deep).report
 
 
 # ----------------------------------------------------------------------------- the command
@@ -276,14 +317,16 @@ def study_pages(folder: Path) -> list[Page]:
 
 
 def write_report(out: Path, pages: list[Page] | None = None) -> Path:
-    """Render ``<out>/REPORT.md`` from the tables and figure captions in ``out``; returns its path."""
+    """Render ``<out>/REPORT.md`` and ``<out>/APPENDIX.md`` from the tables and figure captions in ``out``;
+    returns the report's path."""
     out = Path(out)
     pages = study_pages(out) if pages is None else pages
     deep = load_tables(out / "deep") if (out / "deep").is_dir() else None
-    text = render(load_tables(out), pages, {p.name: captions_of(out / p.name) for p in pages}, current_code(),
-                  deep)
+    both = render_both(load_tables(out), pages, {p.name: captions_of(out / p.name) for p in pages}, current_code(),
+                       deep)
+    write_atomic(out / APPENDIX, both.appendix + "\n")
     path = out / "REPORT.md"
-    write_atomic(path, text + "\n")
+    write_atomic(path, both.report + "\n")
     return path
 
 
