@@ -134,7 +134,8 @@ def _c11_setting(rows: list[dict], n: int, cfl: float) -> tuple[str, str, dict]:
     meshes = len(orders["particle density"]) + 1
     row = {"setting": _label(n, cfl)}
     if meshes < FLOOR_MESHES:
-        row["verdict"] = "not measured"
+        # the cell says why: the sentence may still quote this setting's size against the source's table
+        row["verdict"] = f"not measured ({meshes} of the {FLOOR_MESHES} meshes the shape needs have {MIN_RUNS} runs)"
         return "not measured", f"{meshes} meshes with {MIN_RUNS} runs, the shape needs {FLOOR_MESHES}", row
     shapes = {name: shape.shape([o for _, _, o in found]) for name, found in orders.items()}
     h, ratio = shape.size(rows, C11_JUDGED["particle density"], 0)

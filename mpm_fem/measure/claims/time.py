@@ -105,9 +105,11 @@ def _c2(t: Tables) -> Finding:
     no_jump = bool(smooth) and all(v <= NO_JUMP for v in smooth.values())
     second, text, table = _second_half(t)
     verdict = CONFIRMED if matches and no_jump and second else PARTLY if matches else REFUTED
+    below = f"{max(smooth.values()):.1%}" if smooth else ""
+    smooth_said = (f"the smooth bases' stays below {below} of it" if smooth else
+                   "the smooth bases' jump is not measured (no GIMP or B-spline row with the exact acceleration)")
     sentence = (f"at a node crossing P1's jump of the third time derivative matches the slides' formula within "
-                f"{num(p1[0], 'max_ratio_error'):.1%} over {p1[0]['crossings']} crossings, the smooth bases' stays "
-                f"below {max(smooth.values(), default=math.nan):.1%} of it"
+                f"{num(p1[0], 'max_ratio_error'):.1%} over {p1[0]['crossings']} crossings, {smooth_said}"
                 + (f"; P1's global order in dt is {span([float(r['P1']) for r in table])} against "
                    f"{span([float(v) for r in table for k, v in r.items() if k in ('GIMP', 'B-spline')])} for "
                    "the smooth bases" if table else ""))
@@ -116,7 +118,7 @@ def _c2(t: Tables) -> Finding:
         f"{num(p1[0], 'max_ratio_error'):.3f} over {p1[0]['crossings']} crossings; C1 bases |measured|/P1 formula "
         + ", ".join(f"{b} {v:.3f}" for b, v in smooth.items()) + f"; {text}"), sentence, table,
         key=short(f"P1's jump of d^3 x_p/dt^3 at a node crossing within {num(p1[0], 'max_ratio_error'):.1%} of the "
-                  f"slides' formula over {p1[0]['crossings']} crossings; smooth bases below "
-                  f"{max(smooth.values(), default=math.nan):.1%}",
+                  f"slides' formula over {p1[0]['crossings']} crossings; "
+                  + (f"smooth bases below {below}" if smooth else "smooth bases not measured"),
                   f"P1's jump at a node crossing within {num(p1[0], 'max_ratio_error'):.1%} of the slides' formula; "
-                  f"smooth bases below {max(smooth.values(), default=math.nan):.1%} of it"))
+                  + (f"smooth bases below {below} of it" if smooth else "smooth bases not measured")))
