@@ -282,7 +282,7 @@ def _e6(t: Tables) -> Finding:
                 + (f"; which remedies stop the growth (they change the quadrature): right on {len(agree)} of "
                    f"{len(remedies)} remedies" + (f", not on {', '.join(wrong)}" if wrong else "") if remedies else
                    "; the remedies table is not here"))
-    failed = failures(t.get(REMEDY_ERRORS, []), ("problem", "remedy", "h"), REMEDY_ERRORS)
+    failed = failures(t.get(REMEDY_ERRORS, []), ("problem", "remedy", "h"), REMEDY_ERRORS, flag=None)
     evidence += "".join(f"; {line} (a remedy without a particle order on every mesh is left out)" for line in failed)
     sentence = (f"fitted on the coarse meshes at {FIT_PPC} per cell, the defect model predicts the particle error out "
                 f"of sample (the other particle count, or {OUT_MESHES} meshes or more beyond the fit) within "

@@ -201,7 +201,7 @@ def _e5(t: Tables) -> Finding:
     key = short(sentence, f"{name} keeps Sod's density error converging on {over}, within {fv_ratio:.2f}x the "
                           "finite-volume error", f"{name} keeps Sod's density error converging on {over} within "
                           f"{fv_ratio:.2f}x the FV error") if s["removes_plateau"] else short(sentence)
-    failed = failures(rows, ("problem", "remedy", "h"), REMEDY_ERRORS)
+    failed = failures(rows, ("problem", "remedy", "h"), REMEDY_ERRORS, flag=None)
     why += "".join(f"; {line} (a failed run fails every condition it enters)" for line in failed)
     if s["removes_plateau"] and fv and b_ok:
         return Finding(CONFIRMED, "meets the goal: " + text + f"; {why}", sentence, table, failed, key)

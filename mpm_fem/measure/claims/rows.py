@@ -81,12 +81,13 @@ def successive_orders(rows: list[dict], key: str) -> list[float]:
     return out
 
 
-def failed(rows: list[dict]) -> list[dict]:
-    """The rows of runs that failed: ``ok`` false where the table has an ``ok`` column, else a ``error``
-    that is a message, not a number (``budget/subsets``' ``error`` is the measured error)."""
+def failed(rows: list[dict], flag: str | None = "ok") -> list[dict]:
+    """The rows of runs that failed: ``flag`` (the table's success column) false where the table has it,
+    else (or with ``flag=None``, a table without one) an ``error`` that is a message, not a number
+    (``budget/subsets``' ``error`` is the measured error)."""
     def broke(r: Mapping) -> bool:
-        if "ok" in r:
-            return str(r["ok"]) not in ("True", "true", "1")
+        if flag is not None and flag in r:
+            return str(r[flag]) not in ("True", "true", "1")
         message = str(r.get("error", "")).strip()
         return bool(message) and not _is_number(message)
     return [r for r in rows if broke(r)]
@@ -113,12 +114,13 @@ def failure_cause(message: str) -> str:
     return " ".join(text.split()) or "no message"
 
 
-def failures(rows: list[dict], where: tuple[str, ...] = ("h",), table: str = "") -> tuple[str, ...]:
+def failures(rows: list[dict], where: tuple[str, ...] = ("h",), table: str = "",
+             flag: str | None = "ok") -> tuple[str, ...]:
     """One line per cause of the failed runs among ``rows`` (:func:`failed`, :func:`failure_cause`) of
     ``table``: their count, the values of the columns ``where`` they were run at, and the cause, e.g.
     ``"sod/ppc: 2 of 18 runs failed (ppc = 1; h = 0.0025, 0.000625): positivity lost"``; empty when no run
-    failed."""
-    bad = failed(rows)
+    failed; ``flag`` as in :func:`failed`."""
+    bad = failed(rows, flag)
     causes: dict[str, list[dict]] = {}
     for r in bad:
         causes.setdefault(failure_cause(r.get("error", "")), []).append(r)
