@@ -190,3 +190,25 @@ def test_reused_arrays_and_the_compiled_force_give_the_numpy_force_s_steps():
     gaps = _gaps(a, b)
     assert max(gaps.values()) < ROUND_OFF, f"reused arrays, compiled force - plain, numpy force: {gaps}"
     assert kept[-1] is kept[-3] and kept[-1] is not kept[-2]  # two sets written in turn
+
+
+def test_a_run_takes_the_compiled_step_where_it_serves_with_the_numpy_step_s_errors():
+    from mpm_fem.plane import axis, run
+
+    kw = dict(h=0.125, ppc=2, amplitude=0.05, T=0.004, layout="jittered")
+    compiled, plain = axis(**kw), axis(compiled=False, **kw)
+    assert compiled.compiled and not plain.compiled and compiled.steps == plain.steps >= 10
+    for norm in ("L2", "Linf", "L2_max"):
+        want, got = plain.errors["displacement"]["particles"][norm], compiled.errors["displacement"]["particles"][norm]
+        assert abs(got - want) < 1e-10 * want, f"{norm}: compiled {got!r}, numpy {want!r}"
+    want, got = plain.errors["acceleration"]["nodes"]["L2"], compiled.errors["acceleration"]["nodes"]["L2"]
+    assert abs(got - want) < 1e-10 * want, f"nodal acceleration L2: compiled {got!r}, numpy {want!r}"
+    assert not axis(mass="consistent", **kw).compiled  # served on the numpy step
+    seen = []  # an observer keeps the states: each step's arrays are its own
+    run(PlaneSettings(**kw), observer=lambda n, t, p, g: seen.append((p, p.x.copy())))
+    assert all(np.array_equal(p.x, x) for p, x in seen), "a kept state was overwritten by a later step"
+
+
+def test_compiled_must_be_a_bool():
+    with pytest.raises(ValueError, match="compiled must be True or False"):
+        PlaneSettings(compiled="yes")

@@ -1,6 +1,7 @@
 """The 2D time loop and the two problems' runs: ``axis(...)`` and ``vortex(...)``.
 
-A run steps :func:`mpm_fem.plane.step.step_with_grid` from ``t = 0`` to ``T`` with the fixed step
+A run steps :func:`mpm_fem.plane.step.step_with_grid` (or the compiled step where it serves:
+``PlaneSettings.compiled``) from ``t = 0`` to ``T`` with the fixed step
 ``dt = T / N``, ``N = ceil(T c / (cfl h) * refine)`` (so that ``dt <= cfl h / (c refine)``, with
 ``c = sqrt(E / rho0)`` the material's speed and ``h`` the smaller cell size; the CFL number run is
 ``dt c refine / h``, stated in the :class:`Run`). The loop is over time steps only. Errors
@@ -28,6 +29,8 @@ import numpy as np
 from mpm_fem.core.step import Stages
 from mpm_fem.plane.bases import tensor_basis
 from mpm_fem.plane.exact import ExactStages2, cell_quadrature, reference_of
+from mpm_fem.plane.forces import compiled_force
+from mpm_fem.plane.fused import PlaneFused, served
 from mpm_fem.plane.grid import plane_grid
 from mpm_fem.plane.model import InversionError
 from mpm_fem.plane.norms import nodal_l2, particle_l2, particle_linf
@@ -46,8 +49,11 @@ class PlaneSettings:
     ``T`` (None: one period for ``axis``, 1 for ``vortex``), the PIC/FLIP ``flip``, the stage
     switches ``projection``, ``interpolation``, ``acceleration`` and the time ``refine``, the
     order of the exact projection's reference quadrature ``quadrature``, the ``scheme``
-    (``usl``, or ``musl``: :mod:`mpm_fem.plane.step`), and ``amplitude_y`` the axis-aligned
-    solution's y amplitude (None: ``amplitude``; 0: the y part off; ``axis`` only)."""
+    (``usl``, or ``musl``: :mod:`mpm_fem.plane.step`), ``amplitude_y`` the axis-aligned
+    solution's y amplitude (None: ``amplitude``; 0: the y part off; ``axis`` only), and ``compiled``:
+    True runs the compiled step (:mod:`mpm_fem.plane.fused`) where it serves the basis and the stages
+    (:func:`mpm_fem.plane.fused.served`: a basis with compiled rows, USL, the lumped mass, the MPM
+    stages), the numpy step elsewhere; False the numpy step always (equal to round-off)."""
 
     problem: str = "axis"
     h: float = 1 / 16
@@ -67,6 +73,7 @@ class PlaneSettings:
     quadrature: int = 4
     scheme: str = "usl"
     amplitude_y: float | None = None
+    compiled: bool = True
 
     def __post_init__(self):
         if self.problem not in PROBLEMS:
@@ -86,6 +93,8 @@ class PlaneSettings:
             raise ValueError(f"particles per cell per axis must be an integer >= 1, got {self.ppc!r}")
         if self.amplitude_y is not None and self.problem != "axis":
             raise ValueError(f"amplitude_y is the axis-aligned solution's y amplitude; {self.problem} has none")
+        if not isinstance(self.compiled, bool):
+            raise ValueError(f"compiled must be True or False, got {self.compiled!r}")
         tensor_basis(self.basis)
         check_stages(self.stages)
 
@@ -100,7 +109,8 @@ class PlaneSettings:
 class Run:
     """One 2D run: ``settings``; the particles at ``t`` (``particles``) on ``grid``; ``steps`` of ``dt`` (s) at
     the CFL number ``cfl`` (``dt c / h``); ``errors`` ``{"displacement": {"particles": {"L2", "Linf",
-    "L2_max"}}, "acceleration": {"nodes": {"L2"}}}``; ``wall_s`` the loop's wall time (s)."""
+    "L2_max"}}, "acceleration": {"nodes": {"L2"}}}``; ``wall_s`` the loop's wall time (s); ``compiled``
+    whether the compiled step ran it."""
 
     settings: PlaneSettings
     particles: object = field(repr=False)
@@ -111,6 +121,7 @@ class Run:
     cfl: float
     errors: dict = field(repr=False)
     wall_s: float
+    compiled: bool = False
 
     def __repr__(self) -> str:
         e = self.errors["displacement"]["particles"]
@@ -159,13 +170,19 @@ def run(s: PlaneSettings, observer=None) -> Run:
         keep = inside(solution, Xq)
         exact = ExactStages2(solution, Xq[keep], wq[keep])
     state = start(solution, X, V0, lengths, dt)
+    # the compiled step where it serves (its arrays reused step to step unless an observer may keep a state)
+    fused = PlaneFused(grid, s.basis, reuse=observer is None) if s.compiled and served(s.basis, stages) else None
+    force = (compiled_force(solution) or solution.body_force) if fused is not None else solution.body_force
     worst = 0.0
     t0 = time.perf_counter()
     t = 0.0
     for n in range(n_steps):
         try:
-            state, grid_state = step_with_grid(state, grid, s.basis, solution.material, dt, t, solution.body_force,
-                                               stages, exact)
+            if fused is None:
+                state, grid_state = step_with_grid(state, grid, s.basis, solution.material, dt, t, force, stages,
+                                                   exact)
+            else:
+                state, grid_state = fused.step_with_grid(state, solution.material, dt, t, force, stages)
         except InversionError as error:
             raise error.at(n + 1, t + dt) from None
         a_time = t
@@ -183,7 +200,7 @@ def run(s: PlaneSettings, observer=None) -> Run:
     errors = {"displacement": {"particles": {"L2": particle_l2(state.volume, error), "Linf": particle_linf(error),
                                              "L2_max": worst}},
               "acceleration": {"nodes": {"L2": nodal_l2(grid_state.mass, grid_state.acceleration - a_star)}}}
-    return Run(s, state, grid, t, n_steps, dt, dt * c * s.refine / h, errors, wall)
+    return Run(s, state, grid, t, n_steps, dt, dt * c * s.refine / h, errors, wall, fused is not None)
 
 
 def axis(**settings) -> Run:
