@@ -41,9 +41,8 @@ from mpm_fem.bases.contract import Basis
 from mpm_fem.bases.shape import OutsideGridError
 from mpm_fem.core.step import Stages
 from mpm_fem.fused.step import _uniform_to_round_off
-from mpm_fem.plane import kernels
 from mpm_fem.plane.grid import PlaneGrid
-from mpm_fem.plane.kernels import IBAD, IDT, IFLIP, ILAM, IMU, INEED, IOUT, NSUM, Cloud, Line
+from mpm_fem.plane.kernels import IBAD, IDT, IFLIP, ILAM, IMU, INEED, IOUT, NSUM, Cloud, Line, _move, _project, _solve
 from mpm_fem.plane.model import InversionError
 from mpm_fem.plane.state import PlaneParticles
 from mpm_fem.plane.step import BodyForce, PlaneGridState, check_stages
@@ -51,7 +50,7 @@ from mpm_fem.plane.step import BodyForce, PlaneGridState, check_stages
 #: the stage switches the compiled step serves, with the value they must have
 SERVED = {"scheme": "usl", "mass": "lumped", "projection": "mpm", "interpolation": "mpm",
           "acceleration": "calculated"}
-SOURCES = [Path(kernels.__file__)] + sorted(Path(inspect.getsourcefile(bases)).parent.glob("*.py"))
+SOURCES = [Path(inspect.getsourcefile(_project))] + sorted(Path(inspect.getsourcefile(bases)).parent.glob("*.py"))
 DIGEST = hashlib.sha1(b"".join(path.read_bytes() for path in SOURCES)).hexdigest()[:8]
 _VARIANTS: dict = {}  # (pass, basis name, parallel) -> compiled variant, made on first use
 
@@ -110,9 +109,9 @@ class PlaneFused:
         self.grid, self.threads = grid, int(threads)
         self.axes = tuple(_line(a) for a in grid.axes)
         parallel = self.threads > 1
-        self._project = variant(kernels._project, self.basis, parallel)
-        self._move = variant(kernels._move, self.basis, parallel)
-        self._solve = variant(kernels._solve, None, parallel)
+        self._project = variant(_project, self.basis, parallel)
+        self._move = variant(_move, self.basis, parallel)
+        self._solve = variant(_solve, None, parallel)
         n = grid.n_nodes
         self.buf = np.zeros((self.threads, n, NSUM))
         self.flags = np.full((self.threads, 3), -1, dtype=np.int64)

@@ -73,7 +73,7 @@ class PlaneSettings:
     quadrature: int = 4
     scheme: str = "usl"
     amplitude_y: float | None = None
-    compiled: bool = True
+    compiled: bool = False
 
     def __post_init__(self):
         if self.problem not in PROBLEMS:
