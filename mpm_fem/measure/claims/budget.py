@@ -251,8 +251,12 @@ def _e2(t: Tables) -> Finding:
                                    f"{_BASIS_NAMES.get(b, b)}" for b, v in tails.items()),
                        f"particle density orders, last {FLOOR_STEPS} refinements: "
                        + ", ".join(f"{', '.join(f'{o.mean:.2f}' for o in v['particles_L1'])} "
-                                   f"({_BASIS_NAMES.get(b, b).removeprefix('the ')})" for b, v in tails.items())))
+                                   f"({_BASIS_NAMES.get(b, b).removeprefix('the ')})" for b, v in tails.items()),
+                       f"particle density orders, last {FLOOR_STEPS} refinements: "
+                       + ", ".join(f"{_SHORT_NAMES.get(b, b)} {'/'.join(f'{o.mean:.2f}' for o in v['particles_L1'])}"
+                                   for b, v in tails.items())))
 
 
+_SHORT_NAMES = {"mpm": "P1", "gimp": "GIMP", "bspline": "C1", "bspline_gimp": "C1 domain", "cubic": "C2"}
 _BASIS_NAMES = {"mpm": "P1", "gimp": "GIMP", "bspline": "the C1 B-spline",
                 "bspline_gimp": "the particle-domain B-spline", "cubic": "the C2 cubic B-spline"}
