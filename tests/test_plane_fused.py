@@ -196,16 +196,16 @@ def test_a_run_takes_the_compiled_step_where_it_serves_with_the_numpy_step_s_err
     from mpm_fem.plane import axis, run
 
     kw = dict(h=0.125, ppc=2, amplitude=0.05, T=0.004, layout="jittered")
-    compiled, plain = axis(**kw), axis(compiled=False, **kw)
+    compiled, plain = axis(compiled=True, **kw), axis(**kw)  # the numpy step by default
     assert compiled.compiled and not plain.compiled and compiled.steps == plain.steps >= 10
     for norm in ("L2", "Linf", "L2_max"):
         want, got = plain.errors["displacement"]["particles"][norm], compiled.errors["displacement"]["particles"][norm]
         assert abs(got - want) < 1e-10 * want, f"{norm}: compiled {got!r}, numpy {want!r}"
     want, got = plain.errors["acceleration"]["nodes"]["L2"], compiled.errors["acceleration"]["nodes"]["L2"]
     assert abs(got - want) < 1e-10 * want, f"nodal acceleration L2: compiled {got!r}, numpy {want!r}"
-    assert not axis(mass="consistent", **kw).compiled  # served on the numpy step
+    assert not axis(mass="consistent", compiled=True, **kw).compiled  # served on the numpy step
     seen = []  # an observer keeps the states: each step's arrays are its own
-    run(PlaneSettings(**kw), observer=lambda n, t, p, g: seen.append((p, p.x.copy())))
+    run(PlaneSettings(compiled=True, **kw), observer=lambda n, t, p, g: seen.append((p, p.x.copy())))
     assert all(np.array_equal(p.x, x) for p, x in seen), "a kept state was overwritten by a later step"
 
 
