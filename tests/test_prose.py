@@ -22,7 +22,9 @@ ROOT = Path(__file__).resolve().parent.parent
 #: Study modules left out of the check of typed numbers (none).
 PENDING: set = set()
 MODULES = ([p for p in sorted((ROOT / "studies").glob("*.py")) if p.name not in PENDING]
-           + [ROOT / "mpm_fem" / "app" / name for name in ("report.py", "paper.py", "markdown.py", "pages.py")])
+           + [ROOT / "mpm_fem" / "app" / name for name in ("report.py", "paper.py", "markdown.py", "pages.py",
+                                                           "paper_findings.py", "paper_abstract.py", "paper_method.py",
+                                                           "paper_results.py", "paper_discussion.py")])
 NUMBER = re.compile(r"^[-+~]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(%|x)?$")
 PROSE_WORDS = 6
 

@@ -1,0 +1,129 @@
+"""The report's Results and the appendix of each claim's evidence.
+
+The verdicts counted, then every claim in the order of its study's page: statement, verdict and source,
+its finding in words, one figure (shown once, at the first claim that reads it), the failed runs and
+the links to its evidence, its rule and its study's tables in the appendix. A finding without a
+sentence is said by its evidence's first clause, whole; one without a table shows its evidence as a
+list cut at its semicolons.
+"""
+
+from __future__ import annotations
+
+from mpm_fem.app.markdown import anchor_of, bullets, figure, markdown_table, prose, readable, sentences, split_outside
+from mpm_fem.app.pages import Page
+from mpm_fem.app.paper_abstract import KEY_FIGURES
+from mpm_fem.app.paper_findings import COUNT_MEANING, Found, first_clause, verdict_text
+from mpm_fem.measure.claims import STATEMENTS, Claim, Finding, claims_of
+from mpm_fem.measure.claims.base import PARTLY
+from mpm_fem.measure.claims.rules import VERDICT_MEANING
+from mpm_fem.measure.tables import Tables
+
+#: The results' section of the claims on the record itself (E4): they read the tables' stamps.
+REPRODUCTION = Page("reproduce", "Reproduction", "Every table carries the version of the code that wrote it; one "
+                    "command regenerates them all. Each table's stamp is in the appendix.")
+
+
+def _has_tables(tables: Tables, study: str) -> bool:
+    """Whether ``tables`` hold a table of ``study`` (its appendix is written only then)."""
+    return any(rows for name, rows in tables.items() if name.startswith(study + "/"))
+
+
+def evidence(f: Finding) -> list[str]:
+    """The evidence as its small table, or (a criterion without one) as a list cut at its semicolons."""
+    if f.table:
+        columns = list(dict.fromkeys(k for row in f.table for k in row))
+        return markdown_table(list(f.table), columns) + [""]
+    return bullets(split_outside(f.evidence))
+
+
+def claim_section(c: Claim, f: Finding, figure_lines: list[str] = (), appendix: str = "",
+                  linked: bool = True) -> list[str]:
+    """A claim in the results: statement, verdict and source (a one-row table), its finding in words, one
+    figure, the failed runs, and the links to its evidence, its rule and (``linked``: a study in the folder)
+    its study's tables in the appendix."""
+    text = f.sentence.strip() or first_clause(f)
+    links = (f"Evidence: [table](APPENDIX.md#evidence-{anchor_of(c.label)}), "
+             f"[rule](APPENDIX.md#rule-{anchor_of(c.label)})"
+             + (f", [study](APPENDIX.md#{appendix})." if appendix and linked else "."))
+    return [f'<a id="{anchor_of(c.label)}"></a>', "", f"#### {c.label}: {c.statement}", "",
+            *markdown_table([{"verdict": verdict_text(f), "source": c.source}]), "",
+            *([readable(text[:1].upper() + text[1:]).rstrip(".") + ".", ""] if text else []), *figure_lines,
+            *failed_runs(f), links, ""]
+
+
+def evidence_section(c: Claim, f: Finding) -> list[str]:
+    """A claim's evidence in the appendix: its finding, its small table (or its evidence as a list), the
+    failed runs, and the link back to its results."""
+    return [f'<a id="evidence-{anchor_of(c.label)}"></a>', "", f"#### {c.label}: {c.statement}", "",
+            *markdown_table([{"verdict": verdict_text(f), "source": c.source}]), "", *evidence(f), *failed_runs(f),
+            f"In the report: [{c.label}](REPORT.md#{anchor_of(c.label)}).", ""]
+
+
+def failed_runs(f: Finding) -> list[str]:
+    """The runs of the finding's tables that failed, by cause (count, where, cause), as a paragraph; how the
+    verdict reads them (left out, or failing every condition they enter) is in the evidence."""
+    if not f.failed:
+        return []
+    return [f"Runs that failed (count, where they ran, cause): {'; '.join(f.failed)}.", ""]
+
+
+def claim_figure(c: Claim, page: Page | None, captions: dict) -> list[str]:
+    """The first figure of the page's views of a table the claim reads (none if no view has one)."""
+    for v in page.views if page else ():
+        if v.figure and v.table in c.tables and v.figure in captions:
+            return figure(page.name, v.figure, captions)
+    return []
+
+
+def verdict_counts(found: Found) -> list[str]:
+    """How many of the source's claims and of the extensions got each verdict, as a table (a count of
+    ``partly`` verdicts, whatever each one's count)."""
+    rows = []
+    for v in VERDICT_MEANING:
+        source = sum(f.verdict == v for c, f in found.values() if c.id.startswith("C"))
+        extensions = sum(f.verdict == v for c, f in found.values() if c.id.startswith("E"))
+        if source or extensions:
+            rows.append({"verdict": COUNT_MEANING[0] if v == PARTLY else v, "the source's claims": source,
+                         "the extensions": extensions})
+    return markdown_table(rows) + [""]
+
+
+def results(tables: Tables, found: Found, pages: list[Page], captions: dict, summary) -> list[str]:
+    """Every claim in the order of its study's page: the studies without a table say so. A figure is shown
+    once, at the first claim that reads it; every claim's evidence table is in the appendix."""
+    lines = ["## Results", "", *prose(
+        "The verdicts, counted, then every claim with its key number, the source's claims first; the subsections "
+        "say each finding in words, and each claim's evidence is a table of "
+        "[the appendix](APPENDIX.md#appendix-evidence)."), *verdict_counts(found),
+        "*The source's claims.*", "", *summary("C"), "", "*The extensions.*", "", *summary("E"), ""]
+    shown_pages = [p for p in [*pages, REPRODUCTION] if claims_of(p.name)]
+    drawn = set(KEY_FIGURES)  # the first screen shows these
+    for page in shown_pages:
+        present = any(tables.get(t) for c in claims_of(page.name) for t in c.tables) \
+            and (page is REPRODUCTION or _has_tables(tables, page.name))
+        lines += [f'<a id="{page.name}"></a>', "", f"### {page.title}", "",
+                  *prose(sentences(page.caption)[0] + " The study's settings in full: [its appendix]"
+                         f"(APPENDIX.md#appendix-{page.name})." if present and page is not REPRODUCTION else
+                         page.caption if present else
+                         f"No table of the study `{page.name}` in this folder: its claims are not measured here.")]
+        for c in claims_of(page.name):
+            f = found[c.label][1]
+            picture = claim_figure(c, page, captions.get(page.name, {})) if present else []
+            path = picture[0].rsplit("](", 1)[1].rstrip(")") if picture else ""
+            if path in drawn:
+                picture = []
+            drawn.add(path)
+            lines += claim_section(c, f, picture, ("appendix-stamps" if page is REPRODUCTION else
+                                                   f"appendix-{page.name}") if present else "", linked=present)
+    return lines
+
+
+def evidence_appendix(found: Found) -> list[str]:
+    """Every claim's evidence, in the order of the summary."""
+    order = list(STATEMENTS)
+    lines = ['<a id="appendix-evidence"></a>', "", "## Appendix: the evidence of each claim", "",
+             *prose("Each claim's small table (or its evidence as a list), as its criterion computed it from the "
+                    "study tables; the report's results say each one in words.")]
+    for c, f in sorted(found.values(), key=lambda cf: (order.index(cf[0].id), cf[0].problem)):
+        lines += evidence_section(c, f)
+    return lines
