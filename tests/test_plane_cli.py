@@ -82,7 +82,7 @@ def test_the_periodic_grid_is_written_with_its_end_points(tmp_path):
     (["axis", "--ppc", "0"], "integer >= 1"),
     (["axis", "--h=-0.25"], "must be positive"),
     (["axis", "--seed", "-1"], "seed must be an integer >= 0"),
-    (["axis", "--mass", "diagonal"], "invalid choice: 'diagonal'"),
+    (["axis", "--mass", "diagonal"], "unknown mass 'diagonal'; choose one of lumped, consistent, exact, grid, fmpm1"),
     (["axis", "--ppc", "two"], "invalid int value"),
     (["axis", "--amplitdue", "1e-4"], "did you mean --amplitude"),
     (["square"], "invalid choice: 'square'"),

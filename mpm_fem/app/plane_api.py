@@ -12,6 +12,8 @@ the value, the same line the command line ``mpm-fem plane`` prints (:mod:`mpm_fe
 
     names       an unknown keyword (:class:`~mpm_fem.app.guard.UnknownSetting`, also a ``TypeError``,
                 with the closest name); a type other than the field's (:func:`mpm_fem.app.inputs.check_types`)
+    mass        a name of the grid masses' registry (:func:`mpm_fem.masses.names`: ``lumped``,
+                ``consistent``, ``grid``, ``exact``, ``fmpm1`` .. ``fmpm4``); another is refused listing them
     basis       a registered name, ``p1`` (the point-mass basis ``mpm``), an entry point's or
                 ``package.module:Name`` (:func:`mpm_fem.app.inputs.extension`); one without a 2D
                 (tensor-product) form is refused

@@ -1,6 +1,6 @@
 """``mpm-fem plane axis|vortex``: one 2D run from the command line, its errors and CFL number printed.
 
-    mpm-fem plane axis   [--h 0.0625] [--ppc 2] [--basis p1|gimp|bspline|...] [--mass lumped|consistent|exact]
+    mpm-fem plane axis   [--h 0.0625] [--ppc 2] [--basis p1|gimp|bspline|...] [--mass lumped|consistent|grid|fmpm2|...]
                          [--amplitude A] [--amplitude-y A_y] [--layout regular|jittered] [--seed K] [--cfl C]
                          [--flip ALPHA] [--projection mpm|exact] [--interpolation mpm|exact]
                          [--acceleration calculated|exact] [--refine K] [--T T] [--scheme usl|musl]
@@ -26,15 +26,16 @@ import dataclasses
 import sys
 from pathlib import Path
 
+from mpm_fem import masses
 from mpm_fem.app import guard, output
 from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.guard import UsageError
-from mpm_fem.core.step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS, STAGE_MASS
+from mpm_fem.core.step import ACCELERATIONS, INTERPOLATIONS, PROJECTIONS
 from mpm_fem.plane.problems import LAYOUTS
 from mpm_fem.plane.run import PROBLEMS, PlaneSettings
 from mpm_fem.plane.step import SCHEMES
 
-CHOICES = {"mass": STAGE_MASS, "projection": PROJECTIONS, "interpolation": INTERPOLATIONS,
+CHOICES = {"projection": PROJECTIONS, "interpolation": INTERPOLATIONS,
            "acceleration": ACCELERATIONS, "layout": LAYOUTS, "scheme": SCHEMES}
 HELP = {
     "h": "cell size; must divide the domain ([0, 2] for axis, [-1.5, 1.5] for vortex)",
@@ -44,7 +45,9 @@ HELP = {
     "amplitude_y": "axis only: the y part's amplitude A_y (default A; 0 turns the y part off)",
     "basis": "the 1D basis of the tensor product: a registered name (p1 is mpm), an installed entry point's "
              "or package.module:Name; it must have a 2D form",
-    "mass": "grid mass matrix: lumped, consistent, or exact (the mass stage made exact)",
+    "mass": f"grid mass, one of {', '.join(masses.names())} (lumped: row sums; consistent: the particle mass "
+            "matrix, solved; grid: the grid basis's own mass rho0 int S_i S_j; fmpmK: FMPM(K), the truncated "
+            "series of the full inverse; exact: the mass stage made exact)",
     "cfl": "CFL number dt c / h, c = sqrt(E / rho0), in (0, 1]; refused above the linearised step's limit "
            "(0.862 with the lumped mass and the mpm or gimp basis)",
     "seed": "random seed of the jittered layout",

@@ -31,11 +31,13 @@ import numpy as np
 from skfem import Basis as SkBasis
 from skfem import ElementQuad1
 
+from mpm_fem import masses
 from mpm_fem.bases import get
 from mpm_fem.bases.contract import Basis
+from mpm_fem.masses.contract import MassSystem
 from mpm_fem.plane.bases import plane_shape, tensor_basis
 from mpm_fem.plane.grid import PlaneGrid
-from mpm_fem.plane.step import Nodal, Projected, consistent_solver, lumped
+from mpm_fem.plane.step import Nodal, Projected
 
 NEWTON_STEPS = 30
 CONTINUATION = 32  # time steps of the continuation that follows a node's material point when Newton fails
@@ -106,8 +108,10 @@ class ExactStages2:
         return X
 
     def projection(self, grid: PlaneGrid, basis: str | Basis, t: float, dt: float):
-        """:class:`~mpm_fem.plane.step.Projected`: the quadrature's sums, and ``solver(kind)`` giving
-        the lumped (``m*_i``) or consistent (the points' mass matrix) solve of its data."""
+        """:class:`~mpm_fem.plane.step.Projected`: the quadrature's sums, and ``solver(kind, grid_solve)``
+        giving the solve of its data by the grid mass ``kind`` (a name or a
+        :class:`~mpm_fem.masses.GridMass`: lumped ``m*_i``, consistent the points' mass matrix, FMPM(k)
+        its series; ``grid_solve`` the grid basis's mass for the ``grid`` mass)."""
         s, X, w = self.solution, self.points, self.weights
         functions = get(tensor_basis(basis).grid_functions)
         x = X + _vector(s.displacement, X, t)
@@ -121,10 +125,8 @@ class ExactStages2:
         f_i = -shape.scatter_gradient((w * J)[:, None, None] * sigma)
         f_i += shape.scatter(mass[:, None] * _vector(s.body_force, X, t))
 
-        def solver(kind):
-            if kind == "consistent":
-                return consistent_solver(shape, mass)
-            return lambda rhs: lumped(rhs, m_i)
+        def solver(kind, grid_solve=None):
+            return masses.get(kind).solver(MassSystem(shape.matrix(), mass, m_i, grid_solve))
 
         return Projected(m_i, P_i, f_i, solver)
 

@@ -26,6 +26,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from mpm_fem import masses
 from mpm_fem.core.step import Stages
 from mpm_fem.plane.bases import tensor_basis
 from mpm_fem.plane.exact import ExactStages2, cell_quadrature, reference_of
@@ -44,8 +45,9 @@ VORTEX_BOX = 1.5  # the vortex's grid: [-VORTEX_BOX, VORTEX_BOX]^2 about the cen
 @dataclass(frozen=True)
 class PlaneSettings:
     """One 2D run: the problem, ``h`` the cell size, ``ppc`` particles per cell per axis, the
-    solution's ``amplitude``, the 1D ``basis`` of the tensor basis, the ``mass`` (``lumped``,
-    ``consistent``, ``exact``), ``cfl``, the layout (``regular``, ``jittered``) and its ``seed``,
+    solution's ``amplitude``, the 1D ``basis`` of the tensor basis, the grid ``mass`` (a name of the
+    registry :func:`mpm_fem.masses.names`: ``lumped``, ``consistent``, ``exact``, ``grid``, ``fmpm1`` ..
+    ``fmpm4``), ``cfl``, the layout (``regular``, ``jittered``) and its ``seed``,
     ``T`` (None: one period for ``axis``, 1 for ``vortex``), the PIC/FLIP ``flip``, the stage
     switches ``projection``, ``interpolation``, ``acceleration`` and the time ``refine``, the
     order of the exact projection's reference quadrature ``quadrature``, the ``scheme``
@@ -96,11 +98,14 @@ class PlaneSettings:
         if not isinstance(self.compiled, bool):
             raise ValueError(f"compiled must be True or False, got {self.compiled!r}")
         tensor_basis(self.basis)
+        if masses.get(self.mass).fills and self.problem != "axis":  # ValueError naming the registered masses
+            raise ValueError(f"the {self.mass} mass needs a body that fills the grid; the {self.problem}'s does not "
+                             "(use the consistent mass)")
         check_stages(self.stages)
 
     @property
     def stages(self) -> Stages:
-        return Stages(basis=self.basis, mass=self.mass, flip=self.flip, projection=self.projection,
+        return Stages(basis=self.basis, mass=masses.get(self.mass).stage, flip=self.flip, projection=self.projection,
                       interpolation=self.interpolation, acceleration=self.acceleration, refine=self.refine,
                       scheme=self.scheme)
 
@@ -180,7 +185,7 @@ def run(s: PlaneSettings, observer=None) -> Run:
         try:
             if fused is None:
                 state, grid_state = step_with_grid(state, grid, s.basis, solution.material, dt, t, force, stages,
-                                                   exact)
+                                                   exact, s.mass)
             else:
                 state, grid_state = fused.step_with_grid(state, solution.material, dt, t, force, stages)
         except InversionError as error:
