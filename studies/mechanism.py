@@ -23,8 +23,9 @@ particles per cell, subset and mesh pair: the orders over the runs and whether t
 MPM's growth into convergence on every run where it grows, :func:`mpm_fem.measure.claims.mechanism.summary_rows`),
 ``runs.csv`` (each run's steps and wall time) and ``growth.png``.
 
-Tiers: the quick tier runs the two coarsest meshes of each problem at 4 per cell on the regular layout
-and seed 1 (seconds, after the exact-stage kernels compile). The full tier runs Sod on h = 0.01 ...
+Tiers: the quick tier runs Sod on h = 0.01 and 0.005 and Burgers on its two coarsest meshes at 4 per cell,
+on the regular layout and seeds 1 and 2, every subset of :data:`CASES` (:data:`QUICK`), on the numpy step
+(:func:`run_numpy_case`: about 15 CPU-s, and no exact-stage kernel to compile). The full tier runs Sod on h = 0.01 ...
 0.00125 and Burgers on h = 0.08 ... 0.01, four meshes each, every layout, without the all-exact subset
 (:data:`FULL`). Burgers at h = 0.005 (its viscous step, dt ~ h^2, makes one run there cost as much as
 the full tier's Burgers runs together), Sod at h = 0.000625, 16 per cell (whose growth starts near
@@ -63,12 +64,14 @@ BASIS = "mpm"
 #: a stage that stage alone exact.
 CASES = ("time", "projection", "mass", "interpolation", "all")
 LAYOUTS = (("regular", 0),) + tuple(("jittered", s) for s in SEEDS)
-#: The quick tier: each problem's two coarsest meshes, 4 per cell, the regular layout and seed 1.
-QUICK = {"ppc": (4,), "h": {"sod": (0.02, 0.01), "burgers": (0.08, 0.04)}, "layouts": LAYOUTS[:2],
-         "cases": CASES[:4]}
+#: The quick tier, where the error comes from at a glance: Sod on h = 0.01 and 0.005 and Burgers on its two
+#: coarsest meshes, 4 per cell, the regular layout and seeds 1 and 2, each stage alone exact and every stage
+#: exact, on the numpy step (``kernel``: :func:`run_numpy_case`, which compiles no exact-stage variant).
+QUICK = {"ppc": (4,), "h": {"sod": (0.01, 0.005), "burgers": (0.08, 0.04)}, "layouts": LAYOUTS[:3],
+         "cases": CASES, "kernel": "numpy"}
 #: The full tier: four meshes a problem, every layout, the subsets of all MPM and each stage alone exact.
 FULL = {"ppc": (4, 8), "h": {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.08, 0.04, 0.02, 0.01)},
-        "layouts": LAYOUTS, "cases": QUICK["cases"]}
+        "layouts": LAYOUTS, "cases": CASES[:4]}
 #: The deep tier: one mesh finer a problem, 16 per cell, and the all-exact subset.
 DEEP = {"ppc": (4, 8, 16), "h": {"sod": FULL["h"]["sod"] + (0.000625,), "burgers": FULL["h"]["burgers"] + (0.005,)},
         "layouts": LAYOUTS, "cases": CASES}
@@ -81,9 +84,11 @@ def _case(problem: str, h: float, ppc: int, layout: str, seed: int, made_exact: 
 
 
 def plan(tier: str) -> dict:
-    """``{"growth": {(problem, ppc, layout, seed, h, made_exact): case}}`` of the tier (:data:`TIERS`)."""
+    """``{"growth": {(problem, ppc, layout, seed, h, made_exact): case}}`` of the tier (:data:`TIERS`); a tier
+    naming a ``kernel`` adds it to every case (:func:`task_function`)."""
     t = TIERS[tier]
-    return {"growth": {(p, n, lay, s, h, c): _case(p, h, n, lay, s, c)
+    kernel = {"kernel": t["kernel"]} if "kernel" in t else {}
+    return {"growth": {(p, n, lay, s, h, c): {**_case(p, h, n, lay, s, c), **kernel}
                        for p, meshes in t["h"].items() for n in t["ppc"] for lay, s in t["layouts"]
                        for h in meshes for c in t["cases"]}}
 
@@ -93,8 +98,11 @@ def plan(tier: str) -> dict:
 #: (their numpy grid stage). A least-squares fit, weighted by steps, to the full tier's 384 cases (2026-11-28,
 #: 8.6 CPU-min on the 2-core machine shared with other jobs); the budget's own model (``BUDGET_STEP_MS``)
 #: predates Burgers' compiled loop and overestimates its all-MPM runs sevenfold.
+#: ``numpy``: every run of a case on the numpy step (the quick tier), fitted by eye to its 40 cases of the regular
+#: layout and seed 1 (2026-12-02, 20 CPU-s, the 2-core machine at a load of 5).
 STEP_MS = {("sod", "mpm"): (0.0031, 3.9e-5), ("sod", "exact"): (0.39, 9.1e-5),
-           ("burgers", "mpm"): (0.22, 3.4e-5), ("burgers", "exact"): (0.83, 1.7e-3)}
+           ("burgers", "mpm"): (0.22, 3.4e-5), ("burgers", "exact"): (0.83, 1.7e-3),
+           ("sod", "numpy"): (0.15, 5e-5), ("burgers", "numpy"): (0.4, 0.0)}
 
 
 def cost(case: dict) -> float:
@@ -102,7 +110,8 @@ def cost(case: dict) -> float:
     the cases run at dt and dt / K."""
     problem, h = case["problem"], case["h"]
     n = setting_of(problem, case)["ppc"] / h
-    a, b = STEP_MS[(problem, "mpm" if case["made_exact"] == "time" else "exact")]
+    a, b = STEP_MS[(problem, "numpy" if case.get("kernel") == "numpy" else
+                    "mpm" if case["made_exact"] == "time" else "exact")]
     runs = 1 + K if case["made_exact"] in ("time", "all") else 1
     return runs * _steps(problem, h) * (a + b * n)
 
@@ -134,6 +143,39 @@ def run_case(case: dict) -> dict:
     return {"ok": True, "errors": errors, "runs": runs}
 
 
+def run_numpy_case(case: dict) -> dict:
+    """:func:`run_case` on the numpy step (:mod:`mpm_fem.core.step`: ``kernel="numpy"`` in every run's settings,
+    stepped by :func:`mpm_fem.run.solve.run`): the same runs, subsets and errors, the fused step's arithmetic to
+    round-off, but no compiled particle pass, so that a cold cache compiles no exact-stage variant (the quick
+    tier's cases, :data:`QUICK`)."""
+    problem, h = case["problem"], case["h"]
+    changes = {k: case[k] for k in ("ppc", "layout", "seed") if k in case}
+    exact = () if case["made_exact"] == "time" else STAGES[:3] if case["made_exact"] == "all" else (case["made_exact"],)
+    forms = {k: v for s in exact for k, v in EXACT_FORM[s].items()}
+    points, weights = norm_points(problem, _settings(problem, h, BASIS, changes))
+    refines = (1, K) if case["made_exact"] in ("time", "all") else (1,)
+    fields, runs = {}, []
+    for refine in refines:
+        settings = _settings(problem, h, BASIS, {**changes, **forms, "refine": refine, "kernel": "numpy"})
+        row, got = _run(problem, settings, points)
+        runs.append({"refine": refine, **{k: row[k] for k in ("ok", "error", "steps", "wall_s") if k in row}})
+        if not row["ok"]:
+            return {"ok": False, "runs": runs, "error": row["error"]}
+        fields[refine] = got["particles"]
+    l1 = lambda e: float(np.sum(weights * np.abs(e)))  # noqa: E731
+    at_dt = l1(fields[1])
+    extrapolated = l1((K * fields[K] - fields[1]) / (K - 1)) if K in fields else None
+    errors = {"time": {"none": at_dt, "time": extrapolated}, "all": {"all": extrapolated}}.get(
+        case["made_exact"], {case["made_exact"]: at_dt})
+    return {"ok": True, "errors": errors, "runs": runs}
+
+
+def task_function(case: dict):
+    """The case function of ``case`` (:mod:`mpm_fem.app.estimate` builds ``reproduce``'s tasks with it):
+    :func:`run_numpy_case` for a case on the numpy step, else :func:`run_case`."""
+    return run_numpy_case if case.get("kernel") == "numpy" else run_case
+
+
 def mpm_stages(made_exact: str) -> str:
     """The budget's label of the stages in MPM form of a subset named by what is exact."""
     exact = set(STAGES) if made_exact == "all" else set() if made_exact == "none" else {made_exact}
@@ -161,7 +203,8 @@ def growth_rows(got: dict) -> list[dict]:
 
 
 def run(options: StudyOptions) -> None:
-    got = options.sweep_plan(NAME, run_case, plan(options.tier), cost=cost)["growth"]
+    fn = run_numpy_case if TIERS[options.tier].get("kernel") == "numpy" else run_case
+    got = options.sweep_plan(NAME, fn, plan(options.tier), cost=cost)["growth"]
     rows = growth_rows(got)
     runs = [{"problem": p, "ppc": n, "layout": lay, "seed": s, "h": h, "case": c, **x}
             for (p, n, lay, s, h, c), r in got.items() for x in r["runs"]]

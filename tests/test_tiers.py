@@ -118,15 +118,16 @@ def test_the_estimate_counts_the_cached_cases_and_grows_with_the_tier(tmp_path):
 def test_the_quick_reproduction_leaves_out_the_plateau_studies_and_says_so(tmp_path, monkeypatch):
     """Remedies and drift ask about Sod's plateau, below the quick meshes, and the budget's exact-stage kernels
     cost a minute to compile: the quick ``reproduce`` runs none of them (``mpm-fem study NAME --quick`` still
-    does), the full and deep ones run every study."""
+    does) but the mechanism study's small stage-exact set on the numpy step; the full and deep ones run every
+    study."""
     from mpm_fem.app import report, study
 
-    assert study.reproduced("quick") == ("projection", "sod", "burgers", "identification", "time")
+    assert study.reproduced("quick") == ("projection", "sod", "burgers", "identification", "time", "mechanism")
     assert study.reproduced("full") == study.reproduced("deep") == study.STUDIES
     started = []
     monkeypatch.setattr(study, "run_study", lambda name, options: started.append(name))
     monkeypatch.setattr(report, "write_report", lambda out: out)
-    monkeypatch.setattr("mpm_fem.app.estimate.tasks", lambda name, options: [])
+    monkeypatch.setattr("mpm_fem.app.case_tasks.tasks", lambda name, options: [])
     report.reproduce(StudyOptions(quick=True, out=tmp_path, jobs=1, progress=False))
     assert started == list(study.reproduced("quick"))
     text = "\n".join(report.caveats({"versions": [{"table": "sod/convergence", "code": "x", "tier": "quick"}]}, "x"))

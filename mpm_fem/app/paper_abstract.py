@@ -37,7 +37,8 @@ def _growth_sentence(tables: Tables, found: Found) -> str:
 class StageOrders(NamedTuple):
     """The stage whose exact form alone gives the particle error the highest lowest order between successive
     meshes (``mechanism/summary``), over the mesh pairs where all MPM grows on some layout (every pair when it
-    grows on none): its lowest and highest order there, all MPM's, the pairs and those converging."""
+    grows on none): its lowest and highest order there, all MPM's, the pairs and those converging, and the
+    coarsest and the finest mesh of those pairs."""
 
     stage: str
     lo: float
@@ -47,6 +48,8 @@ class StageOrders(NamedTuple):
     pairs: int
     converging: int
     growing: bool
+    coarsest: float = math.nan
+    finest: float = math.nan
 
 
 def stage_orders(tables: Tables, problem: str) -> StageOrders | None:
@@ -65,7 +68,8 @@ def stage_orders(tables: Tables, problem: str) -> StageOrders | None:
             continue
         best = StageOrders(stage, min(lows), max(num(r, "order_max") for r in mine),
                            min(num(r, "order_min") for r in mpm), max(num(r, "order_max") for r in mpm), len(mine),
-                           sum(x >= CONVERGING_ORDER for x in lows), bool(growing))
+                           sum(x >= CONVERGING_ORDER for x in lows), bool(growing),
+                           max(num(r, "h_coarse") for r in mine), min(num(r, "h_fine") for r in mine))
     return best
 
 
@@ -80,8 +84,9 @@ def _stage_sentence(tables: Tables, found: Found) -> str:
         reading = ("a convergence on every layout" if o.converging == o.pairs else
                    f"the growth stopped but short of the converging order {CONVERGING_ORDER:g}" if o.lo > GROWTH_ORDER
                    else "a growth still on some layout")
+        meshes = f"h = {o.coarsest:g} to {o.finest:g}: " if math.isfinite(o.coarsest + o.finest) else ""
         parts.append(f"from [{o.mpm_lo:.2f}, {o.mpm_hi:.2f}] to [{o.lo:.2f}, {o.hi:.2f}] on {problem.capitalize()} "
-                     f"({reading}{'' if o.growing else '; all MPM does not grow there'})")
+                     f"({meshes}{reading}{'' if o.growing else '; all MPM does not grow there'})")
     stages = list(dict.fromkeys(o.stage for _, o in found_))
     name = _and([f"the {s} stage" for s in stages]) + (" (a particle quadrature)" if "projection" in stages else "")
     stops = all(o.lo > GROWTH_ORDER for _, o in found_ if o.growing)

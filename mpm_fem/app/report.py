@@ -347,7 +347,8 @@ def reproduce(options) -> Path:
     worker writes
     that study's tables and figures from the cache, ahead of the cases still waiting (this process
     does, with one job or a Dask scheduler: :func:`mpm_fem.app.sweep.run_tasks`)."""
-    from mpm_fem.app.estimate import describe, estimate, tasks
+    from mpm_fem.app.case_tasks import estimate, tasks
+    from mpm_fem.app.estimate import describe
     from mpm_fem.app.study import check_folder, reproduced, run_study
     from mpm_fem.app.sweep import default_jobs, run_tasks
 
