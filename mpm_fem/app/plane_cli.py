@@ -41,7 +41,7 @@ HELP = {
     "h": "cell size; must divide the domain ([0, 2] for axis, [-1.5, 1.5] for vortex)",
     "ppc": "particles per cell per axis (ppc x ppc in every cell)",
     "amplitude": "the solution's amplitude A (axis: 0 <= A pi < 1, default 1e-4; vortex: default 1, at which "
-                 "the particles invert before t = 1/2 at 2 x 2 per cell; 0.01 runs to T)",
+                 "every basis loses a particle before T (docs/method.md, 'The vortex at A = 1'); 0.01 runs to T)",
     "amplitude_y": "axis only: the y part's amplitude A_y (default A; 0 turns the y part off)",
     "basis": "the 1D basis of the tensor product: a registered name (p1 is mpm), an installed entry point's "
              "or package.module:Name; it must have a 2D form",
