@@ -185,3 +185,16 @@ def test_the_grid_mass_is_refused_for_a_body_that_does_not_fill_its_grid():
     empty = MassSystem(system.S, system.m, np.where(np.arange(grid.n_nodes) == 5, 0.0, system.m_i), lambda: None)
     with pytest.raises(ValueError, match="1 nodes have none"):
         masses.get("grid").solver(empty)
+
+
+def test_the_command_line_and_the_python_entry_take_a_registered_mass(capsys):
+    import mpm_fem
+    from mpm_fem.app.cli import main
+
+    assert main(["plane", "axis", "--h", "0.25", "--mass", "fmpm2", "--quiet"]) == 0
+    run = mpm_fem.plane.axis(h=0.25, mass="fmpm2")
+    assert run.settings.mass == "fmpm2" and run.settings.stages.mass == "consistent"
+    assert not mpm_fem.plane.axis(h=0.25, mass="fmpm2", compiled=True).compiled  # the numpy step serves it
+    with pytest.raises(mpm_fem.UsageError, match=r"^axis\(\): unknown mass 'fmpm5'; choose one of lumped, "
+                       r"consistent, exact, grid, fmpm1, fmpm2, fmpm3, fmpm4$"):
+        mpm_fem.plane.axis(h=0.25, mass="fmpm5")
