@@ -19,7 +19,7 @@ import sys
 
 from step_cost import interleaved  # benchmarks/step_cost.py, beside this script
 
-from mpm_fem import masses
+import mpm_fem.masses as masses
 from mpm_fem.plane.problems import start
 from mpm_fem.plane.run import PlaneSettings, setup
 from mpm_fem.plane.step import step_with_grid

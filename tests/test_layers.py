@@ -10,8 +10,9 @@ The layers are the folders:
    b. ``mpm_fem/bases/`` (the bases behind their contract, and their registry);
    c. ``mpm_fem/core/`` (shape, particles, transfer, the numpy step, models);
    d. ``mpm_fem/exact_stages/`` (the exact stages and their kernels; the numpy step reaches them
-      through the protocol ``core.step.ExactStages``) and ``baselines/`` (all but
-      ``baselines/exact/``), which import the core only;
+      through the protocol ``core.step.ExactStages``), ``baselines/`` (all but ``baselines/exact/``),
+      which import the core only, and ``mpm_fem/masses/`` (the grid masses behind their contract,
+      and their registry; the 2D step reads them);
    e. ``mpm_fem/fused/`` (the compiled step);
    f. ``mpm_fem/run/`` (the time loop, choosing between the numpy and the compiled step);
    g. ``mpm_fem/problems/`` (the problem set-ups, which run through the time loop);
@@ -44,6 +45,7 @@ FOLDERS = {
     "mpm_fem.core": (2, 2),
     "mpm_fem.exact_stages": (2, 3),
     "baselines": (2, 3),
+    "mpm_fem.masses": (2, 3),
     "mpm_fem.fused": (2, 4),
     "mpm_fem.run": (2, 5),
     "mpm_fem.problems": (2, 6),

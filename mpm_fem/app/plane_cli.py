@@ -26,7 +26,7 @@ import dataclasses
 import sys
 from pathlib import Path
 
-from mpm_fem import masses
+import mpm_fem.masses as masses
 from mpm_fem.app import guard, output
 from mpm_fem.app.compiling import compile_notice
 from mpm_fem.app.guard import UsageError

@@ -31,7 +31,7 @@ import numpy as np
 from skfem import Basis as SkBasis
 from skfem import ElementQuad1
 
-from mpm_fem import masses
+import mpm_fem.masses as masses
 from mpm_fem.bases import get
 from mpm_fem.bases.contract import Basis
 from mpm_fem.masses.contract import MassSystem

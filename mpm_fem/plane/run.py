@@ -28,7 +28,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from mpm_fem import masses
+import mpm_fem.masses as masses
 from mpm_fem.core.step import Stages
 from mpm_fem.plane.bases import tensor_basis
 from mpm_fem.plane.exact import ExactStages2, cell_quadrature, reference_of

@@ -37,7 +37,7 @@ from typing import Callable, NamedTuple, Protocol
 import numpy as np
 import scipy.sparse as sp
 
-from mpm_fem import masses
+import mpm_fem.masses as masses
 from mpm_fem.bases.contract import Basis
 from mpm_fem.core.step import Stages
 from mpm_fem.masses.consistent import factorised
