@@ -6,6 +6,9 @@ bases, a compressible neo-Hookean solid and the explicit USL step with its exact
     state     the particles (frozen arrays with named fields)     :mod:`~mpm_fem.plane.state`
     model     F update, J, neo-Hookean Cauchy stress              :mod:`~mpm_fem.plane.model`
     step      the numpy reference step ``step(...)``              :mod:`~mpm_fem.plane.step`
+    masses    its grid masses, read from the registry             :mod:`mpm_fem.masses`
+    mass      the grid basis's own mass matrix (Q1, Gram)         :mod:`~mpm_fem.plane.mass`
+    stability the CFL limits, at rest and stretched               :mod:`~mpm_fem.plane.stability`
     exact     the exact projection, mass, interpolation stages    :mod:`~mpm_fem.plane.exact`
     norms     the particle and nodal error norms                  :mod:`~mpm_fem.plane.norms`
     problems  seeding and the start of the step                   :mod:`~mpm_fem.plane.problems`

@@ -7,8 +7,9 @@ folded onto the axis nodes). For the P1 grid functions the same matrix is scikit
 ``BilinearForm(u v)`` assembled on the ``MeshQuad`` (:func:`q1_mass`); the 1D Gram matrices of any
 basis come from Gauss points per half cell (exact for the piecewise polynomials up to degree 3).
 The step's ``consistent`` mass is the particle mass matrix ``sum_p m_p S_ip S_jp`` (as in 1D,
-:mod:`mpm_fem.core.transfer`), which carries no mass where the body is not: this matrix is the
-fixed-mesh reference beside it.
+:mod:`mpm_fem.core.transfer`), which carries no mass where the body is not; this matrix, the
+fixed-mesh reference beside it, is the step's ``grid`` mass (:mod:`mpm_fem.masses.grid`,
+:func:`mpm_fem.plane.step.grid_basis_matrix`).
 """
 
 from __future__ import annotations
