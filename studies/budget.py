@@ -46,6 +46,14 @@ on Sod h = 0.0025 and Burgers h = 0.01, and E2's on h = 0.00125 and 0.000625 (:d
 :data:`BASES_LAYOUT_H`). The coarse budgets cost mostly per step (the numpy grid stage of the exact-
 stage runs), hardly per particle, so 4 per cell costs about 0.7x 16 per cell there
 (:data:`BUDGET_STEP_MS`).
+
+E1's control (:func:`control_case`, ``control.csv`` and ``control_runs.csv``): the same budget on a problem
+without node crossings, the neo-Hookean bar of the 1D control at amplitude 1e-4 (P1, lumped mass, FLIP,
+cfl 0.25, one period; :mod:`mpm_fem.measure.control`, :mod:`mpm_fem.run.bar_stages`), on h = 1/8, 1/16,
+1/32 at 4 and 8 per cell on the regular layout and the five jittered ones (full and deep tiers; the quick
+tier runs none). Its cases run through their own case function in a second sweep, so that the cached
+budget cases keep their key; their cost (about 1.5 CPU-min in all, measured 2026-12-02) is not in the
+study's estimate.
 """
 
 from __future__ import annotations
@@ -65,6 +73,7 @@ from mpm_fem.measure.decomposition import decompose, label, share_changes, subse
 from mpm_fem.measure.regions import REGION_NAMES, l1_by_region, plateau_velocity, sod_regions
 from mpm_fem.measure.timing import field_on
 from mpm_fem.problems import burgers, sod
+from mpm_fem.run.bar_stages import ControlSettings
 
 NAME = "budget"
 BASES = ("mpm", "gimp", "bspline", "cubic")  # E2's bases
@@ -151,6 +160,41 @@ def plan(tier: str) -> dict:
     bases_layouts = {(h, b, n, lay, s): {"kind": "bases", "h": h, "basis": b, **_layout_changes("sod", n, lay, s)}
                      for h in BASES_LAYOUT_H[tier] for b in BASES for n in LAYOUT_PPC for lay, s in LAYOUTS}
     return {"budget": budget, "bases": e2, "roundoff": roundoff, "layouts": layouts, "bases_layouts": bases_layouts}
+
+
+#: E1's control (module docstring): its meshes, particles per cell and layouts per tier, and its settings
+CONTROL_H = {"quick": (), "full": (1 / 8, 1 / 16, 1 / 32), "deep": (1 / 8, 1 / 16, 1 / 32)}
+CONTROL_PPC = (4, 8)
+CONTROL = dict(amplitude=1e-4, cfl=0.25, K=2)
+
+
+def control_plan(tier: str) -> dict:
+    """``{(h, ppc, layout, seed): case}`` of the control at ``tier``."""
+    return {(h, n, lay, s): {"kind": "control", "h": h, "ppc": n, "layout": lay, "seed": s, **CONTROL}
+            for h in CONTROL_H[tier] for n in CONTROL_PPC for lay, s in LAYOUTS}
+
+
+def control_case(case: dict) -> dict:
+    """One control run's budget (:func:`mpm_fem.measure.control.control_budget`) and its wall time."""
+    import time
+
+    from mpm_fem.measure.control import control_budget
+
+    start = time.perf_counter()
+    settings = ControlSettings(h=case["h"], ppc=case["ppc"], layout=case["layout"], seed=case["seed"],
+                               amplitude=case["amplitude"], cfl=case["cfl"])
+    return {"ok": True, **control_budget(settings, case["K"]), "wall_s": time.perf_counter() - start}
+
+
+def control_rows(got: dict) -> tuple[list[dict], list[dict]]:
+    """``control.csv`` (v(S) per run and subset, the columns of ``subsets.csv``) and ``control_runs.csv``."""
+    subsets_, runs_ = [], []
+    for (h, n, lay, s), r in got.items():
+        key = {"problem": "bar", "h": h, "basis": "mpm", "ppc": n, "layout": lay, "seed": s}
+        subsets_ += [{**key, "norm": "particles", "mpm_stages": S, "error": v} for S, v in r["subsets"].items()]
+        runs_.append({**key, **{k: r[k] for k in ("interactions", "field_interactions", "readout",
+                                                 "readout_relative", "wall_s")}})
+    return subsets_, runs_
 
 
 #: CPU milliseconds per step of a budget run, ``a + b N`` for ``N`` particles, per (problem, basis): a least-squares
@@ -297,6 +341,9 @@ def run(options: StudyOptions) -> None:
     shapley, interactions = decomposition_rows(rows)
     own = [r for r in shapley if _is_study_setting(r)]
     reference = decomposition_rows(subset_rows({k: r for k, r in got["roundoff"].items() if r["ok"] and k in study}))[0]
+    control, control_runs = control_rows(options.sweep_plan(NAME, control_case, {"control": control_plan(options.tier)},
+                                                            cost=lambda c: c["ppc"] / c["h"] ** 2)["control"])
+    settings["control"] = {"h": list(CONTROL_H[options.tier]), "ppc": list(CONTROL_PPC), **CONTROL}
     bases = {(h, b, SOD["ppc"], "regular", 0): r for (h, b), r in got["bases"].items()}
     for key, r in got["bases_layouts"].items():
         bases.setdefault(key, r)
@@ -305,7 +352,8 @@ def run(options: StudyOptions) -> None:
                      "runs": [{**_key_columns(key), **x} for key, r in every.items() for x in r["runs"]],
                      schema.BUDGET_BASES: [{"h": h, "basis": b, "ppc": n, "layout": lay, "seed": s, **r}
                                            for (h, b, n, lay, s), r in bases.items()],
-                     schema.BUDGET_ROUNDOFF: share_changes(own, reference)}, settings, figures=(BASES_PLOT,))
+                     schema.BUDGET_ROUNDOFF: share_changes(own, reference), schema.BUDGET_CONTROL: control,
+                     schema.BUDGET_CONTROL_RUNS: control_runs}, settings, figures=(BASES_PLOT,))
     for problem in sorted({r["problem"] for r in own}):
         shapley_figure(folder / f"shapley_{problem}.png", [r for r in own if r["problem"] == problem])
         finest = {b: min(h for p, h, bb in study if p == problem and bb == b) for p, _, b in study if p == problem}

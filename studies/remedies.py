@@ -42,6 +42,11 @@ run at 4, 8 and 16 per cell on the regular layout and on the Sod study's five ji
 the deep tier on three (:data:`LAYOUT_H`); ``errors.csv`` names each row's ``ppc``,
 ``layout`` and ``seed`` and takes the orders within one setting; ``orders.csv``, ``cost.csv`` and the
 figures hold the study's own setting.
+
+E5's named remedy where the growth is worst (:data:`NAMED`, :data:`NAMED_PPC`, :data:`NAMED_H`): the
+B-spline domain + XPIC(5) and plain MPM beside it at 4 and 8 per cell on the five jittered layouts, on the
+two coarsest meshes of each problem in the full tier and on every mesh of the study (Sod h = 0.01 ...
+0.000625, Burgers 0.04 ... 0.005) in the deep tier; plain MPM's full-tier runs are the layout runs above.
 """
 
 from __future__ import annotations
@@ -153,6 +158,13 @@ LAYOUT_REMEDIES = {"full": ("MPM",),
                    "deep": tuple(n for n, r in REMEDIES.items() if r.get("basis") not in ("bspline_gimp", "cubic"))}
 
 
+#: E5's named remedy on the jittered layouts (module docstring): the remedies, particles per cell and meshes per tier
+NAMED = ("B-spline domain + XPIC(5)", "MPM")
+NAMED_PPC = (4, 8)
+NAMED_H = {"quick": {}, "full": {"sod": SOD_H[:2], "burgers": BURGERS_H[:2]},
+           "deep": {"sod": SOD_H[:5], "burgers": BURGERS_H}}
+
+
 def _layout_case(problem: str, h: float, name: str, ppc: int, layout: str, seed: int, kernel: dict) -> dict:
     """The case of a remedy at a particle setting: the study's own case at its particles per cell on the regular
     layout (Burgers' names no layout then, as the study's own case)."""
@@ -183,6 +195,9 @@ def _plan(tier: str) -> dict:
                                   for ppc in (QUICK_LAYOUT["ppc"][problem] if quick else LAYOUT_PPC)
                                   for lay, s in LAYOUTS}
            for problem, hs in LAYOUT_H[tier].items()},
+        **{f"{problem}_named": {(n, h, ppc, "jittered", s): _layout_case(problem, h, n, ppc, "jittered", s, kernel)
+                                for n in NAMED for h in hs for ppc in NAMED_PPC for s in SEEDS}
+           for problem, hs in NAMED_H[tier].items()},
     }
 
 
@@ -209,7 +224,9 @@ def run(options: StudyOptions) -> None:
     folder = options.folder(NAME)
     settings = {"sod": SOD_MPM, "burgers": BURGERS, "remedies": REMEDIES, "fem": {"mass": "lumped", **FEM},
                 "fv": FV,
-                "criterion": PLATEAU_CRITERION, "quick": options.quick}
+                "criterion": PLATEAU_CRITERION, "quick": options.quick,
+                "named_layouts": {"remedies": list(NAMED), "ppc": list(NAMED_PPC), "layout": "jittered",
+                                  "seeds": list(SEEDS), "h": {p: list(hs) for p, hs in NAMED_H[options.tier].items()}}}
     rows, cost = _errors(got), _cost_rows(got)
     publish(folder, {REMEDIES_ERRORS: rows, "orders": _summary(rows), "cost": cost}, settings, figures=PLOTS)
     _cost_figure(folder, cost)
@@ -229,8 +246,9 @@ def _series(got, problem: str) -> dict:
     out = {}
     for (name, h), r in got[problem].items():
         out.setdefault((name, *_study_setting(problem)), {})[h] = r
-    for (name, h, *setting), r in got.get(f"{problem}_layouts", {}).items():
-        out.setdefault((name, *setting), {}).setdefault(h, r)
+    for group in (f"{problem}_layouts", f"{problem}_named"):
+        for (name, h, *setting), r in got.get(group, {}).items():
+            out.setdefault((name, *setting), {}).setdefault(h, r)
     return out
 
 

@@ -60,7 +60,7 @@ def _two_bases(finest_gimp: dict, norm: str = "particles") -> dict:
 def test_e1_is_confirmed_when_the_stages_separate_and_the_attributions_agree():
     verdict, evidence = judge("E1 (burgers)", _e1(_two_bases(SEPARATE_TERMS)))
     assert verdict == "confirmed"
-    assert evidence.startswith("the stages separate in 2 of 2 bases and norms at h = 0.02 (the interactions are "
+    assert evidence.startswith("the stages separate in 2 of 2 bases and runs at h = 0.02 (the interactions are "
                                "0.05x |v(all MPM) - v(all exact)|, at most 25% to separate); a dominant stage in 2 of "
                                "2: projection (mpm particles, gimp particles)")
     assert "interactions / |v(all MPM) - v(all exact)| from the coarsest mesh to the finest: mpm particles 0.05 -> " \
@@ -90,11 +90,15 @@ def test_e1_is_refuted_when_no_stage_separates_or_dominates():
     assert judge("E1 (burgers)", _e1(tangled))[0] == "refuted"
 
 
-def test_e1_sod_reads_both_norms_and_is_not_measured_without_its_table():
+def test_e1_sod_is_judged_on_the_particle_norm_and_names_the_nodal_read_out():
+    """The nodal norm (here tangled) does not enter the verdict; its all-exact error is named as the read-out's."""
     groups = {**_two_bases(SEPARATE_TERMS), **_two_bases(TANGLED_TERMS, "nodes")}
     verdict, evidence = judge("E1 (sod)", _e1(groups, "sod"))
-    assert verdict == "partly" and "the stages separate in 3 of 4" in evidence
-    assert "no stage named where the interactions exceed 1x the gap: gimp nodes" in evidence
+    assert verdict == "confirmed" and "the stages separate in 2 of 2" in evidence
+    assert "the nodal read-out is itself a particle quadrature" in evidence
+    assert "v(all exact) at the nodes regular (2 runs) 0.0002 against all MPM" in evidence
+    tangled = {**_two_bases(TANGLED_TERMS), **_two_bases(SEPARATE_TERMS, "nodes")}
+    assert judge("E1 (sod)", _e1(tangled, "sod"))[0] == "partly"
     assert judge("E1 (sod)", {})[0] == "not measured"
     incomplete = _e1(groups, "sod")["budget/subsets"][1:]  # the coarse mesh of mpm particles misses all exact
     assert "from the coarsest mesh to the finest: mpm particles 0.05, gimp" in judge(
@@ -396,5 +400,5 @@ def test_e5_states_e1s_result_and_never_contradicts_it():
     assert "the error budget's stages do not separate (E1" in found.evidence
     assert "no remedy is tied to one stage" in found.evidence and "E1" not in found.sentence
     separate = claim_named("E5").finding({**tangled, "budget/subsets": _subsets(_two_bases(SEPARATE_TERMS), "sod")})
-    assert "separate in 2 of 2 bases and norms (E1), projection dominating there" in separate.evidence
+    assert "separate in 2 of 2 bases and runs (E1), projection dominating there" in separate.evidence
     assert judge("E1 (sod)", tangled)[0] == "refuted" and found.verdict == separate.verdict

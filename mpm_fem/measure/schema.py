@@ -166,6 +166,13 @@ PARTICLE_SETTING = ("ppc", "layout", "seed")
 #: MPM form and the others exact: the raw measurements of the budget, which E1 reads.
 BUDGET_SUBSETS = Table("budget/subsets", ("problem", "h", "basis", "norm", "mpm_stages", "error"),
                        optional=PARTICLE_SETTING)
+#: E1's control (the bar, no node crossing: ``mpm_fem.measure.control``): v(S) as in ``budget/subsets``
+BUDGET_CONTROL = Table("budget/control", ("problem", "h", "basis", "norm", "mpm_stages", "error"),
+                       optional=PARTICLE_SETTING)
+#: one row per control run: the interactions of v and of the fields over the gap, the nodal read-out's own error
+BUDGET_CONTROL_RUNS = Table("budget/control_runs", (
+    "problem", "h", "basis", "ppc", "layout", "seed", "interactions", "field_interactions", "readout",
+    "readout_relative", "wall_s"))
 BUDGET_SHAPLEY = Table("budget/shapley", (
     "problem", "h", "basis", "norm", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error"),
     optional=PARTICLE_SETTING)
@@ -242,7 +249,7 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     SOD_CONVERGENCE, SOD_SEEDS, SOD_REGIONS, SOD_EXTREMA, SOD_PPC, SOD_MASS,
     BURGERS_ORDERS, BURGERS_SEEDS, BURGERS_PPC, BURGERS_LUMPING, BURGERS_DIAGNOSIS,
     TIME_ORDER, TIME_LOCAL_ERROR, TIME_CROSSING_SUMMARY,
-    BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES,
+    BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES, BUDGET_CONTROL, BUDGET_CONTROL_RUNS,
     REMEDIES_ERRORS,
     DRIFT,
     IDENTIFICATION_SOD, IDENTIFICATION_BURGERS,
