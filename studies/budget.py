@@ -47,6 +47,9 @@ on Sod h = 0.0025 and Burgers h = 0.01, and E2's on h = 0.00125 and 0.000625 (:d
 stage runs), hardly per particle, so 4 per cell costs about 0.7x 16 per cell there
 (:data:`BUDGET_STEP_MS`).
 
+``readout.csv``: the nodal read-out's own error on Sod (:mod:`mpm_fem.measure.readout`: the exact density
+at the exact particle positions, read out as the study reads the nodes) beside v(all exact) of the nodal norm.
+
 E1's control (:func:`control_case`, ``control.csv`` and ``control_runs.csv``): the same budget on a problem
 without node crossings, the neo-Hookean bar of the 1D control at amplitude 1e-4 (P1, lumped mass, FLIP,
 cfl 0.25, one period; :mod:`mpm_fem.measure.control`, :mod:`mpm_fem.run.bar_stages`), on h = 1/8, 1/16,
@@ -197,6 +200,24 @@ def control_rows(got: dict) -> tuple[list[dict], list[dict]]:
     return subsets_, runs_
 
 
+def readout_rows(got: dict) -> list[dict]:
+    """``readout.csv``: per Sod budget of P1 (every particle setting), the nodal read-out's own error
+    (:func:`mpm_fem.measure.readout.sod_readout`: exact density, exact particle positions) beside v(all exact)
+    and v(all MPM) of the nodal norm; a few CPU-s in all, computed here, not cached."""
+    from mpm_fem.measure.readout import sod_readout
+
+    rows = []
+    for (p, h, b, *setting), r in ((k if len(k) == 6 else _full_key(k), r) for k, r in got.items()):
+        if p != "sod" or b != "mpm" or "nodes" not in r["subsets"]:
+            continue
+        n, lay, seed = setting
+        v = r["subsets"]["nodes"]
+        rows.append({"problem": p, "h": h, "basis": b, "ppc": n, "layout": lay, "seed": seed,
+                     "readout_L1": sod_readout(h, n, lay, seed, b), "all_exact_L1": v["none"],
+                     "all_mpm_L1": v[label(STAGES)]})
+    return rows
+
+
 #: CPU milliseconds per step of a budget run, ``a + b N`` for ``N`` particles, per (problem, basis): a least-squares
 #: fit to the full tier's runs (``runs.csv`` of 2026-11-26, 2-core machine); the ``a`` of Sod is the numpy grid stage
 #: of the exact-stage runs, of Burgers the numpy step
@@ -341,6 +362,7 @@ def run(options: StudyOptions) -> None:
     shapley, interactions = decomposition_rows(rows)
     own = [r for r in shapley if _is_study_setting(r)]
     reference = decomposition_rows(subset_rows({k: r for k, r in got["roundoff"].items() if r["ok"] and k in study}))[0]
+    readout = readout_rows(ok)
     control, control_runs = control_rows(options.sweep_plan(NAME, control_case, {"control": control_plan(options.tier)},
                                                             cost=lambda c: c["ppc"] / c["h"] ** 2)["control"])
     settings["control"] = {"h": list(CONTROL_H[options.tier]), "ppc": list(CONTROL_PPC), **CONTROL}
@@ -353,7 +375,8 @@ def run(options: StudyOptions) -> None:
                      schema.BUDGET_BASES: [{"h": h, "basis": b, "ppc": n, "layout": lay, "seed": s, **r}
                                            for (h, b, n, lay, s), r in bases.items()],
                      schema.BUDGET_ROUNDOFF: share_changes(own, reference), schema.BUDGET_CONTROL: control,
-                     schema.BUDGET_CONTROL_RUNS: control_runs}, settings, figures=(BASES_PLOT,))
+                     schema.BUDGET_CONTROL_RUNS: control_runs, schema.BUDGET_READOUT: readout}, settings,
+            figures=(BASES_PLOT,))
     for problem in sorted({r["problem"] for r in own}):
         shapley_figure(folder / f"shapley_{problem}.png", [r for r in own if r["problem"] == problem])
         finest = {b: min(h for p, h, bb in study if p == problem and bb == b) for p, _, b in study if p == problem}

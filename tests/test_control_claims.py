@@ -114,3 +114,12 @@ def test_e5_jittered_is_not_measured_without_jittered_runs_of_the_named_remedy()
     tables["remedies/errors"] = [r for r in tables["remedies/errors"]
                                  if not (r["remedy"] == NAMED and r.get("layout") == "jittered")]
     assert judge("E5 (jittered)", tables)[0] == "not measured"
+
+
+def test_e1_sod_names_the_read_out_of_the_exact_density_on_the_jittered_layouts():
+    rows = [{"problem": "sod", "h": "0.005", "basis": "mpm", "ppc": "4", "layout": "jittered", "seed": str(s),
+             "readout_L1": repr(0.036 + 0.001 * s), "all_exact_L1": "0.037", "all_mpm_L1": "0.026"} for s in (1, 2)]
+    evidence = judge("E1 (sod)", {**TABLES, "budget/readout": rows})[1]
+    assert ("the read-out alone (the exact density at the exact particle positions, `budget/readout.csv`) errs by "
+            "0.037..0.038 on the 2 jittered runs, 1.00..1.03x their v(all exact)") in evidence
+    assert "budget/readout" not in judge("E1 (sod)", TABLES)[1]

@@ -173,6 +173,9 @@ BUDGET_CONTROL = Table("budget/control", ("problem", "h", "basis", "norm", "mpm_
 BUDGET_CONTROL_RUNS = Table("budget/control_runs", (
     "problem", "h", "basis", "ppc", "layout", "seed", "interactions", "field_interactions", "readout",
     "readout_relative", "wall_s"))
+#: per Sod budget of P1: the nodal read-out's own error (exact density, exact positions) beside v(all exact), v(all MPM)
+BUDGET_READOUT = Table("budget/readout", ("problem", "h", "basis", "ppc", "layout", "seed", "readout_L1",
+                                          "all_exact_L1", "all_mpm_L1"))
 BUDGET_SHAPLEY = Table("budget/shapley", (
     "problem", "h", "basis", "norm", "stage", "shapley", "share", "removed", "alone", "mpm_error", "exact_error"),
     optional=PARTICLE_SETTING)
@@ -250,6 +253,7 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     BURGERS_ORDERS, BURGERS_SEEDS, BURGERS_PPC, BURGERS_LUMPING, BURGERS_DIAGNOSIS,
     TIME_ORDER, TIME_LOCAL_ERROR, TIME_CROSSING_SUMMARY,
     BUDGET_SUBSETS, BUDGET_SHAPLEY, BUDGET_ROUNDOFF, BUDGET_BASES, BUDGET_CONTROL, BUDGET_CONTROL_RUNS,
+    BUDGET_READOUT,
     REMEDIES_ERRORS,
     DRIFT,
     IDENTIFICATION_SOD, IDENTIFICATION_BURGERS,

@@ -10,7 +10,7 @@ from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Cri
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, failures, num, select, span, successive_orders
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.claims.stages import STEP_ORDER, SUBSETS, decomposition, run_label, runs, values
-from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_CONTROL, BUDGET_CONTROL_RUNS, BUDGET_ROUNDOFF
+from mpm_fem.measure.schema import BUDGET_BASES, BUDGET_CONTROL, BUDGET_CONTROL_RUNS, BUDGET_READOUT, BUDGET_ROUNDOFF
 from mpm_fem.measure.spread import Spread, spread
 
 #: E1 (a): the stages separate when their interactions (the Moebius terms of two stages or more), in
@@ -162,16 +162,21 @@ def _e1(problem: str) -> Criterion:
                        "interactions / gap": f"{series[-1][1]['interactions']:.2g}",
                        "separate": str(series[-1][1]["separate"]), "dominant": series[-1][1]["dominant"] or "none"}
                       for (basis, norm, run), series in r["found"].items())
-        evidence = (_e1_text(r["found"]) + _readout_text(select(t[SUBSETS], problem=problem))
+        evidence = (_e1_text(r["found"]) + _readout_text(select(t[SUBSETS], problem=problem),
+                                                         select(t.get(READOUT) or [], problem=problem))
                     + _roundoff_text(t, problem) + control_clause(t))
         return Finding(r["verdict"], evidence, e1_sentence(problem, r), table, key=e1_key(problem, r))
     return criterion
 
 
-def _readout_text(rows: list[dict]) -> str:
+READOUT = BUDGET_READOUT.name
+
+
+def _readout_text(rows: list[dict], readout: list[dict] = ()) -> str:
     """The nodal read-out's own error (informative: E1 is judged on :data:`JUDGED_NORM`): at the finest mesh
     of each run with a nodal norm, v(all exact) of the nodes against v(all MPM) and the nodal gap; jittered
-    runs and regular ones apart. Empty without a nodal norm."""
+    runs and regular ones apart; and, from ``budget/readout`` where given, the read-out of the exact density
+    at the exact particle positions on the jittered layouts. Empty without a nodal norm."""
     found = {k: series[-1] for k, series in budget_findings(rows).items() if k[1] != JUDGED_NORM}
     if not found:
         return ""
@@ -182,6 +187,12 @@ def _readout_text(rows: list[dict]) -> str:
             parts.append(f"{kind} ({len(at)} run{'s' if len(at) > 1 else ''}) {span([f['exact'] for f in at], '.3g')}"
                          f" against all MPM {span([f['mpm'] for f in at], '.3g')}, a nodal gap of "
                          f"{span([abs(f['mpm'] - f['exact']) for f in at], '.2g')}")
+    jittered = [r for r in readout if r.get("layout") == "jittered"]
+    if jittered:
+        ratio = [num(r, "readout_L1") / num(r, "all_exact_L1") for r in jittered]
+        parts.append(f"the read-out alone (the exact density at the exact particle positions, `{READOUT}.csv`) errs by "
+                     f"{span([num(r, 'readout_L1') for r in jittered], '.3g')} on the {len(jittered)} jittered runs, "
+                     f"{span(ratio, '.2f')}x their v(all exact)")
     return ("; the nodal read-out is itself a particle quadrature, so with every stage exact the nodal error is "
             "not zero (E1 is judged on the particle norm): v(all exact) at the nodes " + "; ".join(parts))
 
