@@ -2,7 +2,8 @@
 
 A sweep's task belongs to a kernel group (:func:`mpm_fem.app.sweep.kernel_group`: its function and the
 case keys that choose its kernels). For each group of the studies' plans this script runs the group's
-cheapest case in a fresh process; all of them share one numba cache, empty at the start, so a variant
+cheapest case of each kind (:func:`signature`: the mechanism study's stages made exact run different
+kernels within one group) in a fresh process; all of them share one numba cache, empty at the start, so a variant
 is compiled once, in the first group that meets it, and loaded from the cache by the later ones. In
 each process it times numba's compiles (the ``"numba:compile"`` event, each function's own time, its
 callees' compiles subtracted: CPU seconds, ``time.process_time``) and, after the case, lists the
@@ -45,10 +46,18 @@ def group_key(task) -> str:
     return "|".join(kernel_group(task))
 
 
+def signature(case: dict) -> tuple:
+    """What of ``case`` can choose its kernels beyond its kernel group: its string-valued settings (a stage made
+    exact, a layout, a quantity), not its numbers (meshes, seeds, particle counts)."""
+    return tuple(sorted((k, v) for k, v in case.items() if isinstance(v, str)))
+
+
 def groups(tier: str, studies, method: bool) -> dict[str, dict]:
-    """``{group key: {"module", "fn", "case"}}``: per group, its cheapest case (by the studies' cost
-    models; the first case of a group of the method study, which states none per case)."""
-    from mpm_fem.app.estimate import tasks
+    """``{group key: {"module", "fn", "cases"}}``: per group, its cheapest case of each :func:`signature` (by the
+    studies' cost models; the first case of a group of the method study, which states none per case), so that
+    every variant the group's cases run through is met; each case with the function ``reproduce`` runs it with
+    (:mod:`mpm_fem.app.case_tasks`)."""
+    from mpm_fem.app.case_tasks import tasks
     from mpm_fem.app.study import StudyOptions, reproduced
     from mpm_fem.app.sweep import Task
 
@@ -59,12 +68,14 @@ def groups(tier: str, studies, method: bool) -> dict[str, dict]:
     if method:
         study = importlib.import_module("studies.method")
         priced += [(float("inf"), Task(study.run_case, c)) for c in study.plan("mpm", None, tier)]
-    cheapest = {}
+    cheapest: dict[str, dict] = {}
     for seconds, task in priced:
-        key = group_key(task)
-        if key not in cheapest or seconds < cheapest[key][0]:
-            cheapest[key] = (seconds, task)
-    return {k: {"module": t.fn.__module__, "fn": t.fn.__qualname__, "case": t.case} for k, (_, t) in cheapest.items()}
+        mine = cheapest.setdefault(group_key(task), {})
+        kind = signature(task.case)
+        if kind not in mine or seconds < mine[kind][0]:
+            mine[kind] = (seconds, task)
+    return {k: {"module": next(iter(v.values()))[1].fn.__module__, "fn": next(iter(v.values()))[1].fn.__qualname__,
+                "cases": [t.case for _, t in sorted(v.values(), key=lambda st: st[0])]} for k, v in cheapest.items()}
 
 
 class _Timer(event.Listener):
@@ -105,13 +116,14 @@ def variant_name(dispatcher) -> str | None:
 
 
 def child(spec: dict) -> dict:
-    """Run one case (in a fresh process): ``{"seconds": {variant: compile CPU s}, "used": [variants]}``."""
+    """Run a group's cases (in a fresh process): ``{"seconds": {variant: compile CPU s}, "used": [variants]}``."""
     from numba.core.registry import CPUDispatcher
 
     timer = _Timer()
     fn = getattr(importlib.import_module(spec["module"]), spec["fn"])
     with event.install_listener("numba:compile", timer):
-        fn(spec["case"])
+        for case in spec["cases"]:
+            fn(case)
     used = sorted({name for obj in gc.get_objects() if isinstance(obj, CPUDispatcher) and obj.overloads
                    for name in [variant_name(obj)] if name is not None})
     return {"seconds": {k: round(v, 2) for k, v in timer.seconds.items()}, "used": used}
