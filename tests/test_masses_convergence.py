@@ -1,4 +1,5 @@
-"""Every grid mass in the 2D run (slow, about 90 s): the axis-aligned solution at A = 1e-4 (every particle
+"""Every grid mass in the 2D run (slow: about 3 min on two quiet cores, the exact mass 90 s of it; 18 min
+under a load average of 13): the axis-aligned solution at A = 1e-4 (every particle
 in its cell), 2 x 2 particles per cell, CFL 0.25, the point-mass basis, h = 1/8, 1/16, 1/32: the particle
 displacement L2 at T converges at order 2 (each mesh pair's order in [1.8, 2.2]); FMPM(k) approaches the
 consistent mass's error as k grows (measured on 2026-12-02: FMPM(2) 8.6 %, FMPM(3) 0.24 %, FMPM(4)
