@@ -12,7 +12,7 @@ from mpm_fem.app.study import STUDIES, TIER_FOLDERS, StudyOptions, study_options
 
 PLANS = {"sod": "_plan", "burgers": "_plan", "budget": "plan", "remedies": "_plan", "time": "plan", "drift": "_plan",
          "defect": "plan",
-         "mechanism": "plan"}
+         "mechanism": "plan", "plane": "plan"}
 
 
 def _cases(plan: dict) -> set:

@@ -59,6 +59,7 @@ from mpm_fem.measure.claims.remedies import (
     remedy_assessment, remedy_budget)
 from mpm_fem.measure.claims.mechanism import MECHANISM_MESHES, growth_cases, summary_rows
 from mpm_fem.measure.claims.model import model_rows, ppc_needed
+from mpm_fem.measure.claims import plane  # noqa: F401,E402  (registers D1-D7)
 # isort: on
 
 __all__ = [

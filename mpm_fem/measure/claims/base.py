@@ -55,6 +55,18 @@ STATEMENTS = {
            "the growth into convergence on every particle layout",
     "E6": "the local defect, accumulated, predicts the particle error: a closed-form model fitted on coarse meshes "
           "predicts the finer meshes and other particle counts within a factor 2, with the measured trend",
+    "D1": "2D: point-mass MPM's particle error grows under refinement, and the smooth B-splines remove the growth "
+          "(the 1D finding)",
+    "D2": "2D: the growth comes from one stage: made exact alone, it turns the growth into convergence on every "
+          "layout (the 1D E6a)",
+    "D3": "2D: error budget on the two coarsest meshes: the stages separate, beside the small-amplitude control "
+          "(the 1D E1)",
+    "D4": "2D: the lumped mass compensates: the consistent mass raises MPM's error (the 1D C15 finding)",
+    "D5": "2D: an approximate full mass inverse, FMPM(k) with k <= 4, recovers the consistent mass's accuracy",
+    "D6": "2D: on the same mesh MPM's error stays within a constant factor of the Q1 FEM's, with either mass "
+          "(the 1D E3)",
+    "D7": "2D: time against space on one mesh: with large steps the time error dominates at second order, with "
+          "the study's step refining dt changes nothing (Steffen, Kirby & Berzins 2010; the 1D C1)",
 }
 
 

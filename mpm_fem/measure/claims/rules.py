@@ -205,6 +205,32 @@ _add("MODEL_MIN_CHECKED", 3,
      _STUDY + ": a trend needs two meshes and a factor more than one row", ("E6",))
 
 
+# ----------------------------------------------------------------------------- the plane (2D)
+_add("PLANE_MIN_RUNS", 6,
+     "D1: the runs (the regular layout and five jittered seeds) a 2D series needs on every mesh before its "
+     "behaviour under refinement is judged",
+     _STUDY + ": the regular layout and the five jittered seeds of the 1D studies (MIN_RUNS)", ("D1",))
+_add("PLANE_MIN_MESHES", 3,
+     "D1, D2, D6: the meshes a 2D series needs: two successive orders, so that a growth is seen over the last "
+     "refinement with one before it",
+     _STUDY + ": the full tier's 4x4 and stage-exact series stop at h = 1/32 (three meshes from h = 1/8)",
+     ("D1", "D2", "D6"))
+_add("FMPM_RECOVERS", 0.1,
+     "D5: FMPM(k) recovers the consistent mass's accuracy on a mesh when its particle error is within this "
+     "fraction of the consistent mass's",
+     _STUDY + ": the question is whether the approximate inverse 'recovers' the consistent mass's accuracy; "
+     "10 % is well inside the factors between the masses", ("D5",))
+_add("TIME_ORDER_2D", 2.0,
+     "D7: the order in dt of the 2D step's time error (central differences, the velocity at half steps, "
+     "started at t = -dt/2), counted within ORDER_TOLERANCE",
+     "Steffen, Kirby & Berzins (IJNME 82 (2010) 1207): with large time steps the time error dominates and "
+     "converges at second order", ("D7",))
+_add("TIME_NEGLIGIBLE", 0.1,
+     "D7: at the study's time step refining dt changes nothing when the error moves by at most this fraction "
+     "from the study's step to the finest",
+     _STUDY + ": Steffen, Kirby & Berzins say that with small steps refining the step changes nothing; a tenth "
+     "of the error", ("D7",))
+
 # ----------------------------------------------------------------------------- identification
 
 _add("IDENTIFICATION_BAND", 0.05,
