@@ -198,3 +198,23 @@ def test_the_command_line_and_the_python_entry_take_a_registered_mass(capsys):
     with pytest.raises(mpm_fem.UsageError, match=r"^axis\(\): unknown mass 'fmpm5'; choose one of lumped, "
                        r"consistent, exact, grid, fmpm1, fmpm2, fmpm3, fmpm4$"):
         mpm_fem.plane.axis(h=0.25, mass="fmpm5")
+
+
+def test_the_cfl_limit_of_each_mass_falls_from_the_lumped_one_toward_the_consistent_one_with_the_order():
+    """The linearised step's limit 2 c / (h omega_max), P1, 2 x 2 regular, h = 1/8, in units of c / c_p
+    (measured 2026-12-02): lumped 1 = FMPM(1), FMPM(2) 0.756, (3) 0.658, (4) 0.605, consistent 0.441;
+    the grid (Q1) mass 1/sqrt(3). FMPM(k)'s step is less stable as k grows (Nairn 2026)."""
+    from mpm_fem.plane.run import PlaneSettings, setup
+    from mpm_fem.plane.stability import linearised_cfl, p_wave_ratio
+
+    solution, grid, (X, V, L), _ = setup(PlaneSettings(h=1 / 8, ppc=2))
+    unit = p_wave_ratio(solution.material)
+    limit = {m: linearised_cfl(grid, "mpm", m, solution.material, X, V, L) / unit
+             for m in ("lumped", "fmpm1", "fmpm2", "fmpm3", "fmpm4", "consistent", "grid")}
+    assert abs(limit["lumped"] - 1) < 1e-9 and abs(limit["fmpm1"] - 1) < 1e-9, limit
+    orders = [limit[f"fmpm{k}"] for k in (1, 2, 3, 4)]
+    assert all(a > b for a, b in zip(orders, orders[1:], strict=False)) and orders[-1] > limit["consistent"], limit
+    assert abs(limit["fmpm2"] - 0.756) < 0.005 and abs(limit["consistent"] - 0.441) < 0.005, limit
+    assert abs(limit["grid"] - 1 / np.sqrt(3)) < 1e-3, limit
+    with pytest.raises(ValueError, match="the exact mass stage has no linearised step"):
+        linearised_cfl(grid, "mpm", "exact", solution.material, X, V, L)

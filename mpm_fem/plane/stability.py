@@ -37,6 +37,8 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.sparse as sp
 
+import mpm_fem.masses as masses
+from mpm_fem.masses.contract import MassSystem
 from mpm_fem.plane.bases import plane_shape
 
 #: the lumped-mass CFL limit in units of ``c / c_p`` by basis (:func:`linearised_cfl`, 2 x 2 regular, h = 1/8)
@@ -60,7 +62,11 @@ def linearised_cfl(grid, basis: str, mass: str, material, X: np.ndarray, volume:
                    lengths: np.ndarray) -> float:
     """``2 c / (h omega_max)`` of the linearised step at the reference particles ``X`` (n_p, 2) with
     volumes (n_p,) and lengths (n_p, 2) on ``grid`` (module docstring); a dense eigenproblem of
-    ``2 n_nodes`` unknowns: small grids only."""
+    ``2 n_nodes`` unknowns: small grids only. ``mass`` is a grid mass of :mod:`mpm_fem.masses`: the
+    lumped and consistent masses as the generalised problem ``K u = omega^2 M u``, every other
+    (``grid``, ``fmpm<k>``) through its solver, ``omega^2`` the largest eigenvalue of ``A K`` with ``A``
+    its (symmetric, positive) inverse applied to the identity; the exact mass stage is no linear
+    operator and is refused."""
     shape = plane_shape(grid, basis, X, lengths)
     n_p, k = shape.nodes.shape
     rows = np.repeat(np.arange(n_p), k)
@@ -72,12 +78,31 @@ def linearised_cfl(grid, basis: str, mass: str, material, X: np.ndarray, volume:
     K = sp.bmat([[(lam + 2 * mu) * xx + mu * yy, lam * xy + mu * yx],
                  [lam * yx + mu * xy, (lam + 2 * mu) * yy + mu * xx]]).toarray()
     S = shape.matrix()
+    if mass not in ("lumped", "consistent"):
+        return _solver_cfl(grid, basis, mass, material, shape, volume, K)
     M = (S.T @ sp.diags(material.rho0 * volume) @ S).toarray()
     if mass == "lumped":
         M = np.diag(M.sum(axis=1))
     M = sl.block_diag(M, M)
     keep = np.diag(M) > 0
     omega2 = sl.eigh(K[np.ix_(keep, keep)], M[np.ix_(keep, keep)], eigvals_only=True)[-1]
+    return 2.0 * material.c / (math.sqrt(omega2) * min(grid.h))
+
+
+def _solver_cfl(grid, basis: str, mass: str, material, shape, volume: np.ndarray, K: np.ndarray) -> float:
+    """:func:`linearised_cfl` of a grid mass given by its solver (its docstring)."""
+    from mpm_fem.plane.step import _grid_solver
+
+    grid_mass = masses.get(mass)
+    if grid_mass.stage == "exact":
+        raise ValueError("the exact mass stage has no linearised step (it reads the exact solution)")
+    m = material.rho0 * volume
+    m_i = shape.scatter(m)
+    solve = grid_mass.solver(MassSystem(shape.matrix(), m, m_i, _grid_solver(grid, basis, material.rho0)))
+    inverse = solve(np.eye(grid.n_nodes))
+    keep = np.tile(m_i > 0, 2)
+    A = sl.block_diag(inverse, inverse)[np.ix_(keep, keep)]
+    omega2 = float(np.max(np.linalg.eigvals(A @ K[np.ix_(keep, keep)]).real))
     return 2.0 * material.c / (math.sqrt(omega2) * min(grid.h))
 
 
