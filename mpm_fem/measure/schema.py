@@ -203,14 +203,29 @@ DRIFT = Table("drift/drift", (
 
 # ----------------------------------------------------------------------------- identification
 
-#: One row per candidate setting (held fixed over the whole source table) and source row: the misfit
-#: (mean |log(measured/source)|) against the corrected and the raw table, over ``meshes`` (and for
-#: Burgers the five eps), the ``rank`` within the source row and ``matching`` (within the band).
-_IDENTIFIED = ("source_row", "misfit", "misfit_raw", "meshes", "rank", "matching")
-IDENTIFICATION_SOD = Table("identification/sod", ("problem", "candidate", "ppc", "cfl", "quantity", "norm",
-                                                  *_IDENTIFIED))
-IDENTIFICATION_BURGERS = Table("identification/burgers", ("problem", "candidate", "solution", "dt_rule", "cfl", "ppc",
-                                                          "norm", *_IDENTIFIED))
+#: One row per candidate (one setting held fixed over the source's table, its continuous settings fitted
+#: by a bracketed search, :mod:`mpm_fem.measure.search`) and source row: ``readout`` (particles or
+#: nodes), the fitted time-step constant ``cfl``, ``misfit`` on the fitted part of the table
+#: (mean |log(measured/source)|, for Burgers plus the spread over eps), ``misfit_held_out`` on the rest,
+#: ``misfit_raw`` against the table as printed, the ``rank`` and ``matching`` (within the band). Sod
+#: fits the L1 column and holds out L2; Burgers' ``fit`` is ``table`` (one candidate for both rows, ranked
+#: by ``table_misfit``, the held-out part some eps) or ``eps`` (the per-eps diagnostic: the best setting
+#: for one row at one ``eps``).
+_IDENTIFIED = ("source_row", "misfit", "misfit_held_out", "misfit_raw", "meshes", "rank", "matching")
+IDENTIFICATION_SOD = Table("identification/sod", ("problem", "candidate", "ppc", "cfl", "readout", "norm",
+                                                  "held_out", *_IDENTIFIED))
+IDENTIFICATION_BURGERS = Table("identification/burgers", (
+    "problem", "fit", "candidate", "solution", "params", "dt_rule", "cfl", "ppc", "readout", "norm", "eps",
+    "table_misfit", "held_out", *_IDENTIFIED))
+#: The refinement test: per problem, the best candidate's search at the stated tolerances and with them
+#: halved (restarted from the converged point), its best misfit and the change.
+IDENTIFICATION_REFINEMENT = Table("identification/refinement", (
+    "problem", "candidate", "tolerance", "cfl_xtol", "param_xtol", "misfit", "change", "evaluations"))
+#: The identified settings rerun: per problem, source row, layout and seed (0 the regular layout), eps (Burgers)
+#: and mesh, the error at the identified setting beside the source's.
+IDENTIFICATION_IDENTIFIED = Table("identification/identified", (
+    "problem", "source_row", "setting", "readout", "norm", "layout", "seed", "eps", "h", "error", "source",
+    "ratio"))
 
 #: One row per problem, basis, run, subset and pair of successive meshes: v(S) on both and the order.
 MECHANISM_GROWTH = Table("mechanism/growth", (
@@ -256,7 +271,7 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     BUDGET_READOUT,
     REMEDIES_ERRORS,
     DRIFT,
-    IDENTIFICATION_SOD, IDENTIFICATION_BURGERS,
+    IDENTIFICATION_SOD, IDENTIFICATION_BURGERS, IDENTIFICATION_REFINEMENT, IDENTIFICATION_IDENTIFIED,
     MECHANISM_GROWTH, MECHANISM_SUMMARY, DEFECT, MODEL, MODEL_FIT)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}

@@ -7,6 +7,7 @@ import math
 
 from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, Finding, Tables, claim, short
 from mpm_fem.measure.claims.identification import source_matching
+from mpm_fem.measure.claims.identified import IDENTIFIED, burgers_orders
 from mpm_fem.measure.claims.mass import MASS_RULE, mass_finding
 from mpm_fem.measure.claims.rows import FIRST_ORDER, FLOOR_ORDER, GROWTH_ORDER, num, saturation, select, span
 from mpm_fem.measure.claims.shared import LUMPING_RULE, PPC_RULE, SATURATION, ppc_claim
@@ -32,7 +33,10 @@ _C13_RULE = (f"the least-squares order of the velocity error over {BURGERS_SHOWN
              "calculated-acceleration row and of the exact row): both first order -> confirmed, both below -> "
              "differs, otherwise partly; without the identification table at the study's settings "
              f"({BURGERS_SHOWN['solution']}, {BURGERS_SHOWN['norm']} norm, {OPTIMAL_PPC[0]} and {OPTIMAL_PPC[1]} "
-             "per cell), said so; every solution shown beside")
+             "per cell), said so; every solution shown beside. Where the identification reran its identified "
+             "setting (identification/identified: the one solution with its fitted parameters for both rows), the "
+             "orders of those runs (the regular layout at every eps, the jittered ones at the largest) are judged "
+             "instead, by the same rule")
 
 
 def _finite(values) -> list[float]:
@@ -144,6 +148,9 @@ def _c13(t: Tables) -> Finding:
     clause reads the diagnosis table (when the study wrote one): each change to the calculated-acceleration
     run, one at a time on the regular layout, by whether its particles' error grows, stalls or falls as h
     shrinks; it names no cause beyond what these changes show."""
+    identified = [r for r in t.get(IDENTIFIED, []) if r.get("problem") == "burgers"]
+    if identified:
+        return _c13_identified(identified, t.get(BURGERS_DIAGNOSIS.name))
     judged, whence = _judged_settings(t)
     found = [(s, *_setting_order(t, s)) for s in judged]
     unmeasured = [f"{s['row']} row ({s['solution']}, {label}, {s['norm']})" for s, o, label in found
@@ -177,6 +184,32 @@ def _c13(t: Tables) -> Finding:
                 f"{exact_order['mean']:.2f} with the exact")
     return Finding(verdict, "; ".join(lines + ([diagnosis_text(diagnosis)] if diagnosis else [])), sentence,
                    _solutions_table(t, judged), key=key)
+
+
+def _c13_identified(rows: list[dict], diagnosis: list[dict] | None) -> Finding:
+    """C13 at the identified Burgers setting: each row's orders over its runs, both rows first order ->
+    confirmed, both below -> differs, else partly (the rule of the claim)."""
+    orders = {row: burgers_orders(rows, row) for row in ("exact", "calculated")}
+    if any(len(v) < 2 for v in orders.values()):
+        return Finding(NOT_MEASURED, "identification/identified: fewer than two runs of a row with two meshes")
+    found = {row: {"mean": sum(v) / len(v), "lo": min(v), "hi": max(v), "side": side(min(v), max(v), FIRST_ORDER),
+                   "runs": str(len(v))} for row, v in orders.items()}
+    verdict = _pair_verdict(found["exact"]["side"], found["calculated"]["side"])
+    first = rows[0]
+    setting = f"{first['setting']} ({first['norm']} norm over {first['readout']})"
+    evidence = (f"judged at the identified setting {setting}: " + "; ".join(
+        f"{row} row {_interval(o, True)}" for row, o in found.items()))
+    e, c = found["exact"], found["calculated"]
+    sentence = (f"on Burgers at the identified solution the velocity error's order in h is {c['mean']:.2f} "
+                f"({c['lo']:.2f} to {c['hi']:.2f}) with the calculated acceleration and {e['mean']:.2f} "
+                f"({e['lo']:.2f} to {e['hi']:.2f}) with the exact one")
+    key = short(f"Burgers' velocity order at the identified solution: {c['mean']:.2f} ({c['lo']:.2f} to "
+                f"{c['hi']:.2f}) calculated acceleration, {e['mean']:.2f} exact",
+                f"Burgers' velocity order: {c['mean']:.2f} calculated, {e['mean']:.2f} exact")
+    table = tuple({"row": row, "orders": _interval(o), "runs": o["runs"], "reading": _reading(o)}
+                  for row, o in found.items())
+    return Finding(verdict, evidence + (f"; {diagnosis_text(diagnosis)}" if diagnosis else ""), sentence, table,
+                   key=key)
 
 
 def _behaviour(orders: list[float]) -> str:

@@ -35,7 +35,8 @@ SOURCE_H = {"sod": tuple(SOD), "burgers": BURGERS_H}
 #: The identification tables, by problem.
 IDENTIFICATION = {"sod": "identification/sod", "burgers": "identification/burgers"}
 #: The settings columns of each problem's table, in the order a candidate's label names them.
-SETTINGS = {"sod": ("ppc", "cfl", "quantity", "norm"), "burgers": ("solution", "dt_rule", "cfl", "ppc", "norm")}
+SETTINGS = {"sod": ("ppc", "cfl", "readout", "norm"),
+            "burgers": ("solution", "params", "dt_rule", "cfl", "ppc", "readout", "norm")}
 #: The source rows of each problem's table, and how a sentence names them.
 SOURCE_ROWS = {"sod": {"L1": "L1 column", "L2": "L2 column"},
                "burgers": {"exact": "exact-acceleration row", "calculated": "calculated-acceleration row"}}
@@ -52,6 +53,22 @@ def misfit(measured: Sequence[float], source: Sequence[float]) -> float:
     if any(m is None or not math.isfinite(m) or m <= 0 for m in measured):
         return math.inf
     return sum(abs(math.log(m / s)) for m, s in zip(measured, source, strict=True)) / len(source)
+
+
+def row_misfit(measured: Mapping[tuple, float | None], source: Mapping[tuple, float]) -> float:
+    """A Burgers row's misfit over its entries ``(eps, h)``: :func:`misfit` plus the rule book's
+    ``IDENTIFICATION_SPREAD_WEIGHT`` times the mean over the meshes of ``|log(max_eps m / min_eps m) -
+    log(max_eps s / min_eps s)|`` (the spread over eps, so that an error independent of eps, as the
+    source's exact row is, counts); one eps: :func:`misfit` alone. ``inf`` when an entry is missing."""
+    keys = list(source)
+    base = misfit([measured.get(k) for k in keys], [source[k] for k in keys])
+    meshes = sorted({h for _, h in keys})
+    if not math.isfinite(base) or len({e for e, _ in keys}) < 2:
+        return base
+    spread = lambda values: math.log(max(values) / min(values))  # noqa: E731
+    term = sum(abs(spread([measured[k] for k in keys if k[1] == h]) - spread([source[k] for k in keys if k[1] == h]))
+               for h in meshes) / len(meshes)
+    return base + rule("IDENTIFICATION_SPREAD_WEIGHT") * term
 
 
 def candidate_rows(problem: str, settings: Mapping[str, object], measured: Mapping[object, float],
@@ -97,7 +114,7 @@ def source_matching(tables: Tables, problem: str, row: str | None = None) -> lis
     if problem not in IDENTIFICATION:
         raise ValueError(f"problem {problem!r} is not one of {tuple(IDENTIFICATION)}")
     rows = [r for r in tables.get(IDENTIFICATION[problem], []) if str(r.get("matching", "")) == "True"
-            and (row is None or r.get("source_row", "") == row)]
+            and (row is None or r.get("source_row", "") == row) and r.get("fit", "table") == "table"]
     return sorted(rows, key=lambda r: float(r.get("rank", "inf") or "inf"))
 
 
@@ -109,40 +126,115 @@ def _percent(m: float) -> str:
 def _setting(problem: str, r: Mapping) -> str:
     """A candidate's settings in words."""
     if problem == "sod":
-        where = "nodal" if r["quantity"] == "nodes" else "particle"
-        return f"{where} density {r['norm']} at {r['ppc']} per cell and CFL {r['cfl']}"
-    rule_text = "dt ~ h" if r["dt_rule"] == "advective" else "the stable dt"
-    return f"the {r['solution']} solution, {r['norm']} norm, {r['ppc']} per cell, {rule_text} at CFL {r['cfl']}"
+        where = "nodal" if readout(r) == "nodes" else "particle"
+        return f"{where} density {r['norm']} at {r['ppc']} per cell and CFL {float(r['cfl']):.3g}"
+    params = "" if r.get("params", "defaults") == "defaults" else f" ({r['params']})"
+    return (f"the {r['solution']} solution{params}, {r['norm']} norm over {readout(r)}, {r['ppc']} per cell, "
+            f"dt ~ h at CFL {float(r['cfl']):.3g}")
+
+
+def readout(r: Mapping) -> str:
+    """A row's read-out (``particles`` or ``nodes``; tables written before 2026-12-02 name it ``quantity``)."""
+    return str(r.get("readout") or r.get("quantity", ""))
+
+
+def _table_rows(rows: list[dict]) -> list[dict]:
+    """Burgers' whole-table candidates (``fit`` = ``table``) by ``table_misfit``, least first."""
+    return sorted((r for r in rows if r.get("fit", "table") == "table"), key=_table_misfit)
+
+
+def _table_misfit(r: Mapping) -> float:
+    """A whole-table candidate's misfit (a table written before 2026-12-02: its row's misfit)."""
+    return float(r.get("table_misfit") or r["misfit"])
+
+
+def _sod_sentence(rows: list[dict], limit: float) -> str:
+    group = sorted((r for r in rows if r["source_row"] == "L1"), key=lambda r: float(r["misfit"]))
+    if not group:
+        return ""
+    best, m = group[0], float(group[0]["misfit"])
+    verb = "is reproduced within" if m <= limit else "is not reproduced: at best within"
+    text = f"the source's Sod L1 column {verb} {_percent(m)} by {_setting('sod', best)}"
+    if best.get("misfit_held_out", "") != "":
+        text += f" (CFL fitted), the L2 column held out within {_percent(float(best['misfit_held_out']))}"
+    stated = [r for r in group if OPTIMAL_PPC[0] <= int(float(r["ppc"])) <= OPTIMAL_PPC[1]]
+    if stated and stated[0] is not best:
+        text += (f"; at the source's {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell within "
+                 f"{_percent(float(stated[0]['misfit']))} at best")
+    return text
+
+
+def _eps_trend(identified: list[dict], row: str) -> str:
+    """The identified Burgers setting's measured/source ratio by eps on the regular layout (coarsest mesh)."""
+    found = [r for r in identified if r.get("problem") == "burgers" and r["source_row"] == row
+             and r["layout"] == "regular"]
+    if not found:
+        return ""
+    h = max(float(r["h"]) for r in found)
+    ratios = {float(r["eps"]): float(r["ratio"]) for r in found if float(r["h"]) == h}
+    return ", ".join(f"{ratios[e]:.2f} at eps {e:g}" for e in sorted(ratios, reverse=True))
+
+
+def _burgers_sentence(rows: list[dict], tables: Tables, limit: float) -> str:
+    table = _table_rows(rows) if "fit" in rows[0] else []  # a table before 2026-12-02 fitted no whole table
+    if not table:
+        return ""
+    best = table[0]
+    m = _table_misfit(best)
+    pair = {r["source_row"]: r for r in table if r["candidate"] == best["candidate"]}
+    if set(pair) != {"exact", "calculated"}:  # a table of one row per candidate (before 2026-12-02)
+        return ""
+    verb = "is reproduced within" if m <= limit else "is not reproduced by one setting: at best within"
+    text = (f"the source's Burgers table (both rows) {verb} {_percent(m)} by {_setting('burgers', pair['exact'])} "
+            f"for the exact row and the stable dt at CFL {float(pair['calculated']['cfl']):.3g} for the calculated "
+            f"one (exact row {_percent(float(pair['exact']['misfit']))}, calculated "
+            f"{_percent(float(pair['calculated']['misfit']))}; held out ({best.get('held_out', '')}) "
+            f"{_percent(float(pair['exact']['misfit_held_out']))} and "
+            f"{_percent(float(pair['calculated']['misfit_held_out']))})")
+    if m > limit:
+        families = {}
+        for r in table:
+            families.setdefault(r["solution"], _table_misfit(r))
+        trend = _eps_trend(tables.get("identification/identified", []), "exact")
+        text += (f"; the closest family is the {best['solution']} solution, the others at best within "
+                 + ", ".join(f"{_percent(v)} ({k})" for k, v in families.items() if k != best["solution"])
+                 + (f"; at the identified setting its exact-row error / source's is {trend}: the source's is "
+                    "nearly the same at every eps, the family's error follows its own eps" if trend else ""))
+    diagnostic = [r for r in rows if r.get("fit") == "eps" and str(r.get("rank")) == "1"]
+    if diagnostic:
+        per = {}
+        for r in diagnostic:
+            per.setdefault(r["source_row"], []).append(f"{_percent(float(r['misfit']))} at eps {float(r['eps']):g} "
+                                                       f"({r['solution']})")
+        text += "; one row at one eps alone: " + "; ".join(f"{k} row {', '.join(v)}" for k, v in per.items())
+    return text
 
 
 def identification_sentence(tables: Tables, problem: str) -> str:
-    """In words, from ``problem``'s identification table: per source row, whether the source's table
-    is reproduced (its least misfit within ``IDENTIFICATION_REPRODUCED``) and where (the best
-    candidate), as the mean factor's excess ``exp(misfit) - 1``; for Sod also the best candidate at the
-    source's stated 4-8 particles per cell. Empty when the table is missing."""
+    """In words, from ``problem``'s identification table: whether the source's table is reproduced (the
+    least misfit within ``IDENTIFICATION_REPRODUCED``) and where (the best candidate), as the mean factor's
+    excess ``exp(misfit) - 1``, with the held-out misfit; Sod: the L1 column and, beside it, the best at
+    the source's 4-8 per cell; Burgers: the whole table, the closest family and its trend over eps when
+    it is not reproduced, and the per-eps diagnostic; the refinement test's change. Empty when the table
+    is missing."""
     rows = tables.get(IDENTIFICATION.get(problem, ""), [])
     if not rows:
         return ""
-    limit, parts = rule("IDENTIFICATION_REPRODUCED"), []
-    for source_row, name in SOURCE_ROWS[problem].items():
-        group = sorted((r for r in rows if r["source_row"] == source_row), key=lambda r: float(r["misfit"]))
-        if not group:
-            continue
-        best, m = group[0], float(group[0]["misfit"])
-        verb = "is reproduced within" if m <= limit else "is not reproduced: at best within"
-        text = f"the source's {_TITLES[problem]} {name} {verb} {_percent(m)} by {_setting(problem, best)}"
-        if problem == "sod":
-            stated = [r for r in group if OPTIMAL_PPC[0] <= int(float(r["ppc"])) <= OPTIMAL_PPC[1]]
-            if stated and stated[0] is not best:
-                text += (f", at the source's {OPTIMAL_PPC[0]}-{OPTIMAL_PPC[1]} per cell within "
-                         f"{_percent(float(stated[0]['misfit']))} at best")
-        parts.append(text)
-    if not parts:
+    limit = rule("IDENTIFICATION_REPRODUCED")
+    text = _sod_sentence(rows, limit) if problem == "sod" else _burgers_sentence(rows, tables, limit)
+    if not text:
         return ""
     meshes = sorted({float(h) for r in rows for h in str(r.get("meshes", "")).split()}, reverse=True)
     layout = next((r["value"] for r in tables.get("settings", []) if r["table"] == IDENTIFICATION[problem]
                    and r["key"] == "layout"), "")
     where = (f" ({f'the {layout} layout, ' if layout else ''}on {len(meshes)} of the source's "
              f"{len(SOURCE_H[problem])} meshes, h = {meshes[0]:g} to {meshes[-1]:g})") if meshes else ""
-    text = "; ".join(parts) + where + "."
+    refined = [r for r in tables.get("identification/refinement", []) if r.get("problem") == problem
+               and r.get("tolerance") == "halved"]
+    if refined:
+        change, limit = float(refined[0]["change"]), rule("IDENTIFICATION_REFINED")
+        converged = "below {limit:g}: converged" if change < limit else "not below {limit:g}: not converged"
+        text += (f"; halving every tolerance of the search moves its best misfit by {change:.3f} "
+                 f"({converged.format(limit=limit)})")
+    text = text + where + "."
     return text[0].upper() + text[1:]

@@ -243,3 +243,13 @@ _add("IDENTIFICATION_REPRODUCED", 0.1,
      "10 %)",
      "the study's (the slides state no tolerance): the goal is the source's behaviour, not its digits; a mean "
      "factor within 10 % is read as the same table", ("C11", "C13"))
+_add("IDENTIFICATION_SPREAD_WEIGHT", 1.0,
+     "the weight of the spread over eps in a Burgers row's misfit: the mean |log(measured/source)| plus this "
+     "times the mean over the meshes of |log(measured max/min over eps) - log(source max/min over eps)|",
+     "the study's: the source's exact row is about the same at every eps (its spread over eps is small), so that "
+     "independence counts as much as the size; weight 1 puts a factor in the spread on a par with a factor in "
+     "every entry", ("C13",))
+_add("IDENTIFICATION_REFINED", 0.05,
+     "the refinement test: halving every tolerance of the search (restarted at the converged point) moves the "
+     "best misfit by less than this",
+     "the study's: the band within which two misfits are not told apart (IDENTIFICATION_BAND)", ("C11", "C13"))

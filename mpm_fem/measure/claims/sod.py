@@ -17,7 +17,7 @@ import math
 import mpm_fem.measure.claims.shape as shape
 from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, PARTLY, REFUTED, Finding, Tables, claim, short
 from mpm_fem.measure.claims.drift import mechanism
-from mpm_fem.measure.claims.identification import source_matching
+from mpm_fem.measure.claims.identification import readout, source_matching
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, num, select, span
 from mpm_fem.measure.claims.sod_settings import (
     CONVERGENCE,
@@ -85,7 +85,7 @@ def _matching(t: Tables) -> tuple[dict, str]:
     the convergence table with the smallest mean |log(measured / source)| (said so)."""
     found = {}
     for r in source_matching(t, "sod"):
-        found.setdefault(Setting(int(num(r, "ppc")), num(r, "cfl")), f"{r['quantity']} {r['norm']}, rank {r['rank']}")
+        found.setdefault(Setting(int(num(r, "ppc")), num(r, "cfl")), f"{readout(r)} {r['norm']}, rank {r['rank']}")
     if found:
         return found, "the identification table"
     rows, misfit, closest, what = t.get(CONVERGENCE, []), math.inf, None, ""
@@ -191,4 +191,5 @@ def _c11(t: Tables) -> Finding:
 from mpm_fem.measure.claims.sod_waves import EXTREMA_RATIO, WAVE_DENSITY, WAVE_REGIONS  # noqa: E402, F401
 from mpm_fem.measure.claims.sod_shared import _c3_sod, _c15_sod  # noqa: E402, F401
 from mpm_fem.measure.claims.sod_fem import SIDE_BY_SIDE  # noqa: E402, F401
+from mpm_fem.measure.claims.identified import _c11_nodes  # noqa: E402, F401  (C11 at the identified setting)
 # isort: on
