@@ -82,9 +82,10 @@ def verdict_counts(found: Found) -> list[str]:
     for v in VERDICT_MEANING:
         source = sum(f.verdict == v for c, f in found.values() if c.id.startswith("C"))
         extensions = sum(f.verdict == v for c, f in found.values() if c.id.startswith("E"))
-        if source or extensions:
+        plane = sum(f.verdict == v for c, f in found.values() if c.id.startswith("D"))
+        if source or extensions or plane:
             rows.append({"verdict": COUNT_MEANING[0] if v == PARTLY else v, "the source's claims": source,
-                         "the extensions": extensions})
+                         "the extensions": extensions, "in two dimensions": plane})
     return markdown_table(rows) + [""]
 
 
@@ -95,7 +96,8 @@ def results(tables: Tables, found: Found, pages: list[Page], captions: dict, sum
         "The verdicts, counted, then every claim with its key number, the source's claims first; the subsections "
         "say each finding in words, and each claim's evidence is a table of "
         "[the appendix](APPENDIX.md#appendix-evidence)."), *verdict_counts(found),
-        "*The source's claims.*", "", *summary("C"), "", "*The extensions.*", "", *summary("E"), ""]
+        "*The source's claims.*", "", *summary("C"), "", "*The extensions.*", "", *summary("E"), "",
+        "*Two dimensions.*", "", *summary("D"), ""]
     shown_pages = [p for p in [*pages, REPRODUCTION] if claims_of(p.name)]
     drawn = set(KEY_FIGURES)  # the first screen shows these
     for page in shown_pages:

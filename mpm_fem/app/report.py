@@ -23,7 +23,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from mpm_fem.app import paper
+from mpm_fem.app import paper, paper_plane
 from mpm_fem.app.discussion import model_appendix
 from mpm_fem.app.markdown import anchor_of, bullets, cell, figure, markdown_table, prose  # noqa: F401  (cell: interface)
 from mpm_fem.app.output import write_atomic
@@ -285,6 +285,7 @@ def render_both(tables: Tables, pages, captions: dict[str, dict] | None = None, 
             lines += figure(study, file, captions[study])
     lines += paper.introduction(found) + paper.method(tables, caveats(everything, current))
     lines += paper.results(tables, found, pages, captions, partial(summary, found, "", brief=True, statements=False))
+    lines += paper_plane.section(found, captions.get(paper_plane.PAGE.name, {}))
     lines += paper.discussion(tables, found, captions, deep_found, note) + paper.conclusions(found, tables)
     extra = [TITLE.replace("?", "? Appendix"), "",
              f"The appendix of [REPORT.md](REPORT.md), rendered with it from the tables of code version "
@@ -310,10 +311,10 @@ def render(tables: Tables, pages, captions: dict[str, dict] | None = None, curre
 
 def study_pages(folder: Path) -> list[Page]:
     """The pages of :data:`mpm_fem.app.pages.PAGES`, then a plain page for every other study folder."""
-    named = {p.name for p in PAGES}
+    named = {p.name for p in (*PAGES, paper_plane.PAGE)}
     others = [Page(d.name, d.name, "Tables and figures of this study.") for d in sorted(Path(folder).iterdir())
               if d.is_dir() and d.name not in named and any(d.glob("*.csv"))]
-    return list(PAGES) + others
+    return [*PAGES, paper_plane.PAGE, *others]
 
 
 def write_report(out: Path, pages: list[Page] | None = None) -> Path:

@@ -54,7 +54,7 @@ ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = ("mpm_fem", "baselines", "studies")
 #: Modules of those packages that only render tables already written (paths from the root).
 RENDERING = ("mpm_fem/app/report.py", "mpm_fem/app/paper.py", "mpm_fem/app/markdown.py", "mpm_fem/app/pages.py",
-             "mpm_fem/app/plots.py", "mpm_fem/app/discussion.py")
+             "mpm_fem/app/plots.py", "mpm_fem/app/discussion.py", "mpm_fem/app/paper_plane.py")
 
 
 def versioned_files(root: Path = ROOT) -> list[Path]:

@@ -1,0 +1,99 @@
+"""The report's 2D section: does the 1D error analysis survive on the plane?
+
+:data:`PAGE` is the 2D study's page (its title, caption and the views of ``plane/*`` with their
+figures); :func:`section` writes ``## Two dimensions``: what was run, the figures (a convergence figure
+per solution with every basis, both amplitudes, the spread over the layouts and the FEM beside it; the
+stage bars with their control; the grid masses with their cost; time against space), then one sentence
+per claim D1-D7 setting the 2D finding beside its 1D counterpart (:data:`COUNTERPARTS`), from the
+findings the report judged once (``found``). No number is typed: every one comes from a finding.
+"""
+
+from __future__ import annotations
+
+from mpm_fem.app.markdown import anchor_of, figure, markdown_table, prose, readable
+from mpm_fem.app.pages import Page, View
+from mpm_fem.app.paper_findings import Found, verdict_text
+
+PAGE = Page("plane", "Two dimensions: the stage-by-stage analysis on the plane",
+            "Point-mass MPM, uGIMP and the quadratic and cubic B-splines run the axis-aligned manufactured solution "
+            "of a neo-Hookean solid at a small amplitude, where every particle stays in its cell, and a large one, "
+            "where particles cross cells, and the generalized vortex, beside the Q1 FEM on the same mesh; the error "
+            "is the particle displacement L2 at the final time.",
+            views=(
+                View("plane/convergence", "The particle displacement L2 per solution, method and mesh: the regular "
+                     "layout and the range over the layouts run", ("solution", "method", "h", "runs", "L2",
+                                                                   "L2_lo", "L2_hi"), {}, "convergence_axis.png"),
+                View("plane/convergence", "The vortex", ("method", "h", "runs", "L2", "L2_lo", "L2_hi"),
+                     {"solution": "vortex"}, "convergence_vortex.png"),
+                View("plane/stages", "Point-mass P1 with each stage made exact alone and every stage exact",
+                     ("solution", "h", "layout", "seed", "made_exact", "ok", "L2")),
+                View("plane/shapley", "The error budget's decomposition on the two coarsest meshes",
+                     ("solution", "h", "stage", "shapley", "share", "alone", "interactions_share"), {}, "stages.png"),
+                View("plane/mass", "The grid masses: error and CPU cost per step", ("solution", "h", "mass", "ok",
+                                                                                    "L2", "step_ms"), {}, "mass.png"),
+                View("plane/fem", "The Q1 FEM on the same meshes", ("solution", "h", "mass", "ok", "L2")),
+                View("plane/time", "The step alone refined on one mesh", ("solution", "refine", "cfl_run", "dt",
+                                                                         "L2"), {}, "time.png"),
+            ))
+
+#: Each 2D claim and the 1D findings it is set beside (their labels), with the words that introduce them.
+COUNTERPARTS = {
+    "D1": (("E6a (burgers)", "E6a (sod)", "E2"), "in 1D"),
+    "D2": (("E6a (burgers)", "E6a (sod)"), "in 1D"),
+    "D3": (("E1 (sod)", "E1 (burgers)"), "the 1D budget:"),
+    "D4": (("C15 (burgers)", "C15 (sod)"), "in 1D"),
+    "D5": ((), ""),
+    "D6": (("E3",), "in 1D"),
+    "D7": (("C1",), "in 1D"),
+}
+#: The figures of the section, in order: (file, what it shows).
+FIGURES = ("convergence_axis.png", "convergence_vortex.png", "stages.png", "mass.png", "mass_cost.png", "time.png")
+
+
+def _said(f) -> str:
+    text = (f.sentence or f.evidence.split(";")[0]).strip().rstrip(".")
+    return readable(text)
+
+
+def comparison_rows(found: Found) -> list[dict]:
+    """One row per 2D claim: its verdict, the 2D finding in words and the 1D finding it is set beside."""
+    rows = []
+    for label, (c, f) in found.items():
+        if not c.id.startswith("D"):
+            continue
+        ones, _ = COUNTERPARTS.get(c.id, ((), ""))
+        beside = [f"{one}: {_said(found[one][1])}" for one in ones if one in found and found[one][1].sentence]
+        rows.append({"claim": f"[{label}](#{anchor_of(label)})", "verdict": verdict_text(f), "in 2D": _said(f),
+                     "in 1D": "; ".join(beside) or "no 1D counterpart measured"})
+    return rows
+
+
+def sentences_per_claim(found: Found) -> list[str]:
+    """A paragraph per 2D claim: its finding, then the 1D one it is set beside."""
+    out = []
+    for label, (c, f) in found.items():
+        if not c.id.startswith("D") or f.verdict == "not measured":
+            continue
+        ones, words = COUNTERPARTS.get(c.id, ((), ""))
+        beside = [_said(found[one][1]) for one in ones if one in found and found[one][1].sentence]
+        text = f"{label}: {_said(f)}" + (f"; {words} {beside[0]}" if beside else "") + "."
+        out += prose(text[:1].upper() + text[1:])
+    return out
+
+
+def section(found: Found, captions: dict) -> list[str]:
+    """``## Two dimensions``: the question, the figures of ``plane`` (``captions``: its ``{file: caption}``),
+    a sentence per 2D claim beside its 1D counterpart and the table of both (:func:`comparison_rows`);
+    nothing when no 2D claim was judged."""
+    rows = comparison_rows(found)
+    if not rows or all(r["verdict"] == "not measured" for r in rows):
+        return []
+    lines = ['<a id="two-dimensions"></a>', "", "## Two dimensions", "", *prose(
+        "Do the 1D findings hold on the plane? " + PAGE.caption + " Each claim D1-D7 below is judged from the "
+        "2D study's tables by the same rule book; each is set beside its 1D counterpart.")]
+    for file in FIGURES:
+        if file in captions:
+            lines += figure(PAGE.name, file, captions)
+    lines += sentences_per_claim(found)
+    lines += markdown_table(rows, ("claim", "verdict", "in 2D", "in 1D")) + [""]
+    return lines
