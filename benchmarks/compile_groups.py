@@ -79,7 +79,9 @@ def groups(tier: str, studies, method: bool) -> dict[str, dict]:
 
 
 class _Timer(event.Listener):
-    """Each compiled function's own CPU seconds, by variant name (a callee's compile subtracted from its caller's)."""
+    """Each compiled variant's own CPU seconds, by variant name: a callee variant's compile subtracted from its
+    caller's, but a function numba does not cache on disk (its own overloads of numpy and the builtins, compiled
+    into the variant that calls them and loaded with it from the cache) counted in its caller's."""
 
     def __init__(self):
         self.stack, self.seconds = [], {}
@@ -90,9 +92,9 @@ class _Timer(event.Listener):
     def on_end(self, ev):
         dispatcher, start, inner = self.stack.pop()
         spent = time.process_time() - start
-        if self.stack:
-            self.stack[-1][2] += spent
         name = variant_name(dispatcher)
+        if self.stack:
+            self.stack[-1][2] += spent if name is not None else inner
         if name is not None:
             self.seconds[name] = self.seconds.get(name, 0.0) + spent - inner
 
