@@ -141,6 +141,7 @@ compile, measured from an empty cache. ``GROUPS``: kernel group (:func:`mpm_fem.
 joined by ``|``) -> the variants its cases run through. :mod:`mpm_fem.app.estimate` adds the seconds
 of the variants numba's cache lacks to a study's estimate.
 """
+# ruff: noqa: E501  (generated: variant names are longer than a line)
 
 '''
     body = (f"SECONDS = {pprint.pformat(dict(sorted(seconds.items())), width=115)}\n\n"

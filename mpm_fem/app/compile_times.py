@@ -7,6 +7,7 @@ compile, measured from an empty cache. ``GROUPS``: kernel group (:func:`mpm_fem.
 joined by ``|``) -> the variants its cases run through. :mod:`mpm_fem.app.estimate` adds the seconds
 of the variants numba's cache lacks to a study's estimate.
 """
+# ruff: noqa: E501  (generated: variant names are longer than a line)
 
 SECONDS = {'baselines/fem_burgers_kernel.py::fem_burgers_kernel._derivative': 0.38,
  'baselines/fem_burgers_kernel.py::fem_burgers_kernel._factor': 0.22,
