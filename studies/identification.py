@@ -24,12 +24,11 @@ the procedures of :mod:`mpm_fem.measure.identify`), never read off a grid; the g
   for Burgers than the fit (``identification/identified``): C11 and C13 read it.
 
 Meshes by tier: Sod full h >= 0.000625 (five of the source's six, the plateau's first mesh inside the
-fit; h = 0.0003125, about a minute a run at 16 per cell and each search point runs it, is in the deep
-tier, with 4, 8 and 32 per cell); Burgers full: the search on h = 0.01 at the five eps, the identified
-setting rerun on h = 0.01 and 0.005 (its second mesh is held out: its ratio to the source is in
-``identified``), deep one mesh more each. A run's wall time is dominated by the step's fixed cost (about
-4 ms a step on the project's 2-core machine, beside the particles' share), so a small CFL costs in
-proportion to its steps. Quick: the coarsest meshes, one solution, loose tolerances.
+fit; h = 0.0003125, about 20 s a run at 16 per cell at every point of the search, is in the deep tier,
+with 4, 8 and 32 per cell); Burgers full: the search on h = 0.01 and 0.005 at the five eps (the calculated
+row's stable step makes a run cost ~ h^-3), the identified setting rerun one mesh further (h = 0.0025:
+its ratio to the source is in ``identified``), deep one mesh more each. Quick: the coarsest meshes, one
+solution, loose tolerances.
 
 Cost: the brackets are the plan (:data:`PLANS`, priced by :mod:`mpm_fem.app.estimate`); the search's
 steps inside the brackets depend on what it measures and are not in the plan: their CPU time is written
@@ -77,15 +76,15 @@ ADVECTIVE_GRID = (0.03, 0.1, 0.3, 1.0)
 #: The stable rule's bracket by tier: dt ~ h^2 makes CFL 0.03 cost ~60000 steps a run at h = 0.005 (minutes
 #: each), so the full tier brackets it from 0.1 and the deep tier from 0.03.
 STABLE_GRID = {"quick": (0.1, 0.3, 1.0), "full": (0.1, 0.3, 1.0), "deep": (0.03, 0.1, 0.3, 1.0)}
-CFL_XTOL, PARAM_XTOL, FTOL, PASSES = 0.1, 0.05, 0.01, 1
+CFL_XTOL, PARAM_XTOL, FTOL, PASSES = 0.05, 0.02, 0.005, 2
 #: The parameters fitted per solution: default (that of baselines.exact.burgers) and search range.
 PARAMETERS = {"rarefaction": {"t0": (0.05, Coordinate(0.01, 1.0, 2 * PARAM_XTOL, log=True)),
                               "u_left": (0.5, Coordinate(0.0, 0.9, PARAM_XTOL)),
                               "u_right": (1.0, Coordinate(1.0, 2.0, PARAM_XTOL))},
               "cole_hopf": {"A": (2.0, Coordinate(1.05, 20.0, 2 * PARAM_XTOL, log=True))}}
 BURGERS_PPC = {"quick": (4,), "full": (4,), "deep": (4, 8)}
-BURGERS_MESHES = {"quick": source.BURGERS_H[:1], "full": source.BURGERS_H[:1], "deep": source.BURGERS_H[:2]}
-IDENTIFIED_MESHES = {"quick": source.BURGERS_H[:2], "full": source.BURGERS_H[:2], "deep": source.BURGERS_H[:3]}
+BURGERS_MESHES = {"quick": source.BURGERS_H[:1], "full": source.BURGERS_H[:2], "deep": source.BURGERS_H[:3]}
+IDENTIFIED_MESHES = {"quick": source.BURGERS_H[:2], "full": source.BURGERS_H[:3], "deep": source.BURGERS_H[:4]}
 #: The quick tier: one solution, its constants only, loose tolerances, two fitted eps and one held out.
 QUICK = dict(solutions=("rarefaction",), parameters={}, fit_eps=(0.045,), held_eps=(0.01,), cfl_xtol=0.3,
              ftol=0.05, passes=1, seeds=(1,))
