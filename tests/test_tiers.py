@@ -122,7 +122,8 @@ def test_the_quick_reproduction_leaves_out_the_plateau_studies_and_says_so(tmp_p
     study."""
     from mpm_fem.app import report, study
 
-    assert study.reproduced("quick") == ("projection", "sod", "burgers", "identification", "time", "mechanism")
+    assert study.reproduced("quick") == ("projection", "sod", "burgers", "identification", "time", "mechanism",
+                                         "plane")
     assert study.reproduced("full") == study.reproduced("deep") == study.STUDIES
     started = []
     monkeypatch.setattr(study, "run_study", lambda name, options: started.append(name))
