@@ -15,7 +15,8 @@ is not lumped); its error is the particle displacement L2 at T (volume-weighted 
     budget      the 16 subsets of {projection, mass, interpolation, time} in MPM form on the two coarsest
                 meshes, both amplitudes (the small one the control), and ``shapley``, their decomposition (D3)
     mass        the grid masses lumped, consistent, exact and FMPM(k), k = 1..4 (:mod:`mpm_fem.masses`),
-                with the CPU cost of a step (D4, D5)
+                with the CPU cost of a step (the lumped mass on the compiled step, the others on the numpy
+                step) (D4, D5)
     fem         the Q1 FEM on the same meshes (:mod:`baselines.fem_solid`), lumped and consistent (D6)
     time        one mesh, the step alone refined (D7)
 
@@ -276,7 +277,8 @@ PLOTS = (
     Plot("mass.png", "Point-mass P1, regular layout: the grid masses, lumped, consistent, exact and FMPM(k)",
          "mass", "h", tuple(Curve("{mass}", "L2", "o-", {"ok": True}, group=("mass",)) for _ in (0,)),
          ylabel=_YLABEL, slopes=(1, 2), split=("solution",), size=(4.6, 4.0)),
-    Plot("mass_cost.png", "The CPU cost of one step with each grid mass (point-mass P1, regular layout)", "mass",
+    Plot("mass_cost.png", "The CPU cost of one step with each grid mass (point-mass P1, regular layout; the lumped "
+         "mass on the compiled step, the others on the numpy step)", "mass",
          "h", (Curve("{mass}", "step_ms", "o-", {"ok": True, "solution": CROSSING}, group=("mass",)),),
          ylabel="CPU ms per step", size=(5.6, 4.4)),
     Plot("time.png", f"The step alone refined on h = 1/{round(1 / TIME_H)} (CFL {TIME_CFL} / refine)", "time", "dt",
