@@ -170,13 +170,15 @@ def _burgers_rows(families: dict) -> list[dict]:
 def test_the_burgers_sentence_gives_the_defended_negative_when_no_candidate_matches():
     rows = _burgers_rows({"rarefaction": 0.3, "cole_hopf": 0.9})
     IDENTIFICATION_BURGERS.check(rows)
-    identified = [{"problem": "burgers", "source_row": "exact", "layout": "regular", "eps": e, "h": 0.01,
-                   "ratio": r} for e, r in ((0.045, 1.0), (0.01, 0.3))]
+    identified = [{"problem": "burgers", "source_row": "exact", "layout": "regular", "eps": e, "h": h,
+                   "ratio": r} for e, h, r in ((0.045, 0.01, 1.0), (0.045, 0.005, 2.0), (0.01, 0.01, 0.3))]
     text = identification_sentence({"identification/burgers": rows, "identification/identified": identified},
                                    "burgers")
     assert "is not reproduced by one setting: at best within 35 %" in text
     assert "the closest family is the rarefaction solution, the others at best within 146 % (cole_hopf)" in text
-    assert "1.00 at eps 0.045, 0.30 at eps 0.01" in text and "exact row 5 % at eps 0.045 (rarefaction)" in text
+    assert ("what keeps it off is its exact row, rerun: exact-row error / source's 1.00 at h = 0.01, 2.00 at h = "
+            "0.005 (eps 0.045) and 1.00 at eps 0.045, 0.30 at eps 0.01 (h = 0.01)") in text
+    assert "exact row 5 % at eps 0.045 (rarefaction)" in text
     matched = identification_sentence({"identification/burgers": _burgers_rows({"rarefaction": 0.08})}, "burgers")
     assert "is reproduced within 8 %" in matched and "closest family" not in matched
     assert [r["source_row"] for r in source_matching({"identification/burgers": rows}, "burgers")] == [

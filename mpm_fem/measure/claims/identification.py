@@ -164,15 +164,19 @@ def _sod_sentence(rows: list[dict], limit: float) -> str:
     return text
 
 
-def _eps_trend(identified: list[dict], row: str) -> str:
-    """The identified Burgers setting's measured/source ratio by eps on the regular layout (coarsest mesh)."""
+def _trends(identified: list[dict], row: str) -> str:
+    """The identified Burgers setting's measured/source ratio of ``row`` on the regular layout: by mesh at
+    the largest eps, and by eps on the coarsest mesh."""
     found = [r for r in identified if r.get("problem") == "burgers" and r["source_row"] == row
              and r["layout"] == "regular"]
     if not found:
         return ""
-    h = max(float(r["h"]) for r in found)
-    ratios = {float(r["eps"]): float(r["ratio"]) for r in found if float(r["h"]) == h}
-    return ", ".join(f"{ratios[e]:.2f} at eps {e:g}" for e in sorted(ratios, reverse=True))
+    coarse, largest = max(float(r["h"]) for r in found), max(float(r["eps"]) for r in found)
+    by_h = {float(r["h"]): float(r["ratio"]) for r in found if float(r["eps"]) == largest}
+    by_eps = {float(r["eps"]): float(r["ratio"]) for r in found if float(r["h"]) == coarse}
+    meshes = ", ".join(f"{by_h[h]:.2f} at h = {h:g}" for h in sorted(by_h, reverse=True))
+    viscosities = ", ".join(f"{by_eps[e]:.2f} at eps {e:g}" for e in sorted(by_eps, reverse=True))
+    return f"{row}-row error / source's {meshes} (eps {largest:g}) and {viscosities} (h = {coarse:g})"
 
 
 def _burgers_sentence(rows: list[dict], tables: Tables, limit: float) -> str:
@@ -195,11 +199,13 @@ def _burgers_sentence(rows: list[dict], tables: Tables, limit: float) -> str:
         families = {}
         for r in table:
             families.setdefault(r["solution"], _table_misfit(r))
-        trend = _eps_trend(tables.get("identification/identified", []), "exact")
+        worse = max(pair, key=lambda k: float(pair[k]["misfit"]))
+        trend = _trends(tables.get("identification/identified", []), worse)
         text += (f"; the closest family is the {best['solution']} solution, the others at best within "
                  + ", ".join(f"{_percent(v)} ({k})" for k, v in families.items() if k != best["solution"])
-                 + (f"; at the identified setting its exact-row error / source's is {trend}: the source's is "
-                    "nearly the same at every eps, the family's error follows its own eps" if trend else ""))
+                 + f"; what keeps it off is its {worse} row" + (f", rerun: {trend}, where the source's falls at "
+                                                                "first order in h"
+                                                                if trend else ""))
     diagnostic = [r for r in rows if r.get("fit") == "eps" and str(r.get("rank")) == "1"]
     if diagnostic:
         per = {}
