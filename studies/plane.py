@@ -32,6 +32,7 @@ from typing import NamedTuple
 
 from mpm_fem.app.plots import Curve, Plot
 from mpm_fem.app.study import StudyOptions, publish, script_main
+from mpm_fem.measure import schema
 from mpm_fem.measure.decomposition import decompose, label, subsets
 
 NAME = "plane"
@@ -138,13 +139,13 @@ def run_case(case: dict) -> dict:
     inverts, a singular mass) is a row with ``ok`` false and its message."""
     if case["kind"] == "fem":
         return _fem_case(case)
+    from mpm_fem.plane import run as plane_run  # the module: the name ``run`` is this study's own
     from mpm_fem.plane.model import InversionError
-    from mpm_fem.plane.run import PlaneSettings, run
 
-    settings = PlaneSettings(**{k: case[k] for k in _SETTINGS if k in case})
+    settings = plane_run.PlaneSettings(**{k: case[k] for k in _SETTINGS if k in case})
     cpu = time.process_time()
     try:
-        r = run(settings)
+        r = plane_run.run(settings)
     except (InversionError, ArithmeticError, ValueError) as err:
         return {"ok": False, "error": " ".join(str(err).split())[:200]}
     cpu = time.process_time() - cpu
@@ -172,8 +173,7 @@ def _fem_case(case: dict) -> dict:
 
 # ---------------------------------------------------------------- tables
 
-_RUN = ("ok", "error", "L2", "Linf", "L2_max", "acc_L2", "steps", "dt", "cfl_run", "n_p", "wall_s", "step_ms",
-        "compiled")
+_RUN = schema.PLANE_RUN
 
 
 def _row(result: dict) -> dict:
@@ -240,8 +240,10 @@ def run(options: StudyOptions) -> None:
     extra = {"time": {"h": TIME_H, "cfl": TIME_CFL, "refines": list(TIME_REFINES)},
              "stages": {"made_exact": "none: all MPM; a stage: that stage alone exact; all: every stage exact"},
              "mass": {"masses": list(MASSES), "step_ms": "CPU milliseconds per step of the run"}}
-    publish(folder, {"growth": growth, "stages": stages, "budget": budget, "shapley": shapley, "mass": mass,
-                     "fem": fem, "time": timing, "convergence": convergence_rows(got["growth"], got["fem"])},
+    publish(folder, {schema.PLANE_GROWTH: growth, schema.PLANE_STAGES: stages, schema.PLANE_BUDGET: budget,
+                     schema.PLANE_SHAPLEY: shapley, schema.PLANE_MASS: mass, schema.PLANE_FEM: fem,
+                     schema.PLANE_TIME: timing,
+                     schema.PLANE_CONVERGENCE: convergence_rows(got["growth"], got["fem"])},
             settings, extra, PLOTS)
     _stage_bars(folder, shapley, stages)
 

@@ -254,6 +254,32 @@ MODEL = Table("defect/model", ("problem", "ppc", "layout", "seed", "h", "role", 
 #: One row per problem and layout class: the defect law ``d = D h^q n^-r`` and the error model ``A h^p + B d``.
 MODEL_FIT = Table("defect/model_fit", ("problem", "layout", "driver", "D", "q", "r", "A", "p", "B"))
 
+# ----------------------------------------------------------------------------- plane (D1-D7)
+
+#: What every 2D run writes (``studies.plane``): ``ok``, the particle displacement errors at T (``L2``, ``Linf``,
+#: ``L2_max`` over time), the nodal acceleration's ``acc_L2``, the steps, ``dt``, the CFL run (``cfl_run``), the
+#: particles, the wall and CPU time per step (``step_ms``) and whether the compiled step ran; ``error`` names the
+#: cause of a failed run (its row then has no errors).
+PLANE_RUN = ("ok", "error", "L2", "Linf", "L2_max", "acc_L2", "steps", "dt", "cfl_run", "n_p", "wall_s", "step_ms",
+             "compiled")
+#: D1, D6: per solution, basis, particles per cell (per axis), layout, seed and mesh.
+PLANE_GROWTH = Table("plane/growth", ("solution", "basis", "ppc", "layout", "seed", "h", *PLANE_RUN))
+#: D2: per solution, mesh, layout and seed, each stage made exact alone (``none``: all MPM; ``all``: every one).
+PLANE_STAGES = Table("plane/stages", ("solution", "h", "layout", "seed", "made_exact", "basis", "ppc", *PLANE_RUN))
+#: D3: v(S) of every subset of stages in MPM form, per solution and mesh, and each stage's Shapley value.
+PLANE_BUDGET = Table("plane/budget", ("solution", "h", "mpm_stages", *PLANE_RUN))
+PLANE_SHAPLEY = Table("plane/shapley", ("solution", "h", "stage", "shapley", "share", "alone", "mpm_error",
+                                        "exact_error", "gap", "interactions", "interactions_share"))
+#: D4, D5: per solution, mesh and grid mass (``mpm_fem.masses``), point-mass MPM at 2x2 per cell.
+PLANE_MASS = Table("plane/mass", ("solution", "h", "mass", "basis", *PLANE_RUN))
+#: D4, D6: the Q1 FEM on the same mesh, per solution, mesh and mass.
+PLANE_FEM = Table("plane/fem", ("solution", "h", "mass", *PLANE_RUN))
+#: D7: one mesh, the step refined ``refine`` times from CFL ``cfl``.
+PLANE_TIME = Table("plane/time", ("solution", "h", "cfl", "refine", "study_cfl", *PLANE_RUN))
+#: The figures' table: per solution, method and mesh, the regular layout's L2 and its spread over the layouts.
+PLANE_CONVERGENCE = Table("plane/convergence", ("solution", "method", "h", "runs", "ok_runs", "L2", "L2_mean",
+                                                "L2_lo", "L2_hi"))
+
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
 #: One row per table: the code version that wrote it and its tier (:func:`mpm_fem.measure.tables.table_tier`;
@@ -272,7 +298,8 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     REMEDIES_ERRORS,
     DRIFT,
     IDENTIFICATION_SOD, IDENTIFICATION_BURGERS, IDENTIFICATION_REFINEMENT, IDENTIFICATION_IDENTIFIED,
-    MECHANISM_GROWTH, MECHANISM_SUMMARY, DEFECT, MODEL, MODEL_FIT)}
+    MECHANISM_GROWTH, MECHANISM_SUMMARY, DEFECT, MODEL, MODEL_FIT,
+    PLANE_GROWTH, PLANE_STAGES, PLANE_BUDGET, PLANE_SHAPLEY, PLANE_MASS, PLANE_FEM, PLANE_TIME, PLANE_CONVERGENCE)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}
 
