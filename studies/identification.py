@@ -85,6 +85,8 @@ PARAMETERS = {"rarefaction": {"t0": (0.05, Coordinate(0.01, 1.0, 2 * PARAM_XTOL,
 BURGERS_PPC = {"quick": (4,), "full": (4,), "deep": (4, 8)}
 BURGERS_MESHES = {"quick": source.BURGERS_H[:1], "full": source.BURGERS_H[:2], "deep": source.BURGERS_H[:3]}
 IDENTIFIED_MESHES = {"quick": source.BURGERS_H[:2], "full": source.BURGERS_H[:3], "deep": source.BURGERS_H[:4]}
+#: The weight of the spread over eps in a Burgers row's misfit (the rule book's).
+SPREAD_WEIGHT = rule("IDENTIFICATION_SPREAD_WEIGHT")
 #: The quick tier: one solution, its constants only, loose tolerances, two fitted eps and one held out.
 QUICK = dict(solutions=("rarefaction",), parameters={}, fit_eps=(0.045,), held_eps=(0.01,), cfl_xtol=0.3,
              ftol=0.05, passes=1, seeds=(1,))
@@ -272,13 +274,13 @@ def _burgers(options: StudyOptions) -> dict:
     for solution in search.solutions:
         names = list(search.parameters.get(solution, {}))
         for n in search.ppc:
-            scores = identify.BurgersTable(measure, solution, n, names, corrected)
+            scores = identify.BurgersTable(measure, solution, n, names, corrected, SPREAD_WEIGHT)
             fit = identify.fit_family(scores, search)
             fits[(solution, n)] = (scores, fit)
             x = {**fit.params, **{f"cfl_{r}": c for r, c in fit.cfl.items()}}
             for r in identify.candidate_results(scores, fit, search):
                 label = f"{solution} ({_params_text(fit.params)}), {n} ppc, {r['readout']} {r['norm']}"
-                raw_rows = identify.BurgersTable(measure, solution, n, names, raw)
+                raw_rows = identify.BurgersTable(measure, solution, n, names, raw, SPREAD_WEIGHT)
                 rows.append({"problem": "burgers", "fit": "table", "candidate": label, "solution": solution,
                              "params": _params_text(fit.params), "dt_rule": identify.DT_RULES[r["source_row"]],
                              "cfl": round(fit.cfl[r["source_row"]], 5), "ppc": n, "readout": r["readout"],

@@ -118,7 +118,8 @@ def test_the_burgers_fit_finds_the_constant_and_the_parameter_of_a_known_table()
         advective_grid=identification.ADVECTIVE_GRID, stable_grid=identification.STABLE_GRID["full"], cfl_xtol=0.01,
         ftol=1e-4)
     corrected, _ = identification.burgers_source(source.BURGERS_H[:2])
-    scores = identify.BurgersTable(_burgers_measure(0.2, 0.05), "rarefaction", 4, ["t0"], corrected)
+    scores = identify.BurgersTable(_burgers_measure(0.2, 0.05), "rarefaction", 4, ["t0"], corrected,
+                                   rule("IDENTIFICATION_SPREAD_WEIGHT"))
     fit = identify.fit_family(scores, search)
     # the exact row fixes the product cfl * t0 only: the fit lands on that ridge
     assert (fit.cfl["exact"] / 0.2) * (fit.params["t0"] / 0.05) == pytest.approx(1.0, rel=0.03)

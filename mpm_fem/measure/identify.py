@@ -29,7 +29,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
-from mpm_fem.measure.claims.identification import misfit, row_misfit
+from mpm_fem.measure.misfit import misfit, row_misfit
 from mpm_fem.measure.search import Coordinate, bracketed, coordinate_fit, fit_scalar
 
 READOUTS = ("particles", "nodes")
@@ -134,8 +134,10 @@ class BurgersTable:
     measured entries of every read-out and norm at the point ``x`` (``{"cfl_exact", "cfl_calculated",
     parameters}``), ``source`` the source's entries ``{row: {(eps, h): value}}``."""
 
-    def __init__(self, measure: Measure, solution: str, ppc: int, names: Sequence[str], source: Mapping):
+    def __init__(self, measure: Measure, solution: str, ppc: int, names: Sequence[str], source: Mapping,
+                 spread_weight: float):
         self.measure, self.solution, self.ppc, self.names, self.source = measure, solution, ppc, tuple(names), source
+        self.spread_weight = spread_weight
 
     def runs(self, row: str, x: Mapping[str, float], eps: Sequence[float]) -> Mapping:
         params = {k: x[k] for k in self.names}
@@ -145,7 +147,7 @@ class BurgersTable:
         """:func:`row_misfit` of ``row`` at ``x`` over ``eps`` (the source's entries of those eps)."""
         runs = self.runs(row, x, eps)
         source = {k: v for k, v in self.source[row].items() if k[0] in eps}
-        return row_misfit({k: value(runs.get(k), readout, norm) for k in source}, source)
+        return row_misfit({k: value(runs.get(k), readout, norm) for k in source}, source, self.spread_weight)
 
     def table(self, x, eps, readout, norm) -> float:
         return sum(self.row(r, x, eps, readout, norm) for r in DT_RULES) / len(DT_RULES)
