@@ -3,7 +3,7 @@ as soon as its last case is in (fake studies: the pool and the order, not the nu
 
 from __future__ import annotations
 
-from mpm_fem.app import estimate, report, study
+from mpm_fem.app import case_tasks, report, study
 from mpm_fem.app.study import StudyOptions
 from mpm_fem.app.sweep import Task
 
@@ -31,7 +31,7 @@ def test_each_study_is_written_once_after_its_last_case_the_cheapest_study_first
 
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", run_study)
-    monkeypatch.setattr(estimate, "tasks", tasks)
+    monkeypatch.setattr(case_tasks, "tasks", tasks)
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))
     started = [int(n) for n in trace.read_text().split()]
@@ -68,7 +68,7 @@ def test_with_two_workers_a_worker_writes_each_study_once_its_cases_are_in(tmp_p
 
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", write_study)
-    monkeypatch.setattr(estimate, "tasks", tasks)
+    monkeypatch.setattr(case_tasks, "tasks", tasks)
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=2, progress=False))
     written = [line.split() for line in (tmp_path / "written").read_text().splitlines()]

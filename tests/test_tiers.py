@@ -159,25 +159,32 @@ def test_the_quick_plan_runs_c11s_setting_on_the_meshes_and_runs_c11_needs():
     assert set(meshes) <= set(plan["fem_lumped"]) and set(meshes) <= set(plan["fv"])  # E3 and the figure
 
 
-def test_the_quick_plan_runs_c13s_settings_on_every_seed_and_every_eps():
-    """The settings the quick identification can pick for C13 (its particles per cell, calculated a, and exact
-    a with dt ~ h) run on every seed at the compared solution and at every eps on each solution it compares, on
-    the identification's meshes (its own cases: nothing runs twice)."""
-    burgers = importlib.import_module("studies.burgers")
+def test_the_quick_identification_reruns_c13s_setting_on_two_meshes_every_eps_and_a_seed():
+    """C13 is judged at the identified Burgers setting's reruns (``identification/identified``): in the quick
+    tier as in the full one, both rows on two meshes, every eps on the regular layout and the largest eps on
+    the jittered seeds, so that the criterion has two meshes per run (fake measurements: the plan, not the
+    numerics)."""
+    from types import SimpleNamespace
+
     identification = importlib.import_module("studies.identification")
-    plan = burgers._plan("quick")
-    ppc = identification.QUICK["burgers_ppc"]
-    judged = {burgers.CALCULATED[n] for n in ppc} | {"mpm_exact_dt_h"}
-    for method in judged:
-        runs = [k for k in plan["seeds"] if k[0] == method]
-        meshes = {k[2] for k in runs}
-        assert len(meshes) >= 2 and len(runs) == len(meshes) * (1 + len(burgers.SEEDS)), method
-        for solution in identification.QUICK["solutions"]:
-            got = {(e, h) for s, m, e, h in plan["table"] if (s, m) == (solution, method)}
-            assert got == {(e, h) for e in burgers.EPS for h in identification.BURGERS_MESHES["quick"]}
-    candidates = identification.plans("quick")["burgers"]["candidates"].values()
-    assert all(c in candidates for (s, m, *_), c in plan["table"].items()
-               if s == "cole_hopf" and m in judged)
+    calls = []
+
+    def measure(row, solution, params, ppc, cfl, eps, hs, **changes):
+        calls.append((row, tuple(eps), tuple(hs), changes.get("seed", 0)))
+        return {(e, h): {"ok": True, "nodes": {"L1": h}, "particles": {"L1": h}} for e in eps for h in hs}
+
+    fit = SimpleNamespace(solution="rarefaction", params={}, ppc=4, cfl={"exact": 0.1, "calculated": 0.3},
+                          readout="nodes", norm="L1")
+    rows = identification._burgers_identified(measure, fit, "identified", "quick")
+    meshes = identification.IDENTIFIED_MESHES["quick"]
+    assert len(meshes) >= 2
+    assert {r for r, *_ in calls} == {"exact", "calculated"}
+    for row in ("exact", "calculated"):
+        regular = [c for c in calls if c[0] == row and c[3] == 0]
+        assert regular == [(row, identification.EPS, meshes, 0)]
+        jittered = sorted(c[3] for c in calls if c[0] == row and c[3])
+        assert jittered == sorted(identification.QUICK["seeds"]) and jittered
+    assert len(rows) == 2 * len(meshes) * (len(identification.EPS) + len(identification.QUICK["seeds"]))
 
 
 def test_the_criteria_never_read_the_tier():
