@@ -123,4 +123,5 @@ def test_e1_sod_names_the_read_out_of_the_exact_density_on_the_jittered_layouts(
     evidence = judge("E1 (sod)", {**TABLES, "budget/readout": rows})[1]
     assert ("the read-out alone (the exact density at the exact particle positions, `budget/readout.csv`) errs by "
             "0.037..0.038 on the 2 jittered runs, 1.00..1.03x their v(all exact)") in evidence
-    assert "budget/readout" not in judge("E1 (sod)", TABLES)[1]
+    without = {k: v for k, v in TABLES.items() if k != "budget/readout"}
+    assert "budget/readout" not in judge("E1 (sod)", without)[1]

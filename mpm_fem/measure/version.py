@@ -54,7 +54,9 @@ ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = ("mpm_fem", "baselines", "studies")
 #: Modules of those packages that only render tables already written (paths from the root).
 RENDERING = ("mpm_fem/app/report.py", "mpm_fem/app/paper.py", "mpm_fem/app/markdown.py", "mpm_fem/app/pages.py",
-             "mpm_fem/app/plots.py", "mpm_fem/app/discussion.py", "mpm_fem/app/paper_plane.py")
+             "mpm_fem/app/plots.py", "mpm_fem/app/discussion.py", "mpm_fem/app/paper_plane.py",
+             "mpm_fem/app/paper_findings.py", "mpm_fem/app/paper_abstract.py", "mpm_fem/app/paper_method.py",
+             "mpm_fem/app/paper_results.py", "mpm_fem/app/paper_discussion.py")
 
 
 def versioned_files(root: Path = ROOT) -> list[Path]:
