@@ -17,7 +17,8 @@ edit of :mod:`mpm_fem.app.estimate` is a new version of those cases (:mod:`mpm_f
 
 from __future__ import annotations
 
-from mpm_fem.app.estimate import Estimate, _cpu_s, _key, _Priced, _priced, _with_compile
+from mpm_fem.app.estimate import Estimate, _Priced, _priced, _with_compile
+from mpm_fem.app.estimate import estimate as _estimate
 from mpm_fem.app.sweep import Task
 
 
@@ -47,14 +48,4 @@ def tasks(name: str, options, seen: set | None = None) -> list[tuple[float, Task
 def estimate(name: str, options, seen: set | None = None) -> Estimate | None:
     """:func:`mpm_fem.app.estimate.estimate` with each case's function: the :class:`Estimate` of study
     ``name`` at ``options.tier`` with ``options``' cache; ``None`` without a cost model."""
-    found = _priced(name, options.tier)
-    if found is None:
-        return None
-    plain = _plain(found, options)
-    priced = _with_compile(plain, set() if seen is None else seen)
-    seconds = [s for s, task in priced if not task.path.exists()]
-    compiling = sum(seconds) - sum(s for s, task in plain if not task.path.exists())
-    owned = {_key(p.case) for p in found if p.owned}
-    measured = sum(_cpu_s(task.path) for _, task in priced if task.path.exists() and _key(task.case) not in owned)
-    return Estimate(len(priced), len(priced) - len(seconds), sum(seconds), max(seconds, default=0.0), measured,
-                    compiling)
+    return _estimate(name, options, seen, tasks=_plain)

@@ -158,13 +158,14 @@ def _median_group() -> float:
     return statistics.median(sum(SECONDS.get(v, 0.0) for v in vs) for vs in GROUPS.values()) if GROUPS else 0.0
 
 
-def estimate(name: str, options, seen: set | None = None) -> Estimate | None:
+def estimate(name: str, options, seen: set | None = None, tasks=None) -> Estimate | None:
     """The :class:`Estimate` of study ``name`` at ``options.tier`` with ``options``' cache; ``None`` if
-    the study does not state its cost model. ``seen``: the variants priced already by another study (updated)."""
+    the study does not state its cost model. ``seen``: the variants priced already by another study (updated);
+    ``tasks(found, options)``: the priced cases' tasks (default :func:`_plain`, each with its study's ``run_case``)."""
     found = _priced(name, options.tier)
     if found is None:
         return None
-    plain = _plain(found, options)
+    plain = (tasks or _plain)(found, options)
     priced = _with_compile(plain, set() if seen is None else seen)
     seconds = [s for s, task in priced if not task.path.exists()]
     compiling = sum(seconds) - sum(s for s, task in plain if not task.path.exists())
