@@ -4,7 +4,7 @@
 figures); :func:`section` writes ``## Two dimensions``: what was run, the figures (a convergence figure
 per solution with every basis, both amplitudes, the spread over the layouts and the FEM beside it; the
 stage bars with their control; the grid masses with their cost; time against space), then one sentence
-per claim D1-D7 setting the 2D finding beside its 1D counterpart (:data:`COUNTERPARTS`), from the
+per claim D1-D9 setting the 2D finding beside its 1D counterpart (:data:`COUNTERPARTS`), from the
 findings the report judged once (``found``). No number is typed: every one comes from a finding.
 """
 
@@ -45,6 +45,8 @@ COUNTERPARTS = {
     "D5": ((), ""),
     "D6": (("E3",), "in 1D"),
     "D7": (("C1",), "in 1D"),
+    "D8": (("C5", "C7", "C8", "C9"), "in 1D"),
+    "D9": (("C4",), "in 1D"),
 }
 #: The figures of the section, in order: (file, what it shows).
 FIGURES = ("convergence_axis.png", "convergence_vortex.png", "stages.png", "mass.png", "mass_cost.png", "time.png")
@@ -89,7 +91,7 @@ def section(found: Found, captions: dict) -> list[str]:
     if not rows or all(r["verdict"] == "not measured" for r in rows):
         return []
     lines = ['<a id="two-dimensions"></a>', "", "## Two dimensions", "", *prose(
-        "Do the 1D findings hold on the plane? " + PAGE.caption + " Each claim D1-D7 below is judged from the "
+        "Do the 1D findings hold on the plane? " + PAGE.caption + " Each claim D1-D9 below is judged from the "
         "2D study's tables by the same rule book; each is set beside its 1D counterpart.")]
     for file in FIGURES:
         if file in captions:

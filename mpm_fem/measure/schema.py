@@ -280,6 +280,28 @@ PLANE_TIME = Table("plane/time", ("solution", "h", "cfl", "refine", "study_cfl",
 PLANE_CONVERGENCE = Table("plane/convergence", ("solution", "method", "h", "runs", "ok_runs", "L2", "L2_mean",
                                                 "L2_lo", "L2_hi"))
 
+# ----------------------------------------------------------------------------- plane projection (D8, D9)
+
+#: ``studies.plane_projection``: the 2D projection errors (``mpm_fem.plane.projection``) per quantity, layout,
+#: weights, basis, particles per cell per axis ``ppc``, mesh and norm, the mean over the seeds and its spread.
+PLANE_PROJECTION_ERRORS = Table("plane_projection/errors", (
+    "quantity", "layout", "weights", "basis", "ppc", "h", "norm", "value", "spread", "min", "max", "seeds"))
+#: D8: the least-squares order over every mesh of the mean error, ``order`` in the 1D units (an extensive error,
+#: ``E_m``, ``E_P``, ``E_F``, divided by ``h``: one order below ``order_per_node``, the order of the nodal values
+#: as measured), the orders between the two coarsest and the two finest meshes and between successive meshes,
+#: the source's band and whether ``order`` lies in it.
+PLANE_PROJECTION_ORDERS = Table("plane_projection/orders", (
+    "quantity", "layout", "weights", "basis", "ppc", "norm", "order", "order_per_node", "order_coarse",
+    "order_fine", "successive", "band", "inside"))
+#: D9: per check (``cell_rho``, ``node_m``, ``node_F``), layout, ``ppc`` and mesh, the smallest bound/error over
+#: every entry of every seed, the entries and whether the bound holds on all of them.
+PLANE_PROJECTION_BOUNDS = Table("plane_projection/bounds", (
+    "check", "layout", "ppc", "h", "min_ratio", "entries", "holds"))
+#: The 2D discrepancy (``mpm_fem.plane.discrepancy``) per layout, ``ppc`` and mesh: mean, min and max over the
+#: cells and seeds, the regular pattern's closed form beside, and the cells' particle counts.
+PLANE_PROJECTION_D2 = Table("plane_projection/d2", (
+    "layout", "ppc", "h", "D2_mean", "D2_min", "D2_max", "D2_regular", "count_min", "count_max", "seeds"))
+
 # ----------------------------------------------------------------------------- built by load_tables (E3, E4, E5)
 
 #: One row per table: the code version that wrote it and its tier (:func:`mpm_fem.measure.tables.table_tier`;
@@ -299,7 +321,8 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     DRIFT,
     IDENTIFICATION_SOD, IDENTIFICATION_BURGERS, IDENTIFICATION_REFINEMENT, IDENTIFICATION_IDENTIFIED,
     MECHANISM_GROWTH, MECHANISM_SUMMARY, DEFECT, MODEL, MODEL_FIT,
-    PLANE_GROWTH, PLANE_STAGES, PLANE_BUDGET, PLANE_SHAPLEY, PLANE_MASS, PLANE_FEM, PLANE_TIME, PLANE_CONVERGENCE)}
+    PLANE_GROWTH, PLANE_STAGES, PLANE_BUDGET, PLANE_SHAPLEY, PLANE_MASS, PLANE_FEM, PLANE_TIME, PLANE_CONVERGENCE,
+    PLANE_PROJECTION_ERRORS, PLANE_PROJECTION_ORDERS, PLANE_PROJECTION_BOUNDS, PLANE_PROJECTION_D2)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.
 BUILT: dict[str, Table] = {t.name: t for t in (VERSIONS, SETTINGS)}
 

@@ -67,6 +67,9 @@ STATEMENTS = {
           "(the 1D E3)",
     "D7": "2D: time against space on one mesh: with large steps the time error dominates at second order, with "
           "the study's step refining dt changes nothing (Steffen, Kirby & Berzins 2010; the 1D C1)",
+    "D8": "2D projection: the nodal mass, momentum and force errors are O(h^p), 1 <= p <= 2, the acceleration and "
+          "velocity 0 <= p <= 1, as in 1D (the 1D C5-C9)",
+    "D9": "2D: Hickernell's particle-quadrature bound carries over to the plane with the 2D discrepancy (the 1D C4)",
 }
 
 

@@ -69,7 +69,7 @@ _add("ORDER_TOLERANCE", 0.2,
      "twice the spread of the fitted first orders over the seeded layouts of the projection study (0.96-1.05, a "
      "spread of 0.09) and less than half the gap to the next half order, so a first-order error never reads as "
      "order 0.5 or 1.5",
-     ("C1", "C5", "C6", "C7", "C8", "C9", "C10", "C13"))
+     ("C1", "C5", "C6", "C7", "C8", "C9", "C10", "C13", "D8"))
 _add("CONVERGING_ORDER", 0.7,
      "an order at or above this counts as converging (the error falls with h) on a problem with a shock and a "
      "contact, whose L1 orders stay below one",
