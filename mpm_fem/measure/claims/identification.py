@@ -93,7 +93,8 @@ def source_matching(tables: Tables, problem: str, row: str | None = None) -> lis
     if problem not in IDENTIFICATION:
         raise ValueError(f"problem {problem!r} is not one of {tuple(IDENTIFICATION)}")
     rows = [r for r in tables.get(IDENTIFICATION[problem], []) if str(r.get("matching", "")) == "True"
-            and (row is None or r.get("source_row", "") == row) and r.get("fit", "table") == "table"]
+            and (row is None or r.get("source_row", "") == row)
+            and (problem == "sod" or r.get("fit", "table") == "table")]  # Sod's candidates fit no whole table
     return sorted(rows, key=lambda r: float(r.get("rank", "inf") or "inf"))
 
 
