@@ -220,6 +220,13 @@ NOT_JUDGED = {"quick": {
                "the growth needs more of both, and the abstract quotes its orders unjudged")
        for c in ("E6a (sod)", "E6a (burgers)")},
     "E6": ("full", "the quick reproduction leaves out the defect study"),
+    "E1 (control)": ("full", _NO_BUDGET),
+    "E5 (jittered)": ("full", "the quick reproduction leaves out the remedies study"),
+    "C11 (nodes)": ("full", "the quick identification fits Sod on two meshes, above the source's levelling"),
+    **{c: ("full", "the quick plane study runs two meshes, the point mass on two layouts, the lumped and "
+                   "consistent masses; these need three meshes, six layouts, the stages, FMPM or the time step")
+       for c in ("D1 (axis-1e-4)", "D1 (axis-0.05)", "D1 (vortex)", "D2 (axis-0.05)", "D3", "D5",
+                 "D6 (axis-1e-4)", "D6 (axis-0.05)", "D6 (vortex)", "D7")},
 }}
 
 
