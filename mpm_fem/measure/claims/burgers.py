@@ -202,7 +202,8 @@ def _c13_identified(rows: list[dict], diagnosis: list[dict] | None) -> Finding:
     e, c = found["exact"], found["calculated"]
     sentence = (f"on Burgers at the identified solution the velocity error's order in h is {c['mean']:.2f} "
                 f"({c['lo']:.2f} to {c['hi']:.2f}) with the calculated acceleration and {e['mean']:.2f} "
-                f"({e['lo']:.2f} to {e['hi']:.2f}) with the exact one")
+                f"({e['lo']:.2f} to {e['hi']:.2f}) with the exact one: first order on "
+                f"{sum(o['side'] == 'above' for o in found.values())} of {len(found)} rows")
     key = short(f"Burgers' velocity order at the identified solution: {c['mean']:.2f} ({c['lo']:.2f} to "
                 f"{c['hi']:.2f}) calculated acceleration, {e['mean']:.2f} exact",
                 f"Burgers' velocity order: {c['mean']:.2f} calculated, {e['mean']:.2f} exact")

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, Finding, Tables, claim
+from mpm_fem.measure.claims.base import CONFIRMED, DIFFERS, NOT_MEASURED, PARTLY, Finding, Tables, claim, short
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, FLOOR_ORDER, GROWTH_ORDER, num, span
 from mpm_fem.measure.claims.rules import rule
 from mpm_fem.measure.errors import fitted_order
@@ -84,9 +84,13 @@ def nodal_plateau(rows: list[dict]) -> Finding:
     where = "levels off where the source's does" if verdict == CONFIRMED else (
         "keeps converging (or grows) where the source's levels" if verdict == DIFFERS
         else "levels off on some runs only")
+    level_orders = [o for v in orders["levels"].values() for o in v]
+    hits = sum(GROWTH_ORDER <= o < FLOOR_ORDER for o in level_orders)
     sentence = (f"at the identified Sod setting ({setting}) the nodal density error {where}, {span(ratios)} times "
-                "the source's")
-    return Finding(verdict, evidence, sentence, table)
+                f"the source's: it levels on {hits} of {len(level_orders)} runs and levelling steps")
+    key = short(f"at the identified Sod setting the nodal density error levels on {hits} of {len(level_orders)} runs "
+                f"and steps, {span(ratios)}x the source's")
+    return Finding(verdict, evidence, sentence, table, key=key)
 
 
 @claim("C11", source="the density error levels off near 0.0011 from h = 0.000625 (the source's L1 column)",

@@ -142,8 +142,10 @@ def _d1(solution: str):
         smooth = {b: judged.get((b, min(p1))) for b in SMOOTH}
         sentence = (f"on the {solution} solution point-mass MPM's last order at {min(p1)}x{min(p1)} per cell is "
                     f"{_order_text(first)} ({_counts_text(first['counts'])} of {first['runs']} runs), the cubic "
-                    f"B-spline's {_order_text(smooth['cubic']) if smooth['cubic'] else '-'}")
-        key = short(sentence, f"{solution}: P1's last order {_order_text(first)}, {first['verdict']}")
+                    f"B-spline's {_order_text(smooth['cubic']) if smooth['cubic'] else '-'}; P1 grows on "
+                    f"{first['counts'].get('grows', 0)} of {first['runs']} runs")
+        key = short(sentence, f"{solution}: P1's last order {_order_text(first)}, {first['verdict']}; grows on "
+                              f"{first['counts'].get('grows', 0)} of {first['runs']} runs")
         return Finding(verdict, evidence, sentence, table, key=key)
     return criterion
 
@@ -228,8 +230,11 @@ def _d2(t: Tables) -> Finding:
         sentence = (f"on the {CROSSING} solution point-mass MPM's error grows on {c['growing']} of {c['runs']} runs "
                     f"over {_pair(*pair)} (orders {_spread_text(c['mpm'])}); made exact alone, the {best} stage "
                     f"gives orders {_spread_text(c['exact'][best]['orders'])}, every stage exact "
-                    f"{_spread_text(c['exact']['all']['orders'])}")
-    return Finding(verdict, evidence, sentence, tuple(table), key=short(sentence))
+                    f"{_spread_text(c['exact']['all']['orders'])}; a stage alone turns it on "
+                    f"{sum(bool(v) for v in named.values())} of {len(named)} mesh pairs")
+    terse = (f"P1 grows on {c['growing']} of {c['runs']} runs ({_pair(*pair)}); the {best} stage exact alone: "
+             f"{_spread_text(c['exact'][best]['orders'])}") if growth else sentence
+    return Finding(verdict, evidence, sentence, tuple(table), key=short(sentence, terse))
 
 
 # ---------------------------------------------------------------- D3: the budget
@@ -265,7 +270,9 @@ def _d3(t: Tables) -> Finding:
                 f"of the gap at h = {last['h']}, interactions {last['interactions / gap']})"
                 + (f", in the control the {control[-1]['largest']} stage's (interactions "
                    f"{control[-1]['interactions / gap']})" if control else ""))
-    return Finding(verdict, evidence, sentence, tuple(table), key=short(sentence))
+    terse = (f"the stages separate on {hits} of {len(table)} budgets; the largest share is the {last['largest']} "
+             f"stage's ({last[last['largest']]} of the gap)")
+    return Finding(verdict, evidence, sentence, tuple(table), key=short(sentence, terse))
 
 
 # ---------------------------------------------------------------- D4, D5: the grid masses
@@ -311,7 +318,9 @@ def _d4(t: Tables) -> Finding:
     sentence = (f"in 2D the consistent mass changes point-mass MPM's error by a factor "
                 f"{min(ratios.values()):.2f} to {max(ratios.values()):.2f}: lumping compensates on {hits} of "
                 f"{len(ratios)} solutions and meshes") if ratios else ""
-    return Finding(verdict, evidence or "no ratio", sentence, table, key=short(sentence))
+    terse = (f"the consistent mass changes P1's error {min(ratios.values()):.2f} to {max(ratios.values()):.2f}x; "
+             f"lumping compensates on {hits} of {len(ratios)}") if ratios else ""
+    return Finding(verdict, evidence or "no ratio", sentence, table, key=short(sentence, terse))
 
 
 def mass_costs(t: Tables, reference: str = "consistent") -> dict[str, tuple[float, bool]]:
@@ -362,7 +371,10 @@ def _d5(t: Tables) -> Finding:
                 + f"; CPU per step over the consistent mass's: {cost_text}")
     sentence = (f"FMPM(k) with k <= 4 comes within {FMPM_RECOVERS:.0%} of the consistent mass's error on {hits} of "
                 f"{len(table)} solutions and meshes; against a step with the consistent mass a step costs {cost_text}")
-    return Finding(verdict, evidence, sentence, tuple(table), key=short(sentence))
+    fmpm = [x for m, (x, _) in cost.items() if m.startswith("fmpm")]
+    terse = (f"FMPM(k <= 4) within {FMPM_RECOVERS:.0%} of the consistent mass's error on {hits} of {len(table)}"
+             + (f", at {min(fmpm):.2g}-{max(fmpm):.2g}x its cost per step" if fmpm else ""))
+    return Finding(verdict, evidence, sentence, tuple(table), key=short(sentence, terse))
 
 
 # ---------------------------------------------------------------- D6: MPM against the FEM
@@ -404,7 +416,8 @@ def _d6(solution: str):
         sentence = (f"on the {solution} solution MPM's error over the FEM's on the same mesh moves by a factor "
                     + " and ".join(f"{change[m]:.2f} ({m} mass, {reading[m]})" for m in ratios)
                     + " from the coarsest mesh to the finest")
-        return Finding(verdict, evidence, sentence, table, key=short(sentence))
+        terse = "MPM / FEM moves by " + ", ".join(f"{change[m]:.3g}x ({m}, {reading[m]})" for m in ratios)
+        return Finding(verdict, evidence, sentence, table, key=short(sentence, terse))
     return criterion
 
 
@@ -453,8 +466,11 @@ def _d7(t: Tables) -> Finding:
     evidence = "; ".join(f"{r['solution']}: time/space error at CFL 0.8 {r['time error at CFL 0.8 / space error']}, "
                          f"order {r['time order at the largest step']}, at the study's step "
                          f"{r['study step change']}" for r in table)
-    sentence = ("with the time step alone refined on one mesh, " + "; ".join(
+    sentence = (f"with the time step alone refined on one mesh the readings hold on {hits} of {parts} readings: "
+                + "; ".join(
         f"{r['solution']}: the time error at CFL 0.8 is {r['time error at CFL 0.8 / space error']} times the space "
         f"error and falls at order {r['time order at the largest step']}, and at the study's step refining moves "
         f"the error by {r['study step change'].split(' ')[0]}" for r in table))
-    return Finding(verdict, evidence, sentence, tuple(table), key=short(sentence))
+    terse = f"time against space on one mesh: {hits} of {parts} readings hold; " + "; ".join(
+        f"{r['solution']} order {r['time order at the largest step']}" for r in table)
+    return Finding(verdict, evidence, sentence, tuple(table), key=short(sentence, terse))

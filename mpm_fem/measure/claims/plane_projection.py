@@ -90,5 +90,5 @@ def _d9(t: Tables) -> Finding:
                 f"({entries} entries), the smallest bound over error {ratio:.3g}")
     return Finding(verdict, f"bound >= error on {len(holding)} of {len(rows)} rows, smallest bound/error {ratio:.3g}"
                    + (f"; fails on {', '.join(failing)}" if failing else ""), sentence, table,
-                   key=short(sentence, f"the 2D bound holds on {len(holding)} of {len(rows)} rows, smallest bound "
+                   key=short(f"the 2D bound holds on {len(holding)} of {len(rows)} rows, smallest bound "
                                        f"over error {ratio:.3g}"))
