@@ -18,6 +18,7 @@ extensive nodal error divided by ``h``, and as measured per node), ``bounds.csv`
 
 from __future__ import annotations
 
+import inspect
 import sys
 from collections import defaultdict
 
@@ -157,8 +158,11 @@ def settings(tier: str) -> dict:
     t = _tier(tier)
     return {
         "tier": tier,
-        "fields": {"rho": "r(x) r(y), r = 1 + 0.5 sin(2 pi s)", "v": "(sin 2pi x cos 2pi y, cos 2pi x sin 2pi y)",
-                   "sigma": "-rho^1.4 I + 0.25 sin 2pi x sin 2pi y (e_x e_y + e_y e_x)", "domain": [[0, 1], [0, 1]]},
+        "fields": {"rho": "r(x) r(y), r a sinusoid of amplitude rho_amplitude about unity",
+                   "v": "v_amplitude (sin 2pi x cos 2pi y, cos 2pi x sin 2pi y)",
+                   "sigma": "-rho^gamma I + shear sin 2pi x sin 2pi y (e_x e_y + e_y e_x)",
+                   "constants": {k: v.default for k, v in inspect.signature(smooth_fields).parameters.items()},
+                   "domain": [[0, 1], [0, 1]]},
         "h": [1.0 / k for k in CELLS[t]], "ppc": list(PPC), "layouts": list(LAYOUTS), "seeds": SEEDS[t],
         "random": "n^2 uniform points in every cell", "jitter": 1.0,
         "advection": {"displacement": "A (sin 2pi X sin pi Y, sin pi X sin 2pi Y)", "A": DISPLACEMENT.amplitude,
@@ -169,7 +173,7 @@ def settings(tier: str) -> dict:
         "nodes": "interior nodes (whole tensor hats); norms weighted by h^2 (nodes, cells) or w_p (particles)",
         "units": "order: an extensive error (E_m, E_P, E_F) divided by h, the 1D units; order_per_node as measured",
         "exact_integrals": f"scikit-fem Gauss order {EXACT_ORDER} on the half cells (plane.exact.cell_quadrature)",
-        "discrepancy": "the modified L2 discrepancy (Hickernell 1998), the tensor-product extension of the 1D D2",
+        "discrepancy": "Hickernell's modified L2 discrepancy, the tensor-product extension of the 1D D2",
         "bands": {q: band_text(q) for q in QUANTITIES}, "tolerance": TOLERANCE,
     }
 

@@ -7,7 +7,7 @@ from claim_mutations import TABLES
 from test_plane_claims import _fem_tables, _growth
 
 from mpm_fem.app import paper_plane
-from mpm_fem.app.paper_findings import judge
+from mpm_fem.app.paper_findings import judge, key_text
 
 
 def _with_plane(p1_last: float) -> dict:
@@ -20,11 +20,15 @@ def test_the_section_sets_each_2d_finding_beside_its_1d_counterpart():
     lines = paper_plane.section(found, {"convergence_axis.png": "the caption"})
     text = "\n".join(lines)
     assert "## Two dimensions" in text and "![the caption](plane/convergence_axis.png)" in text
-    assert "D1 (axis-0.05): on the axis-0.05 solution point-mass MPM's last order" in text, text
-    e3 = found["E3"][1].sentence
-    assert e3 and e3.split(" changes by")[0] in text, e3
-    rows = paper_plane.comparison_rows(found)
+    assert "**D1 (axis-0.05)** (" in text and "axis-0.05: P1's last order -0.50 [" in text, text
+    assert '<a id="d1-axis-0.05"></a>' in text and "(APPENDIX.md#evidence-d1-axis-0.05)" in text
+    e3 = key_text(found["E3"][1], brief=True)
+    assert e3 and f"in 1D {e3}" in text, e3
+    rows = paper_plane.comparison_rows(found)  # the appendix's table: the full sentences of both
     assert {r["claim"].split("]")[0][1:] for r in rows} >= {"D1 (axis-0.05)", "D6 (vortex)", "D7"}
+    d1 = next(r for r in rows if r["claim"].startswith("[D1 (axis-0.05)]"))
+    assert d1["in 2D"].startswith("on the axis-0.05 solution point-mass MPM's last order")
+    assert "## Appendix: two dimensions beside one" in "\n".join(paper_plane.appendix(found))
 
 
 def test_a_perturbed_growth_table_changes_the_section():
@@ -34,5 +38,5 @@ def test_a_perturbed_growth_table_changes_the_section():
 
 
 def test_no_section_without_a_2d_table():
-    plain = {k: v for k, v in TABLES.items() if not k.startswith("plane/")}
+    plain = {k: v for k, v in TABLES.items() if not k.startswith("plane")}  # plane/ and plane_projection/
     assert paper_plane.section(judge(plain), {}) == []

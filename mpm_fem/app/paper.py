@@ -19,6 +19,7 @@ numbers the sections (:func:`numbered`) and gives their names in one place, as t
 
 from __future__ import annotations
 
+from mpm_fem.app.discussion import defect_section  # noqa: F401  (this module's interface)
 from mpm_fem.app.paper_abstract import (  # noqa: F401  (this module's interface)
     KEY_FIGURES,
     StageOrders,
@@ -61,6 +62,7 @@ from mpm_fem.app.paper_method import (  # noqa: F401  (this module's interface)
     method,
     rule_book,
     seeds_text,
+    settings_appendix,
     settings_table,
     sod_settings,
     terms,

@@ -8,7 +8,6 @@ state five to eight findings, each with its number, no verdict string pasted in.
 
 from __future__ import annotations
 
-from mpm_fem.app.discussion import defect_section
 from mpm_fem.app.markdown import anchor_of, bullets, figure, markdown_table, prose
 from mpm_fem.app.paper_findings import Found, _and, key_text, said, verdict_text
 from mpm_fem.app.paper_method import _study_setting
@@ -33,9 +32,9 @@ DEPARTS = (DIFFERS, REFUTED)
 #: Where the discussion measures a discrepancy's mechanism in a section of its own.
 MEASURED_ELSEWHERE = {
     "C11": "[The drift study](#drift) below measures what makes the particle error grow on the regular layout, and "
-           "[the local defect, accumulated](#defect) traces the growth on every layout to the defect of the rate L_p "
-           "at the particles, summed over the steps (E6).",
-    "C13": "[The local defect, accumulated](#defect) traces the Burgers stall to the defect of the particle "
+           "[the local defect, accumulated](APPENDIX.md#defect) traces the growth on every layout to the defect of "
+           "the rate L_p at the particles, summed over the steps (E6).",
+    "C13": "[The local defect, accumulated](APPENDIX.md#defect) traces the Burgers stall to the defect of the particle "
            "acceleration, summed over the steps (E6)."}
 
 
@@ -43,7 +42,8 @@ def discrepancies(found: Found) -> list[str]:
     """Each claim whose verdict departs from the source's statement: what was measured and why."""
     lines = ["### Where the measurements depart from the source", ""]
     order = list(STATEMENTS)
-    departing = sorted(((c, f) for c, f in found.values() if f.verdict in DEPARTS and c.study != REPRODUCTION.name),
+    departing = sorted(((c, f) for c, f in found.values() if f.verdict in DEPARTS and c.study != REPRODUCTION.name
+                        and not c.id.startswith("D")),  # the 2D claims: their own section
                        key=lambda cf: (order.index(cf[0].id), cf[0].problem))
     if not departing:
         return lines + prose("Every measured claim holds at the source's settings.")
@@ -128,8 +128,19 @@ def discussion(tables: Tables, found: Found, captions: dict, deep_found: Found |
         "about why; then the drift study, which measures the mechanism of the growth of Sod's particle error, the "
         "defect study, which predicts that error from the local defect of each step, and what the deep tier's "
         "finer meshes change. The tables behind each are in [the appendix](APPENDIX.md)."), *discrepancies(found),
-        *drift_section(tables, captions.get("drift", {})), *defect_section(tables, captions.get("defect", {})),
+        *drift_section(tables, captions.get("drift", {})), *defect_pointer(tables),
         *deep_changes(found, deep_found, deep_note)]
+
+
+def defect_pointer(tables: Tables) -> list[str]:
+    """The defect study in one paragraph of the discussion: its section is in the appendix."""
+    if not tables.get("defect/defect"):
+        return []
+    return ["### Why the particle error grows: the local defect, accumulated", "", *prose(
+        "The defect study measures, at every step, what the particle update takes from the grid against its exact "
+        "value and accumulates the difference along each particle's path; its norm predicts the particle error "
+        "without reading it. What it predicts, and the closed-form model fitted on it (E6), are in "
+        "[the appendix](APPENDIX.md#defect).")]
 
 
 def conclusions(found: Found, tables: Tables | None = None) -> list[str]:

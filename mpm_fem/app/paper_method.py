@@ -229,6 +229,12 @@ def terms(tables: Tables) -> list[str]:
     return markdown_table([{"term": t, "meaning": m} for t, m in rows]) + [""]
 
 
+def settings_appendix(tables: Tables) -> list[str]:
+    """The appendix's table of the problems' settings (:func:`settings_table`)."""
+    return ['<a id="appendix-settings"></a>', "", "## Appendix: the problems and their settings", "",
+            *settings_table(tables)]
+
+
 def method(tables: Tables, caveats: list[str]) -> list[str]:
     """The problems and settings, the terms, the source-matching settings, the verdict words and the rule book,
     the seeds, the record."""
@@ -236,7 +242,10 @@ def method(tables: Tables, caveats: list[str]) -> list[str]:
         "Each study runs its cases, writes its tables with the settings in a JSON file beside each, and draws "
         "its figures; this report only reads them. A claim's verdict is a function of the numbers in these "
         "tables, by the rules below; the tables themselves are in [the appendix](APPENDIX.md)."),
-        "### Problems and settings", "", *settings_table(tables), "### Terms", "", *terms(tables)]
+        "### Problems and settings", "", *prose(
+            "Sod's shock tube and viscous Burgers in 1D, manufactured solutions of a neo-Hookean solid in 2D; "
+            "every setting a study records, with the reason it is chosen, is in "
+            "[the appendix](APPENDIX.md#appendix-settings)."), "### Terms", "", *terms(tables)]
     lines += identification_section(tables)
     vocabulary = [{"verdict": v, "meaning": m} for v, m in VERDICT_MEANING.items()]
     vocabulary.insert(list(VERDICT_MEANING).index(PARTLY) + 1, dict(zip(("verdict", "meaning"), COUNT_MEANING,

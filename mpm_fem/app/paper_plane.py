@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from mpm_fem.app.markdown import anchor_of, figure, markdown_table, prose, readable
 from mpm_fem.app.pages import Page, View
-from mpm_fem.app.paper_findings import Found, verdict_text
+from mpm_fem.app.paper_findings import Found, key_text, verdict_text
 
 PAGE = Page("plane", "Two dimensions: the stage-by-stage analysis on the plane",
             "Point-mass MPM, uGIMP and the quadratic and cubic B-splines run the axis-aligned manufactured solution "
@@ -49,7 +49,7 @@ COUNTERPARTS = {
     "D9": (("C4",), "in 1D"),
 }
 #: The figures of the section, in order: (file, what it shows).
-FIGURES = ("convergence_axis.png", "convergence_vortex.png", "stages.png", "mass.png", "mass_cost.png", "time.png")
+FIGURES = ("convergence_axis.png", "convergence_vortex.png", "stages.png", "mass.png")
 
 
 def _said(f) -> str:
@@ -71,31 +71,46 @@ def comparison_rows(found: Found) -> list[dict]:
 
 
 def sentences_per_claim(found: Found) -> list[str]:
-    """A paragraph per 2D claim: its finding, then the 1D one it is set beside."""
-    out = []
+    """A paragraph per 2D claim (its anchor first): its verdict and key number, then (once per claim) the key
+    number of the 1D finding it is set beside, and the link to its evidence in the appendix (the full
+    sentences of both are in the appendix's table)."""
+    out, set_beside = [], set()
     for label, (c, f) in found.items():
         if not c.id.startswith("D") or f.verdict == "not measured":
             continue
         ones, words = COUNTERPARTS.get(c.id, ((), ""))
-        beside = [_said(found[one][1]) for one in ones if one in found and found[one][1].sentence]
-        text = f"{label}: {_said(f)}" + (f"; {words} {beside[0]}" if beside else "") + "."
-        out += prose(text[:1].upper() + text[1:])
+        beside = [key_text(found[one][1], brief=True) for one in ones if one in found and found[one][1].sentence
+                  and c.id not in set_beside]
+        set_beside.add(c.id)  # a claim judged per solution is set beside its 1D counterpart once
+        text = (f"**{label}** ({verdict_text(f)}): {key_text(f, brief=True)}"
+                + (f"; {words} {beside[0]}" if beside else "")
+                + f" ([evidence](APPENDIX.md#evidence-{anchor_of(label)})).")
+        out += [f'<a id="{anchor_of(label)}"></a>', "", *prose(text)]
     return out
 
 
 def section(found: Found, captions: dict) -> list[str]:
-    """``## Two dimensions``: the question, the figures of ``plane`` (``captions``: its ``{file: caption}``),
-    a sentence per 2D claim beside its 1D counterpart and the table of both (:func:`comparison_rows`);
-    nothing when no 2D claim was judged."""
+    """``## Two dimensions``: the question, the figures of ``plane`` (``captions``: its ``{file: caption}``)
+    and a sentence per 2D claim beside its 1D counterpart; nothing when no 2D claim was judged. The table of
+    both is in the appendix (:func:`appendix`)."""
     rows = comparison_rows(found)
     if not rows or all(r["verdict"] == "not measured" for r in rows):
         return []
     lines = ['<a id="two-dimensions"></a>', "", "## Two dimensions", "", *prose(
         "Do the 1D findings hold on the plane? " + PAGE.caption + " Each claim D1-D9 below is judged from the "
-        "2D study's tables by the same rule book; each is set beside its 1D counterpart.")]
+        "2D studies' tables by the same rule book and set beside its 1D counterpart; the table of both, and the "
+        "studies' tables, are in [the appendix](APPENDIX.md#appendix-two-dimensions).")]
     for file in FIGURES:
         if file in captions:
             lines += figure(PAGE.name, file, captions)
-    lines += sentences_per_claim(found)
-    lines += markdown_table(rows, ("claim", "verdict", "in 2D", "in 1D")) + [""]
-    return lines
+    return lines + sentences_per_claim(found)
+
+
+def appendix(found: Found) -> list[str]:
+    """The appendix's table of every 2D claim beside its 1D counterpart (:func:`comparison_rows`)."""
+    rows = comparison_rows(found)
+    if not rows:
+        return []
+    return ['<a id="appendix-two-dimensions"></a>', "", "## Appendix: two dimensions beside one", "",
+            *prose("Each 2D claim's finding in words beside the 1D finding it is set beside."),
+            *markdown_table(rows, ("claim", "verdict", "in 2D", "in 1D")), ""]

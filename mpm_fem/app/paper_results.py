@@ -97,8 +97,10 @@ def results(tables: Tables, found: Found, pages: list[Page], captions: dict, sum
         "say each finding in words, and each claim's evidence is a table of "
         "[the appendix](APPENDIX.md#appendix-evidence)."), *verdict_counts(found),
         "*The source's claims.*", "", *summary("C"), "", "*The extensions.*", "", *summary("E"), "",
-        "*Two dimensions.*", "", *summary("D"), ""]
-    shown_pages = [p for p in [*pages, REPRODUCTION] if claims_of(p.name)]
+        *prose("The two-dimensional claims D1-D9 are said in [their own section](#two-dimensions).")]
+    # the 2D claims are said in the report's own section (mpm_fem.app.paper_plane), their tables in the appendix
+    shown_pages = [p for p in [*pages, REPRODUCTION] if claims_of(p.name)
+                   and not all(c.id.startswith("D") for c in claims_of(p.name))]
     drawn = set(KEY_FIGURES)  # the first screen shows these
     for page in shown_pages:
         present = any(tables.get(t) for c in claims_of(page.name) for t in c.tables) \

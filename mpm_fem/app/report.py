@@ -292,7 +292,10 @@ def render_both(tables: Tables, pages, captions: dict[str, dict] | None = None, 
              f"{code_version(tables)}: each claim's verdict rule and evidence, the rule book, the source-matching "
              "settings, every study's tables and figures, the code version of each table and the deep tier.", ""]
     extra += rules_appendix(found) + paper.rule_book() + paper.evidence_appendix(found)
-    extra += paper.identification_appendix(tables) + model_appendix(tables, captions.get("defect", {}))
+    extra += paper.settings_appendix(tables)
+    extra += paper_plane.appendix(found)
+    extra += paper.identification_appendix(tables) + paper.defect_section(tables, captions.get("defect", {}))
+    extra += model_appendix(tables, captions.get("defect", {}))
     shown = [page for page in pages if any(t.startswith(page.name + "/") for t in tables)]
     for page in shown:
         extra += appendix_section("", page, tables, captions.get(page.name, {}))
