@@ -24,7 +24,9 @@ from mpm_fem.run.solve import Problem, run
 H = 0.0004  # 2,500 cells: 10,000 particles at 4 per cell, five blocks
 
 
-@pytest.mark.parametrize(("basis", "changes"), [(b, {}) for b in names()] + [
+# the smooth bases' swept variants (1.5-3 min of numba each on a cold 2-core machine) run with the slow tests
+@pytest.mark.parametrize(("basis", "changes"), [
+    pytest.param(b, {}, marks=() if b in ("mpm", "gimp") else pytest.mark.slow) for b in names()] + [
     ("mpm", {"flip": 0.99}), ("mpm", {"layout": "jittered", "seed": 3}), ("gimp", {"layout": "jittered", "seed": 1})])
 def test_the_swept_loop_equals_the_per_step_path_over_several_blocks(basis, changes, loop_steps, one_at_a_time):
     """Sod's tube on 2,500 cells to T = 0.01 (about 80 steps): each node's sums run across the
@@ -141,8 +143,10 @@ def test_the_loop_with_and_without_the_sweep_takes_the_same_steps_bit_for_bit(ba
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
 
 
-# fast: Sod (the stored rows on two threads); slow: Burgers (the point masses, a threaded variant of its own)
-@pytest.mark.parametrize("kind", ["sod", pytest.param("burgers", marks=pytest.mark.slow)])
+# both slow: each a threaded variant of its own (Sod 6 min of numba and two threads beside the other test worker);
+# the fast set keeps two threads in tests/test_fused_remedies.py and tests/test_plane_fused.py
+@pytest.mark.parametrize("kind", [pytest.param("sod", marks=pytest.mark.slow),
+                                  pytest.param("burgers", marks=pytest.mark.slow)])
 def test_the_threaded_swept_loop_equals_the_threaded_per_step_path(kind, loop_steps, one_at_a_time):
     """Two threads: the swept loop's run equals the per-step path's on two threads bit for bit (Sod
     with the particle-domain B-spline's stored rows, Burgers with the point masses)."""

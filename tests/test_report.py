@@ -76,9 +76,14 @@ def test_the_first_screen_says_when_the_figures_lag_the_code():
 
 
 def test_every_claim_is_in_the_summary(rendered):
+    """The 1D claims in the results' summary; the 2D ones (D) each a paragraph of their own section."""
     summary = rendered.split("## 3 Results")[1].split("<a id=")[0]
+    plane = rendered.split("## 4 Two dimensions")[1].split("\n## ")[0]
     for cid in STATEMENTS:
-        assert re.search(rf"^\| \[?{cid}[\] (|]", summary, re.M), cid
+        if cid.startswith("D"):
+            assert re.search(rf"^\*\*{cid}[* (]", plane, re.M), cid
+        else:
+            assert re.search(rf"^\| \[?{cid}[\] (|]", summary, re.M), cid
 
 
 def test_the_first_screen_holds_the_abstract_and_the_two_key_figures(rendered):
@@ -211,10 +216,10 @@ def test_a_folder_with_some_studies_has_a_section_for_every_claim():
 # ----------------------------------------------------------------------------- the report as a paper
 
 SECTIONS = ("## Abstract", "## 1 Introduction", "## 2 Method", "### 2.1 Problems and settings", "### 2.2 Terms",
-            "### 2.4 Verdicts and the rule book", "### 2.5 Seeds", "## 3 Results", "## 4 Discussion",
-            "### 4.2 What makes Sod's particle error grow: the drift study",
-            "### 4.3 Why the particle error grows: the local defect, accumulated", "### 4.4 What the deep tier changes",
-            "## 5 Conclusions")
+            "### 2.4 Verdicts and the rule book", "### 2.5 Seeds", "## 3 Results", "## 4 Two dimensions",
+            "## 5 Discussion", "### 5.2 What makes Sod's particle error grow: the drift study",
+            "### 5.3 Why the particle error grows: the local defect, accumulated", "### 5.4 What the deep tier changes",
+            "## 6 Conclusions")
 
 
 def test_the_sections_of_a_paper_come_in_order(rendered):
@@ -285,7 +290,7 @@ def test_a_perturbed_table_changes_the_abstract(tables):
 
 
 def test_the_conclusions_are_five_to_eight_findings_with_their_numbers(rendered):
-    block = rendered.split("## 5 Conclusions")[1].split("\n## ")[0]
+    block = rendered.split("## 6 Conclusions")[1].split("\n## ")[0]
     items = [line for line in block.splitlines() if line.startswith("- ")]
     assert 5 <= len(items) <= 8, items
     assert all(re.search(r"\d", item) for item in items), items
@@ -314,7 +319,7 @@ def test_a_finding_shows_its_table_or_its_evidence_as_a_list():
 
 
 def test_the_drift_study_is_a_section_of_the_discussion(rendered):
-    section = rendered.split("### 4.2 What makes Sod's particle error grow")[1].split("### 4.3")[0]
+    section = rendered.split("### 5.2 What makes Sod's particle error grow")[1].split("### 5.3")[0]
     assert "| study settings | regular |" in section and "volume drift" in section
     assert "drift/drift.png" in section
 
@@ -377,7 +382,7 @@ def test_a_finding_with_a_sentence_and_a_table_is_said_in_words(tables):
     assert sentence in text.split('<a id="c11"></a>')[1].split("<a id=")[0]
     evidence = extra.split('<a id="evidence-c11"></a>')[1].split("<a id=")[0]
     assert "| ppc | last order |" in evidence and "| 8 | -0.52 |" in evidence
-    assert sentence.rstrip(".") + " (C11)." in text.split("## 5 Conclusions")[1]
+    assert sentence.rstrip(".") + " (C11)." in text.split(" Conclusions\n")[1]
     assert "The evidence in full: orders 0.18, -0.24; the rest." in extra.split('<a id="rule-c11"></a>')[1]
 
 

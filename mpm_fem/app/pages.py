@@ -137,11 +137,11 @@ PAGES = (
          views=(
              View("identification/sod", "Sod: the source-matching settings of the L1 and L2 columns",
                   ("source_row", "rank", "ppc", "cfl", "quantity", "norm", "misfit", "misfit_raw", "meshes"),
-                  {"matching": "True"}, "sod.png"),
+                  {"matching": "True"}),
              View("identification/burgers", "Burgers: the source-matching settings of the exact- and the "
                   "calculated-acceleration rows", ("source_row", "rank", "solution", "dt_rule", "cfl", "ppc", "norm",
                                                   "misfit", "misfit_raw", "meshes"),
-                  {"matching": "True"}, "burgers.png"),
+                  {"matching": "True"}),
          )),
     Page("budget", "Error budget (E1) and bases (E2)",
          "Every combination of the four stages in MPM or exact form, on each mesh and basis: the error of each "

@@ -8,7 +8,7 @@ state five to eight findings, each with its number, no verdict string pasted in.
 
 from __future__ import annotations
 
-from mpm_fem.app.markdown import anchor_of, bullets, figure, markdown_table, prose
+from mpm_fem.app.markdown import anchor_of, bullets, figure, markdown_table, prose, split_outside
 from mpm_fem.app.paper_findings import Found, _and, key_text, said, verdict_text
 from mpm_fem.app.paper_method import _study_setting
 from mpm_fem.app.paper_results import REPRODUCTION
@@ -149,7 +149,9 @@ def conclusions(found: Found, tables: Tables | None = None) -> list[str]:
     chosen = [found[label] for label in CONCLUSIONS if label in found and found[label][1].verdict != "not measured"]
     reproduced = [identification.identification_sentence(tables, p) for p in identification.IDENTIFICATION
                   if tables is not None and tables.get(identification.IDENTIFICATION[p])]
-    items = (reproduced + [said(c, f) for c, f in chosen])[:MAX_CONCLUSIONS]
+    # an identification's sentence is its finding, then its particulars after a semicolon: the first only
+    items = ([split_outside(r)[0].rstrip(".") + "." for r in reproduced]
+             + [said(c, f) for c, f in chosen])[:MAX_CONCLUSIONS]
     return ["## Conclusions", "", *(bullets(items) if items else prose("No claim is measured in this folder.")),
             *prose("Every table behind these findings, each claim's evidence and verdict rule, and the rule book "
                    "are in [the appendix](APPENDIX.md).")]

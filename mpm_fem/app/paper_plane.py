@@ -65,7 +65,7 @@ def comparison_rows(found: Found) -> list[dict]:
             continue
         ones, _ = COUNTERPARTS.get(c.id, ((), ""))
         beside = [f"{one}: {_said(found[one][1])}" for one in ones if one in found and found[one][1].sentence]
-        rows.append({"claim": f"[{label}](#{anchor_of(label)})", "verdict": verdict_text(f), "in 2D": _said(f),
+        rows.append({"claim": f"[{label}](REPORT.md#{anchor_of(label)})", "verdict": verdict_text(f), "in 2D": _said(f),
                      "in 1D": "; ".join(beside) or "no 1D counterpart measured"})
     return rows
 

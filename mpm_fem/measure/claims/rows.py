@@ -102,14 +102,17 @@ def _is_number(value) -> bool:
 
 
 #: the particulars of a run's error message (where and when), removed to leave its cause
+_INVERTED = re.compile(r"^\s*J = det F = \S+ <= 0\b.*$")
 _PARTICULARS = re.compile(r"\([^)]*\)|\b(at step|in particle|at [xt]\s*=)\s*[-+0-9.e]+")
 
 
 def failure_cause(message: str) -> str:
     """The cause of a failed run, its particulars removed: ``"positivity lost at step 1317 (t=0.06) in
     particle 180 at x=0.46: ..."`` -> ``"positivity lost"``; ``"particle 0 at x=-1e-06 lies outside the grid
-    [0.0, 1.0] (1 such particles)"`` -> ``"a particle lies outside the grid [0.0, 1.0]"``."""
+    [0.0, 1.0] (1 such particles)"`` -> ``"a particle lies outside the grid [0.0, 1.0]"``; ``"J = det F = -6.8 <= 0
+    at step 7 ..."`` -> ``"a particle inverts"``."""
     text = re.split(r"[:;]", str(message), maxsplit=1)[0]
+    text = _INVERTED.sub("a particle inverts", text)  # the 2D model's "J = det F = -6.8 <= 0 at ..."
     text = re.sub(r"\bparticle \d+", "a particle", _PARTICULARS.sub("", text))
     return " ".join(text.split()) or "no message"
 
