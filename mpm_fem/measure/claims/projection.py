@@ -104,7 +104,9 @@ def _c4(t: Tables) -> Finding:
     table = tuple({"layout": lay, "fitted C": span([num(r, "C") for r in t[PROJECTION_D2_CONSTANT.name]
                                                     if r["layout"] == lay], ".3g")} for lay in layouts)
     sentence = (f"Hickernell's bound holds with the smallest bound over error {ratio:.3g}; the fitted constant C is "
-                f"{span(cs, '.3g')} against the source's {D2_C[0]:.3g}-{D2_C[1]:.3g}")
+                f"{span(cs, '.3g')} against the source's {D2_C[0]:.3g}-{D2_C[1]:.3g}: the claim holds on "
+                f"{int(ratio >= 1) + int(inside)} of 2 parts (the bound; C inside the band on "
+                f"{sum(D2_C[0] <= c <= D2_C[1] for c in cs)} of {len(cs)} fits)")
     return Finding(verdict, (f"smallest bound/error {ratio:.3g}; fitted C (jittered, random) {span(cs, '.3g')}, "
                              f"source [{D2_C[0]:.3g}, {D2_C[1]:.3g}]"), sentence, table, key=short(
         sentence, f"Hickernell's bound over error at least {ratio:.3g}; fitted C {span(cs, '.3g')} against the "

@@ -40,7 +40,8 @@ def _c1(t: Tables) -> Finding:
                    "local order of x_p": span([o for k, o in local.items() if k == (p, b)])}
                   for p, b in dict.fromkeys((p, b) for p, b, _ in fits))
     sentence = (f"the global error's order in dt is {span(fits.values())} and the local position error's "
-                f"{span(local.values())} over {len(fits)} and {len(local)} fits")
+                f"{span(local.values())} over {len(fits)} and {len(local)} fits, in the band on {total - len(off)} of "
+                f"{total} fits")
     return Finding(count_verdict(total - len(off), total), (
         f"global order in dt {span(fits.values())}, local order of x_p {span(local.values())} over "
         f"{len(fits)} global and {len(local)} local fits" + (f"; outside the band: {', '.join(off)}" if off else "")),
@@ -112,7 +113,9 @@ def _c2(t: Tables) -> Finding:
                 f"{num(p1[0], 'max_ratio_error'):.1%} over {p1[0]['crossings']} crossings, {smooth_said}"
                 + (f"; P1's global order in dt is {span([float(r['P1']) for r in table])} against "
                    f"{span([float(v) for r in table for k, v in r.items() if k in ('GIMP', 'B-spline')])} for "
-                   "the smooth bases" if table else ""))
+                   "the smooth bases" if table else "")
+                + f"; the claim holds on {int(matches) + int(no_jump) + int(bool(second))} of 3 checks (the jump, "
+                "the smooth bases, the order in dt)")
     return Finding(verdict, (
         f"P1, exact acceleration: measured/predicted median {num(p1[0], 'median_ratio'):.3f}, worst deviation "
         f"{num(p1[0], 'max_ratio_error'):.3f} over {p1[0]['crossings']} crossings; C1 bases |measured|/P1 formula "
