@@ -49,7 +49,7 @@ COUNTERPARTS = {
     "D9": (("C4",), "in 1D"),
 }
 #: The figures of the section, in order: (file, what it shows).
-FIGURES = ("convergence_axis.png", "convergence_vortex.png", "stages.png", "mass.png")
+FIGURES = ("convergence_axis.png", "stages.png")  # the others in the appendix with the studies' pages
 
 
 def _said(f) -> str:
