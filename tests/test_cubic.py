@@ -160,6 +160,9 @@ def test_the_compiled_kernels_are_the_numpy_rows():
     np.testing.assert_allclose(sums[:, 3], want.gather_gradient(v_n), atol=1e-12)
 
 
+# slow: each scheme is a loop variant of its own (1.5-3.5 CPU-min of numba on a cold cache); the cubic's compiled
+# rows stay in the fast set (test_the_compiled_kernels_are_the_numpy_rows, tests/test_walls.py's end cells)
+@pytest.mark.slow
 @pytest.mark.parametrize("scheme", ["usl", "musl"])
 def test_the_fused_step_equals_the_numpy_step_on_sod(scheme):
     """Sod's tube with the cubic basis, 0.1 in time (over 100 steps, the shock formed): the fused

@@ -62,7 +62,9 @@ def rebuilt_fe_mass(grid, basis, fields, t):
     return (E.T @ asm(_density_mass, pieces, rho=rho) @ E).tocsr()
 
 
-@pytest.mark.parametrize("basis", names())
+# the smooth bases' compiled FE-mass entries (20 s of numba each on a cold cache) with the slow tests
+@pytest.mark.parametrize("basis", [pytest.param(b, marks=pytest.mark.slow) if b in ("bspline", "cubic") else b
+                                   for b in names()])
 @pytest.mark.parametrize("case", FIELDS)
 def test_the_operator_built_once_equals_scikit_fem_assembling_from_scratch(basis, case):
     """:class:`FEMass` (scikit-fem's basis evaluated once per grid, the density summed per step)

@@ -74,7 +74,7 @@ def test_exact_stages_compiled_equal_the_numpy_step_bit_for_bit(basis, subset):
     assert _worst(reference, fused) == 0.0
 
 
-@pytest.mark.parametrize("basis", ["mpm", "gimp", "bspline", "bspline_gimp"])
+@pytest.mark.parametrize("basis", ["mpm", "gimp", pytest.param("bspline", marks=pytest.mark.slow), "bspline_gimp"])
 def test_exact_stages_compiled_on_a_uniform_grid_within_the_tolerance(basis):
     """On a uniform grid (uniform-grid arithmetic): within ``TOLERANCE`` of the numpy step over
     1,000 steps with every stage exact but the time step, and with the exact interpolation alone,

@@ -102,7 +102,8 @@ def _reduce(a):
     return speed
 
 
-@pytest.mark.parametrize(("basis", "changes"), [("mpm", {}), ("gimp", {}), ("bspline_gimp", {}),
+@pytest.mark.parametrize(("basis", "changes"), [("mpm", {}), ("gimp", {}),
+                                                pytest.param("bspline_gimp", {}, marks=pytest.mark.slow),
                                                 ("mpm", {"acceleration": "exact"})])
 def test_a_swept_burgers_loop_equals_the_per_step_path_over_several_blocks(basis, changes, loop_steps, one_at_a_time):
     """Viscous Burgers (the rarefaction, its exact data at the ends, the reservoir) on 2,500 cells,
@@ -117,9 +118,11 @@ def test_a_swept_burgers_loop_equals_the_per_step_path_over_several_blocks(basis
     assert_same_run(burgers.simulate(settings, progress=False), swept)
 
 
-# fast: one point basis and one stored-row basis on one thread, the point basis on two threads (each loop
-# without the sweep is a variant no other test compiles: 1-3 min of numba each on a cold cache); slow: the rest
-@pytest.mark.parametrize(("basis", "threads"), [("mpm", 1), ("bspline_gimp", 1), ("mpm", 2),
+# fast: one point basis and one stored-row basis on one thread (each loop without the sweep is a variant no
+# other test compiles: 1-3 min of numba each on a cold cache); slow: the rest, threads included (the fast set's
+# two-thread run is tests/test_fused_remedies.py's grid volume)
+@pytest.mark.parametrize(("basis", "threads"), [("mpm", 1), ("bspline_gimp", 1),
+                                                 pytest.param("mpm", 2, marks=pytest.mark.slow),
                                                  pytest.param("gimp", 2, marks=pytest.mark.slow),
                                                  pytest.param("bspline_gimp", 2, marks=pytest.mark.slow),
                                                  pytest.param("cubic", 3, marks=pytest.mark.slow)])
