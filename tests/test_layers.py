@@ -7,12 +7,13 @@ The layers are the folders:
    and those before it, so no cycle runs between them):
 
    a. ``mpm_fem/core/grid.py`` (the mesh every basis is defined on);
-   b. ``mpm_fem/bases/`` (the bases behind their contract, and their registry);
+   b. ``mpm_fem/bases/`` (the bases behind their contract, and their registry) and
+      ``mpm_fem/masses/`` (the grid masses behind their contract, and their registry: numpy and
+      scipy only; the 1D and the 2D step read them);
    c. ``mpm_fem/core/`` (shape, particles, transfer, the numpy step, models);
    d. ``mpm_fem/exact_stages/`` (the exact stages and their kernels; the numpy step reaches them
-      through the protocol ``core.step.ExactStages``), ``baselines/`` (all but ``baselines/exact/``),
-      which import the core only, and ``mpm_fem/masses/`` (the grid masses behind their contract,
-      and their registry; the 2D step reads them);
+      through the protocol ``core.step.ExactStages``) and ``baselines/`` (all but ``baselines/exact/``),
+      which import the core only;
    e. ``mpm_fem/fused/`` (the compiled step);
    f. ``mpm_fem/run/`` (the time loop, choosing between the numpy and the compiled step);
    g. ``mpm_fem/problems/`` (the problem set-ups, which run through the time loop);
@@ -45,7 +46,7 @@ FOLDERS = {
     "mpm_fem.core": (2, 2),
     "mpm_fem.exact_stages": (2, 3),
     "baselines": (2, 3),
-    "mpm_fem.masses": (2, 3),
+    "mpm_fem.masses": (2, 1),
     "mpm_fem.fused": (2, 4),
     "mpm_fem.run": (2, 5),
     "mpm_fem.problems": (2, 6),
@@ -147,12 +148,12 @@ def test_no_module_imports_a_higher_layer():
 
 
 def test_layer_two_packages_import_in_their_order():
-    """grid < bases < core < exact_stages, baselines < fused < run < problems: no package of layer 2
+    """grid < bases, masses < core < exact_stages, baselines < fused < run < problems: no package of layer 2
     imports one ranked at or above it (nor does any folder of another layer)."""
     found = upward(graph())
     assert not found, "\n".join(found)
     order = sorted((p for p in FOLDERS if FOLDERS[p][0] == 2), key=FOLDERS.get)
-    assert order[:3] == ["mpm_fem.core.grid", "mpm_fem.bases", "mpm_fem.core"], order
+    assert order[:4] == ["mpm_fem.core.grid", "mpm_fem.bases", "mpm_fem.masses", "mpm_fem.core"], order
     assert order[-4:] == ["mpm_fem.fused", "mpm_fem.run", "mpm_fem.problems", "mpm_fem.plane"], order
 
 

@@ -31,7 +31,7 @@ from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force
 from mpm_fem.core.shape import Shape, make_shape
-from mpm_fem.core.transfer import MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
+from mpm_fem.core.transfer import FMPM_KINDS, MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
 from mpm_fem.core.transfers import GridVelocities
 from mpm_fem.core.transfers import get as get_transfer
 from mpm_fem.core.volume import VOLUME_RATES, VOLUMES, domain_rate, grid_volume_factor
@@ -67,7 +67,8 @@ class Stages(StageSwitches):
     """Which form each stage of the step takes.
 
     ``basis``: ``"mpm"`` (point mass), ``"gimp"`` or ``"bspline"``; ``mass``: ``"lumped"``,
-    ``"consistent"`` (particle mass matrix) or ``"exact"`` (FE + lumping error removed);
+    ``"consistent"`` (particle mass matrix), ``"fmpm1"`` .. ``"fmpm4"`` (FMPM(k), the k-term series
+    of its inverse: :mod:`mpm_fem.masses.fmpm`) or ``"exact"`` (FE + lumping error removed);
     ``acceleration``: ``"calculated"`` (``F_i/m_i``) or ``"exact"`` (the problem's exact nodal
     acceleration); ``scheme``: ``"usl"``, ``"usf"`` or ``"musl"``; ``projection`` and
     ``interpolation``: ``"mpm"`` or ``"exact"``; ``refine``: the time step is ``dt / refine``.
@@ -102,6 +103,9 @@ class Stages(StageSwitches):
                 raise ValueError(f"unknown {name} {value!r}; choose one of {', '.join(allowed)}")
         if isinstance(self.refine, bool) or not isinstance(self.refine, (int, np.integer)) or self.refine < 1:
             raise ValueError(f"the time refinement must be an integer >= 1, got {self.refine!r}")
+        if self.mass in FMPM_KINDS and self.projection == "exact":
+            raise ValueError(f"the mass {self.mass} is the series of the particles' mass matrix: it runs with the MPM "
+                             "projection (projection 'mpm')")
         if self.uses_exact_fields and self.scheme == "musl":
             raise ValueError("the exact projection, mass and interpolation stages are defined for USL and USF only")
         if isinstance(self.flip, bool) or not isinstance(self.flip, (int, float, np.number)) or not 0 <= self.flip <= 1:

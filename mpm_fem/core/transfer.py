@@ -8,7 +8,9 @@ Slides, "MPM Basis Overview" and "Mass/Momentum/Force Projection Error":
 
 with the Cauchy stress ``sigma_p`` (gas: ``sigma = -p``, so ``F_i = sum_p V_p p_p G_ip``). With a
 consistent mass the nodal values solve ``M v = P`` and ``M a = F`` instead, where ``M`` is the
-particle mass matrix ``M_ij = sum_p m_p S_ip S_jp``. Interpolation back to the particles:
+particle mass matrix ``M_ij = sum_p m_p S_ip S_jp``; with FMPM(k) they are ``v = A_k P`` and
+``a = A_k F``, ``A_k`` the k-term series of ``M^-1`` (:mod:`mpm_fem.masses.fmpm`, read from the
+grid-mass registry). Interpolation back to the particles:
 
     v_p = sum_i S_ip v_i,     (dv/dx)_p = sum_i G_ip v_i.
 """
@@ -21,8 +23,15 @@ from scipy.linalg import solve_banded
 from scipy.sparse.linalg import spsolve
 
 from mpm_fem.core.shape import Shape
+from mpm_fem.masses import ORDERS, MassSystem
+from mpm_fem.masses import get as get_mass
 
-MASS_KINDS = ("lumped", "consistent")
+#: the registered FMPM(k) masses the 1D step takes (:mod:`mpm_fem.masses.fmpm`)
+FMPM_KINDS = tuple(f"fmpm{k}" for k in ORDERS)
+MASS_KINDS = ("lumped", "consistent") + FMPM_KINDS
+#: the masses that are not diagonal (FMPM(1) is the lumped mass): their stable step is the
+#: consistent mass's or larger (the series' eigenvalues lie between the two; masses.fmpm)
+COUPLED_KINDS = ("consistent",) + FMPM_KINDS[1:]
 
 
 def nodal_mass(shape: Shape, mass: np.ndarray) -> np.ndarray:
@@ -95,12 +104,22 @@ def solve_consistent(shape: Shape, mass: np.ndarray, rhs: np.ndarray) -> np.ndar
     return out
 
 
+def registered_values(shape: Shape, mass: np.ndarray, m_i: np.ndarray, rhs: np.ndarray, kind: str) -> np.ndarray:
+    """``rhs -> A rhs`` (n_nodes,) with the registered grid mass ``kind``'s solver
+    (:class:`mpm_fem.masses.GridMass`, or an instance) on the particles' rows: ``MassSystem(S, m_p, m_i)``."""
+    solve = get_mass(kind).solver(MassSystem(shape.matrix(), mass, m_i))
+    return solve(rhs[:, None])[:, 0]
+
+
 def grid_values(shape: Shape, mass: np.ndarray, m_i: np.ndarray, rhs: np.ndarray, kind: str) -> np.ndarray:
-    """Nodal values from a projected right-hand side: ``rhs/m_i`` (lumped) or ``M^{-1} rhs``."""
+    """Nodal values from a projected right-hand side: ``rhs/m_i`` (lumped), ``M^{-1} rhs``
+    (consistent) or ``A_k rhs`` (FMPM(k), :func:`registered_values`)."""
     if kind == "lumped":
         return divide_by_lumped(rhs, m_i)
     if kind == "consistent":
         return solve_consistent(shape, mass, rhs)
+    if kind in FMPM_KINDS:
+        return registered_values(shape, mass, m_i, rhs, kind)
     raise ValueError(f"unknown mass kind {kind!r}; choose one of {', '.join(MASS_KINDS)}")
 
 

@@ -15,6 +15,7 @@ from mpm_fem.core.grid import n_cells_for
 from mpm_fem.core.particles import LAYOUTS
 from mpm_fem.core.step import Stages, StageSwitches
 from mpm_fem.core.transfers import get as get_transfer
+from mpm_fem.fused.support import COMPILED_MASSES
 
 # Bytes and seconds of one run, measured and then given a margin (stated, not tuned per run):
 # the particle state plus the peak of one step is 212-250 B per particle (benchmarks/step_cost.py,
@@ -100,6 +101,7 @@ def run_cost(settings, domain: tuple[float, float], max_speed: float, dt_cap: fl
     steps = math.ceil(ratio)
     stages = settings.stages
     fused = (settings.kernel == "fused" and not (stages.uses_exact_fields or stages.reconstruct != "none")
+             and stages.mass in COMPILED_MASSES
              and compiled(stages.basis) and get_transfer(stages.transfer_name).compiled)  # else the numpy step
     return Cost(particles=n_cells * settings.ppc, nodes=n_cells + 1, steps=steps, kernel="fused" if fused else "numpy")
 

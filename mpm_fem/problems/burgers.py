@@ -33,6 +33,7 @@ from mpm_fem.core.norms import norms
 from mpm_fem.core.particles import Particles, make_particles, seed_positions
 from mpm_fem.core.shape import locate
 from mpm_fem.core.step import ACCELERATIONS, Dirichlet
+from mpm_fem.core.transfer import COUPLED_KINDS
 from mpm_fem.fused.step import check_kernel
 from mpm_fem.problems import Cost, RunSettings, check_run_settings, check_stable_cfl, relative_change, run_cost, totals
 from mpm_fem.run.solve import Problem, Result, run
@@ -196,9 +197,10 @@ def simulate(settings: BurgersSettings = BurgersSettings(), progress: bool | Non
 
 def check_stable(settings: BurgersSettings) -> None:
     """Refuse a CFL number outside the stable range (``ValueError``): (0, 1], and (0, 1/3] with
-    consistent mass and the calculated acceleration."""
-    if settings.mass == "consistent" and settings.acceleration == "calculated":
-        check_stable_cfl(settings, CFL_LIMIT_CONSISTENT, "with consistent mass and the calculated acceleration")
+    a coupled mass (the consistent one, FMPM(k >= 2)) and the calculated acceleration."""
+    if settings.mass in COUPLED_KINDS and settings.acceleration == "calculated":
+        check_stable_cfl(settings, CFL_LIMIT_CONSISTENT, f"with the {settings.mass} mass and the calculated "
+                         "acceleration")
 
 
 def cost(settings: BurgersSettings) -> Cost:

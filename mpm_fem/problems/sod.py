@@ -20,6 +20,7 @@ from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.norms import norms
 from mpm_fem.core.particles import make_particles, seed_positions
 from mpm_fem.core.step import Walls
+from mpm_fem.core.transfer import COUPLED_KINDS, FMPM_KINDS
 from mpm_fem.exact_stages import kernels
 from mpm_fem.fused.step import check_kernel
 from mpm_fem.problems import (
@@ -40,7 +41,9 @@ DOMAIN = (0.0, 1.0)
 # particles per cell, every basis and scheme): 0.5 runs and 0.6 loses positivity with lumped mass;
 # 0.25 runs and 0.3 does not with consistent mass. A run inside the range can still lose
 # positivity (1 particle per cell at 0.4 does): it then stops, naming the step.
-CFL_LIMIT = {"lumped": 0.5, "exact": 0.5, "consistent": 0.25}
+# FMPM(k) takes the consistent mass's bound (its stable step lies between the two), FMPM(1) the lumped one's.
+CFL_LIMIT = {"lumped": 0.5, "exact": 0.5, "consistent": 0.25,
+             **{kind: 0.25 if kind in COUPLED_KINDS else 0.5 for kind in FMPM_KINDS}}
 
 
 @dataclass(frozen=True)

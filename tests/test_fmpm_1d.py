@@ -1,0 +1,100 @@
+"""FMPM(k) in the 1D step: the registry's grid masses behind ``Stages.mass``.
+
+FMPM(1) is the lumped mass bit for bit; FMPM(k) tends to the consistent (particle) mass matrix as k
+grows, its error ``R^k M^-1 rhs`` bounded by ``rho(R)^k`` (``R = I - M_L^-1 M``: for P1 at 4 regular
+particles per cell ``rho(R)`` is 11/16, the FE mass's 2/3 with the integrals taken by the particles'
+midpoint rule: ``sum xi^2`` over a cell 21/16 in place of 4/3); every
+order conserves momentum to round-off; the fused step leaves it to the numpy step, and the stable
+range of a coupled mass is the consistent one's."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg as sl
+
+from mpm_fem import masses
+from mpm_fem.core.grid import uniform_grid
+from mpm_fem.core.models.euler import IdealGas
+from mpm_fem.core.particles import seed_positions
+from mpm_fem.core.shape import make_shape
+from mpm_fem.core.step import Stages
+from mpm_fem.core.transfer import FMPM_KINDS, grid_values, particle_mass_matrix, registered_values, solve_consistent
+from mpm_fem.fused import supported
+from mpm_fem.problems import burgers, sod
+
+
+def _rows(layout="jittered", seed=4, h=0.05, ppc=4, hole=False):
+    """Rows and masses of particles on [0, 1] (masses varying by 10 %); ``hole``: the particles of the
+    middle two cells removed, so that a node carries no mass."""
+    grid = uniform_grid(0.0, 1.0, h)
+    x, volume = seed_positions(grid, ppc, layout, seed)
+    if hole:
+        keep = np.abs(x - 0.5) > h
+        x, volume = x[keep], volume[keep]
+    m = volume * (1 + 0.1 * np.random.default_rng(seed).random(x.size))
+    shape = make_shape(grid, x, volume)
+    return grid, shape, m, shape.scatter(m)
+
+
+def test_fmpm1_is_the_lumped_step_bit_for_bit():
+    runs = {mass: sod.simulate(sod.SodSettings(h=0.02, ppc=4, layout="jittered", seed=2, T=0.05, mass=mass,
+                                               kernel="numpy"), progress=False) for mass in ("lumped", "fmpm1")}
+    a, b = runs["lumped"].particles, runs["fmpm1"].particles
+    for name in ("x", "velocity", "density", "energy"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    assert np.array_equal(runs["lumped"].nodal_velocity, runs["fmpm1"].nodal_velocity)
+
+
+@pytest.mark.parametrize("layout", ["regular", "jittered"])
+def test_fmpm_tends_to_the_consistent_mass_as_rho_to_the_k(layout):
+    """The series' error is R^k M^-1 rhs: in the lumped norm at most rho(R)^k of M^-1 rhs; at k = 200 the
+    nodal values equal the consistent solve's (banded, :func:`solve_consistent`) to 1e-12 relative, at
+    k = 4 they differ by more than 1e-3 (the test can fail)."""
+    grid, shape, m, m_i = _rows(layout)
+    M = particle_mass_matrix(shape, m).toarray()
+    rho = 1.0 - sl.eigvalsh(M, np.diag(m_i))[0]
+    if layout == "regular":  # equal masses would give 11/16 exactly; the 10 % mass variation moves it a little
+        assert abs(rho - 11 / 16) < 0.005, f"rho(R) = {rho:.4f}, not near 11/16"
+    rhs = np.sin(7.0 * grid.nodes) + 0.3 * np.random.default_rng(1).standard_normal(grid.n_nodes)
+    exact = solve_consistent(shape, m, rhs)
+    norm = lambda e: np.sqrt(np.sum(m_i * e**2))  # noqa: E731
+    for k in (1, 2, 3, 4, 8):
+        error = exact - registered_values(shape, m, m_i, rhs, masses.FMPM(k))
+        assert norm(error) <= rho**k * norm(exact) * (1 + 1e-9), f"k = {k}: error above rho^k"
+        if k == 4:
+            assert np.abs(error).max() / np.abs(exact).max() > 1e-3
+    far = registered_values(shape, m, m_i, rhs, masses.FMPM(200))
+    assert np.abs(far - exact).max() / np.abs(exact).max() < 1e-12
+
+
+@pytest.mark.parametrize("kind", FMPM_KINDS)
+@pytest.mark.parametrize("hole", [False, True])
+def test_every_fmpm_order_conserves_momentum_to_round_off(kind, hole):
+    """``sum_i m_i (A_k rhs)_i = sum_i rhs_i``; a node without mass gets 0."""
+    grid, shape, m, m_i = _rows(hole=hole)
+    rhs = np.cos(5.0 * grid.nodes) * (m_i > 0)
+    values = grid_values(shape, m, m_i, rhs, kind)
+    assert abs(m_i @ values - rhs.sum()) <= 1e-14 * np.abs(rhs).sum()
+    assert np.all(values[m_i == 0] == 0) and (not hole or (m_i == 0).any())
+
+
+def test_a_run_with_fmpm_takes_the_numpy_step_and_the_stages_refuse_what_it_cannot_run():
+    stages = Stages(mass="fmpm3")
+    assert "grid mass 'fmpm3'" in supported(IdealGas(1.4), stages)
+    result = sod.simulate(sod.SodSettings(h=0.05, ppc=4, T=0.02, mass="fmpm3"), progress=False)
+    assert result.kernel == "numpy" and result.steps > 0
+    assert sod.cost(sod.SodSettings(h=0.05, mass="fmpm3")).kernel == "numpy"
+    with pytest.raises(ValueError, match="the mass fmpm2 is the series of the particles' mass matrix"):
+        Stages(mass="fmpm2", projection="exact")
+    with pytest.raises(ValueError, match="unknown mass 'fmpm9'"):
+        Stages(mass="fmpm9")
+
+
+def test_a_coupled_mass_takes_the_consistent_mass_s_stable_range():
+    sod.check_stable(sod.SodSettings(mass="fmpm1", cfl=0.5))
+    with pytest.raises(ValueError, match="fmpm2"):
+        sod.check_stable(sod.SodSettings(mass="fmpm2", cfl=0.3))
+    burgers.check_stable(burgers.BurgersSettings(mass="fmpm1", cfl=0.5))
+    with pytest.raises(ValueError, match="with the fmpm4 mass and the calculated acceleration"):
+        burgers.check_stable(burgers.BurgersSettings(mass="fmpm4", cfl=0.5))
