@@ -98,3 +98,36 @@ def test_a_coupled_mass_takes_the_consistent_mass_s_stable_range():
     burgers.check_stable(burgers.BurgersSettings(mass="fmpm1", cfl=0.5))
     with pytest.raises(ValueError, match="with the fmpm4 mass and the calculated acceleration"):
         burgers.check_stable(burgers.BurgersSettings(mass="fmpm4", cfl=0.5))
+
+
+def _lumping(consistent: float, fmpm: tuple[float, ...], failed: str = "") -> dict:
+    """``lumping/errors`` of made-up runs: lumped error 1 h, consistent ``consistent`` h, FMPM(k) ``consistent``
+    times ``fmpm[k - 1]``, exact 0.5 h, on two meshes, both problems (Burgers with both accelerations); ``failed``:
+    that mass's run on the finer Sod mesh stops, naming why."""
+    from studies import lumping
+
+    factor = {"lumped": 1.0 / consistent, "consistent": 1.0, "exact": 0.5 / consistent,
+              **{f"fmpm{k}": f for k, f in enumerate(fmpm, 1)}}
+    got = {}
+    for p in ("sod", "burgers"):
+        for a in lumping.ACCELERATIONS[p]:
+            for h in (0.01, 0.005):
+                for k, m in enumerate(lumping.MASSES):
+                    e = consistent * factor[m] * h
+                    got[(p, a, h, m)] = ({"ok": False, "error": "lost positivity of the density at step 7"}
+                                         if (p, h, m) == ("sod", 0.005, failed) else
+                                         {"ok": True, "nodes": e, "particles": 2 * e, "steps": 10, "step_ms": 1.0 + k})
+    return {"lumping/errors": [{k: str(v) for k, v in row.items()} for row in lumping.rows(got)]}
+
+
+@pytest.mark.parametrize("problem", ["sod", "burgers"])
+def test_e7_follows_the_fmpm_errors_against_the_rule_and_names_a_failed_run(problem):
+    from claim_mutations import judge
+
+    near = _lumping(1.5, (1.5 ** -1, 1.2, 1.05, 1.01))
+    verdict, evidence = judge(f"E7 ({problem})", near)
+    assert verdict == "confirmed" and "fmpm3" in evidence and "fmpm2 2.5x" in evidence, evidence
+    assert judge(f"E7 ({problem})", _lumping(1.5, (1.5 ** -1, 1.4, 1.3, 1.2)))[0] == "refuted"
+    failed = judge(f"E7 ({problem})", _lumping(1.5, (1.5 ** -1, 1.2, 1.05, 1.01), failed="fmpm3"))
+    if problem == "sod":  # the finer mesh's FMPM(3) stopped: FMPM(4) still recovers it; the failure is named
+        assert failed[0] == "confirmed" and "1 of 14 runs failed (mass = fmpm3; h = 0.005): " in failed[1], failed

@@ -12,7 +12,7 @@ from mpm_fem.app.study import STUDIES, TIER_FOLDERS, StudyOptions, study_options
 
 PLANS = {"sod": "_plan", "burgers": "_plan", "budget": "plan", "remedies": "_plan", "time": "plan", "drift": "_plan",
          "defect": "plan",
-         "mechanism": "plan", "plane": "plan", "plane_projection": "plan"}
+         "mechanism": "plan", "lumping": "plan", "plane": "plan", "plane_projection": "plan"}
 
 
 def _cases(plan: dict) -> set:
@@ -123,7 +123,7 @@ def test_the_quick_reproduction_leaves_out_the_plateau_studies_and_says_so(tmp_p
     from mpm_fem.app import report, study
 
     assert study.reproduced("quick") == ("projection", "sod", "burgers", "identification", "time", "mechanism",
-                                         "plane", "plane_projection")
+                                         "lumping", "plane", "plane_projection")
     assert study.reproduced("full") == study.reproduced("deep") == study.STUDIES
     started = []
     monkeypatch.setattr(study, "run_study", lambda name, options: started.append(name))

@@ -222,6 +222,17 @@ PAGES = (
                       "order_max", "order_regular", "mpm_growing", "stops_growth", "converging_where_mpm_grows",
                       "turns_growth"), {}, "growth.png"),
          )),
+    Page("lumping", "The grid masses in 1D: lumped, consistent, exact and FMPM(k) (E7)",
+         "The same run with each grid mass, all else equal: the lumped mass, the particle mass matrix solved "
+         "(consistent), the mass stage made exact, and FMPM(k), the particle mass matrix's inverse by k terms of its "
+         "series. Sod with the study's settings (density) and Burgers' compared solution at the first eps with both "
+         "accelerations (velocity), over the nodes and over the particles; every run on the numpy step, with its "
+         "wall time per step.",
+         views=(
+             View("lumping/errors", "Per run: the errors over the nodes and the particles, and the wall time per step",
+                  ("problem", "acceleration", "h", "mass", "ok", "quantity", "norm", "nodes", "particles", "steps",
+                   "step_ms")),
+         )),
     Page("defect", "The local defect, accumulated: a prediction of the particle error",
          "The mechanism study's all-MPM runs once more on the numpy step with an observer: at every step the defect "
          "of each quantity the particle update takes from the grid (the particle acceleration, the motion, the rate "

@@ -203,7 +203,7 @@ def study_options(args: argparse.Namespace) -> StudyOptions:
 #: The studies, by name: ``studies/<name>.py``. The application loads them by name (they are the top
 #: layer and import it, never the other way round).
 STUDIES = ("projection", "sod", "burgers", "identification", "budget", "time", "remedies", "drift", "mechanism",
-           "defect", "plane", "plane_projection")
+           "lumping", "defect", "plane", "plane_projection")
 #: The studies the quick reproduction leaves out: their questions (E5, the mechanism of C11, E1 and the defect) are
 #: about the plateau of Sod's particle error, which the quick tier's meshes reach at one setting only
 #: (C11's). ``mpm-fem study NAME --quick`` still runs them. The mechanism study's small stage-exact set stays in

@@ -136,6 +136,11 @@ BURGERS_PPC = Table("burgers/ppc", (
     "steps", "error", "best_ppc"))
 BURGERS_LUMPING = Table("burgers/lumping", (
     "method", "mass", "eps", "h", "where", "L1", "L2", "max", "nodes_L2", "dt", "error"))
+#: The 1D grid masses (lumped, consistent, exact and FMPM(k)) on Sod (density L1) and Burgers (velocity L2, both
+#: accelerations; ``acceleration`` empty on Sod), every run on the numpy step; ``step_ms`` its wall time per step.
+LUMPING_ERRORS = Table("lumping/errors", (
+    "problem", "acceleration", "h", "mass", "ok", "quantity", "norm", "nodes", "particles", "steps", "step_ms"),
+    optional=("error",))
 #: One change at a time to the calculated-acceleration run (``variant``, ``changes``); ``order_L1``:
 #: the observed order of the particles' L1 error against the next coarser mesh (absent on one mesh).
 BURGERS_DIAGNOSIS = Table("burgers/diagnosis", (
@@ -320,7 +325,7 @@ TABLES: dict[str, Table] = {t.name: t for t in (
     REMEDIES_ERRORS,
     DRIFT,
     IDENTIFICATION_SOD, IDENTIFICATION_BURGERS, IDENTIFICATION_REFINEMENT, IDENTIFICATION_IDENTIFIED,
-    MECHANISM_GROWTH, MECHANISM_SUMMARY, DEFECT, MODEL, MODEL_FIT,
+    MECHANISM_GROWTH, MECHANISM_SUMMARY, DEFECT, MODEL, MODEL_FIT, LUMPING_ERRORS,
     PLANE_GROWTH, PLANE_STAGES, PLANE_BUDGET, PLANE_SHAPLEY, PLANE_MASS, PLANE_FEM, PLANE_TIME, PLANE_CONVERGENCE,
     PLANE_PROJECTION_ERRORS, PLANE_PROJECTION_ORDERS, PLANE_PROJECTION_BOUNDS, PLANE_PROJECTION_D2)}
 #: The tables :func:`mpm_fem.measure.tables.load_tables` builds from the JSON files, by name.

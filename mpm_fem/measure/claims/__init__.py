@@ -10,7 +10,7 @@ report's summary. A claim whose tables are missing is ``not measured``; no verdi
 One module per study registers its claims with :func:`claim` (:mod:`.base`, with :data:`STATEMENTS`
 and :data:`CLAIMS`): :mod:`.projection` (C4-C10), :mod:`.sod` (C3, C11, C12, C14, C15, E3),
 :mod:`.reproduce` (E4), :mod:`.burgers` (C3, C13, C15), :mod:`.time` (C1, C2), :mod:`.budget` (E1,
-E2), :mod:`.remedies` (E5), :mod:`.mechanism` (E6a), :mod:`.model` (E6), :mod:`.plane` (D1-D7) and
+E2), :mod:`.remedies` (E5), :mod:`.mechanism` (E6a), :mod:`.model` (E6), :mod:`.lumping` (E7), :mod:`.plane` (D1-D7) and
 :mod:`.plane_projection` (D8, D9); :mod:`.shared` holds the criteria of C3 and
 C15 that Sod and Burgers share, :mod:`.rows` the helpers that read rows. The tables' names and columns
 are declared once, in :mod:`mpm_fem.measure.schema` (the mechanism's in :mod:`.mechanism`, which adds
@@ -60,6 +60,7 @@ from mpm_fem.measure.claims.remedies import (
     remedy_assessment, remedy_budget)
 from mpm_fem.measure.claims.mechanism import MECHANISM_MESHES, growth_cases, summary_rows
 from mpm_fem.measure.claims.model import model_rows, ppc_needed
+from mpm_fem.measure.claims import lumping  # noqa: F401,E402  (registers E7)
 from mpm_fem.measure.claims import plane  # noqa: F401,E402  (registers D1-D7)
 from mpm_fem.measure.claims import plane_projection  # noqa: F401,E402  (registers D8, D9)
 # isort: on

@@ -216,10 +216,10 @@ _add("PLANE_MIN_MESHES", 3,
      _STUDY + ": the full tier's 4x4 and stage-exact series stop at h = 1/32 (three meshes from h = 1/8)",
      ("D1", "D2", "D6"))
 _add("FMPM_RECOVERS", 0.1,
-     "D5: FMPM(k) recovers the consistent mass's accuracy on a mesh when its particle error is within this "
+     "D5, E7: FMPM(k) recovers the consistent mass's accuracy on a mesh when its particle error is within this "
      "fraction of the consistent mass's",
      _STUDY + ": the question is whether the approximate inverse 'recovers' the consistent mass's accuracy; "
-     "10 % is well inside the factors between the masses", ("D5",))
+     "10 % is well inside the factors between the masses", ("D5", "E7"))
 _add("TIME_ORDER_2D", 2.0,
      "D7: the order in dt of the 2D step's time error (central differences, the velocity at half steps, "
      "started at t = -dt/2), counted within ORDER_TOLERANCE",
