@@ -42,7 +42,7 @@ COUNTERPARTS = {
     "D2": (("E6a (burgers)", "E6a (sod)"), "in 1D"),
     "D3": (("E1 (sod)", "E1 (burgers)"), "the 1D budget:"),
     "D4": (("C15 (burgers)", "C15 (sod)"), "in 1D"),
-    "D5": ((), ""),
+    "D5": (("E7 (sod)", "E7 (burgers)"), "in 1D"),
     "D6": (("E3",), "in 1D"),
     "D7": (("C1",), "in 1D"),
     "D8": (("C5", "C7", "C8", "C9"), "in 1D"),
