@@ -31,7 +31,15 @@ from mpm_fem.core.grid import Grid
 from mpm_fem.core.particles import Particles
 from mpm_fem.core.reconstruction import RECONSTRUCTIONS, reconstructed_force
 from mpm_fem.core.shape import Shape, make_shape
-from mpm_fem.core.transfer import FMPM_KINDS, MASS_KINDS, grid_values, nodal_internal_force, nodal_mass, nodal_momentum
+from mpm_fem.core.transfer import (
+    COUPLED_KINDS,
+    FMPM_KINDS,
+    MASS_KINDS,
+    grid_values,
+    nodal_internal_force,
+    nodal_mass,
+    nodal_momentum,
+)
 from mpm_fem.core.transfers import GridVelocities
 from mpm_fem.core.transfers import get as get_transfer
 from mpm_fem.core.volume import VOLUME_RATES, VOLUMES, domain_rate, grid_volume_factor
@@ -190,6 +198,10 @@ class Boundary(Protocol):
 class Walls:
     """Rigid walls at both ends: ``v_i = a_i = 0`` on the boundary nodes."""
 
+    def fixed_nodes(self, grid):
+        """The nodes whose values :meth:`velocity` and :meth:`acceleration` prescribe, whatever their input."""
+        return grid.boundary_nodes
+
     def velocity(self, grid, v, t):
         v = v.copy()
         v[grid.boundary_nodes] = 0.0
@@ -233,6 +245,10 @@ class Dirichlet:
             self._last.update(key=key, value=self.g(grid.nodes[b], t))
         return b, self._last["value"]
 
+    def fixed_nodes(self, grid):
+        """The nodes whose values :meth:`velocity` and :meth:`acceleration` prescribe, whatever their input."""
+        return grid.boundary_nodes
+
     def end_values(self, grid, t):
         """``g`` at the boundary nodes at ``t``, the evaluation the step uses (kept per ``t``)."""
         return self._values(grid, t)[1]
@@ -253,6 +269,19 @@ class Dirichlet:
         b, g = self._values(grid, t + dt)
         a[b] = (g - v[b]) / dt
         return a
+
+
+def prescribed(boundary: Boundary, grid: Grid, kind: str, impose: Callable[[np.ndarray], np.ndarray]):
+    """The ``fixed`` argument of :func:`~mpm_fem.core.transfer.grid_values`: ``(nodes, values)`` a boundary
+    prescribes, for a coupled mass (``COUPLED_KINDS``: its solve must see them) and a boundary that names its
+    nodes (``fixed_nodes(grid)``, as :class:`Walls` and :class:`Dirichlet`); ``impose`` applies the boundary
+    (its values at those nodes do not depend on its input: they are read off ``impose(0)``). ``None``
+    otherwise: the lumped mass has no coupling, and the boundary is imposed on the solution as before."""
+    nodes_of = getattr(boundary, "fixed_nodes", None)
+    if kind not in COUPLED_KINDS or nodes_of is None:
+        return None
+    nodes = np.asarray(nodes_of(grid))
+    return nodes, impose(np.zeros(grid.n_nodes))[nodes]
 
 
 class ExactGrid(Protocol):
@@ -320,7 +349,9 @@ def explicit_step(
     m_i = nodal_mass(shape, m)
     transfer = get_transfer(stages.transfer_name)
     P_i = transfer.momentum(shape, grid.nodes, particles.x, m, particles.velocity, particles.affine)
-    v_i = boundary.velocity(grid, grid_values(shape, m, m_i, P_i, stages.mass), t)
+    velocity_at_t = lambda u: boundary.velocity(grid, u, t)  # noqa: E731
+    v_i = velocity_at_t(grid_values(shape, m, m_i, P_i, stages.mass,
+                                    prescribed(boundary, grid, stages.mass, velocity_at_t)))
     if stages.volume == "grid":
         particles = _reset_volume(model, particles, grid_volume_factor(grid, particles.x, V, stages.basis, shape))
         V = particles.volume
@@ -345,7 +376,8 @@ def explicit_step(
             F_i = reconstructed_force(grid, particles.x, stress, stages.basis)
         else:
             F_i = nodal_internal_force(shape, V, stress)
-        a_i = grid_values(shape, m, m_i, F_i, stages.mass)
+        a_i = grid_values(shape, m, m_i, F_i, stages.mass, prescribed(
+            boundary, grid, stages.mass, lambda u: boundary.acceleration(grid, u, v_i, t, dt)))
     a_i = boundary.acceleration(grid, a_i, v_i, t, dt)
     v_new = v_i + dt * a_i
 
@@ -360,7 +392,9 @@ def explicit_step(
 
     if stages.scheme == "musl":
         P_new = transfer.momentum(shape, grid.nodes, x_old, m, velocity, affine)
-        v_new = boundary.velocity(grid, grid_values(shape, m, m_i, P_new, stages.mass), t + dt)
+        velocity_at_end = lambda u: boundary.velocity(grid, u, t + dt)  # noqa: E731
+        v_new = velocity_at_end(grid_values(shape, m, m_i, P_new, stages.mass,
+                                            prescribed(boundary, grid, stages.mass, velocity_at_end)))
     if stages.scheme in ("usl", "musl"):
         particles = _update(model, grid, particles, shape, x_n, v_new, dt, h_p, stages)
     return particles, GridState(m_i, v_i, a_i, v_new)

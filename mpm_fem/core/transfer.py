@@ -72,26 +72,52 @@ def _tridiagonal_mass(shape: Shape, mass: np.ndarray) -> tuple[np.ndarray, np.nd
     return diag, np.bincount(c, mass * S0 * S1, n)[: n - 1]
 
 
-def solve_consistent(shape: Shape, mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Solve ``M u = rhs`` with the particle mass matrix; nodes with no mass get 0.
+Fixed = tuple  # (nodes (k,) int, values (k,)): nodal values a boundary prescribes
+
+
+def _coupling(shape: Shape, mass: np.ndarray, fixed: Fixed | None, tridiagonal: bool, n: int):
+    """``(M u_E, is_fixed)``: the particle mass matrix times the vector holding the prescribed values at their
+    nodes (0 elsewhere), and the mask of those nodes; ``(0, none)`` without ``fixed``."""
+    is_fixed = np.zeros(n, dtype=bool)
+    if fixed is None:
+        return 0.0, is_fixed
+    nodes, values = fixed
+    is_fixed[nodes] = True
+    u = np.zeros(n)
+    u[nodes] = values
+    if not tridiagonal:
+        return particle_mass_matrix(shape, mass) @ u, is_fixed
+    diag, upper = _tridiagonal_mass(shape, mass)
+    Mu = diag * u
+    Mu[:-1] += upper * u[1:]
+    Mu[1:] += upper * u[:-1]
+    return Mu, is_fixed
+
+
+def solve_consistent(shape: Shape, mass: np.ndarray, rhs: np.ndarray, fixed: Fixed | None = None) -> np.ndarray:
+    """Solve ``M u = rhs`` with the particle mass matrix; nodes with no mass get 0. With ``fixed`` (nodes,
+    values) those nodes take the prescribed values and the free rows ``F`` solve ``M_FF u_F = rhs_F - M_FE
+    u_E``: the wall or Dirichlet condition imposed on the system, not on its solution.
 
     For P1 the matrix is tridiagonal and is solved banded; otherwise by sparse LU.
     """
     out = np.zeros_like(rhs)
     tridiagonal = shape.nodes.shape[1] == 2 and np.array_equal(shape.nodes[:, 1], shape.nodes[:, 0] + 1)
+    coupling, is_fixed = _coupling(shape, mass, fixed, tridiagonal, out.size)
+    rhs = rhs - coupling if fixed is not None else rhs
     try:
         if tridiagonal:
             diag, upper = _tridiagonal_mass(shape, mass)
-            active = np.flatnonzero(diag > 0)
+            active = np.flatnonzero((diag > 0) & ~is_fixed)
             ab = np.zeros((3, active.size))
             ab[1] = diag[active]
-            # neighbours across a node without mass are not coupled
+            # neighbours across a node without mass (or a prescribed one) are not coupled
             ab[0, 1:] = np.where(np.diff(active) == 1, upper[active[:-1]], 0.0)
             ab[2, :-1] = ab[0, 1:]
             out[active] = solve_banded((1, 1), ab, rhs[active])
         else:
             M = particle_mass_matrix(shape, mass)
-            active = np.asarray(M.diagonal()) > 0
+            active = (np.asarray(M.diagonal()) > 0) & ~is_fixed
             out[active] = spsolve(M[active][:, active].tocsc(), rhs[active])
         singular = not np.all(np.isfinite(out))
     except np.linalg.LinAlgError:
@@ -101,25 +127,35 @@ def solve_consistent(shape: Shape, mass: np.ndarray, rhs: np.ndarray) -> np.ndar
             "the consistent particle mass matrix is singular (too few particles in some cells); "
             "use the lumped mass or more particles per cell"
         )
+    if fixed is not None:
+        out[fixed[0]] = fixed[1]
     return out
 
 
-def registered_values(shape: Shape, mass: np.ndarray, m_i: np.ndarray, rhs: np.ndarray, kind: str) -> np.ndarray:
+def registered_values(shape: Shape, mass: np.ndarray, m_i: np.ndarray, rhs: np.ndarray, kind,
+                      fixed: Fixed | None = None) -> np.ndarray:
     """``rhs -> A rhs`` (n_nodes,) with the registered grid mass ``kind``'s solver
-    (:class:`mpm_fem.masses.GridMass`, or an instance) on the particles' rows: ``MassSystem(S, m_p, m_i)``."""
-    solve = get_mass(kind).solver(MassSystem(shape.matrix(), mass, m_i))
-    return solve(rhs[:, None])[:, 0]
+    (:class:`mpm_fem.masses.GridMass`, or an instance) on the particles' rows: ``MassSystem(S, m_p, m_i)``;
+    with ``fixed`` (nodes, values) its :meth:`~mpm_fem.masses.GridMass.constrained_solver`."""
+    grid_mass, system = get_mass(kind), MassSystem(shape.matrix(), mass, m_i)
+    if fixed is None:
+        return grid_mass.solver(system)(rhs[:, None])[:, 0]
+    nodes, values = fixed
+    return grid_mass.constrained_solver(system, nodes)(rhs[:, None], np.asarray(values, dtype=float)[:, None])[:, 0]
 
 
-def grid_values(shape: Shape, mass: np.ndarray, m_i: np.ndarray, rhs: np.ndarray, kind: str) -> np.ndarray:
+def grid_values(shape: Shape, mass: np.ndarray, m_i: np.ndarray, rhs: np.ndarray, kind: str,
+                fixed: Fixed | None = None) -> np.ndarray:
     """Nodal values from a projected right-hand side: ``rhs/m_i`` (lumped), ``M^{-1} rhs``
-    (consistent) or ``A_k rhs`` (FMPM(k), :func:`registered_values`)."""
+    (consistent) or ``A_k rhs`` (FMPM(k), :func:`registered_values`). ``fixed`` (nodes, values): the
+    values a boundary prescribes, imposed on the coupled masses' systems (the lumped mass has no coupling:
+    the caller imposes them after the division, as without ``fixed``)."""
     if kind == "lumped":
         return divide_by_lumped(rhs, m_i)
     if kind == "consistent":
-        return solve_consistent(shape, mass, rhs)
+        return solve_consistent(shape, mass, rhs, fixed)
     if kind in FMPM_KINDS:
-        return registered_values(shape, mass, m_i, rhs, kind)
+        return registered_values(shape, mass, m_i, rhs, kind, fixed)
     raise ValueError(f"unknown mass kind {kind!r}; choose one of {', '.join(MASS_KINDS)}")
 
 

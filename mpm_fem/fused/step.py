@@ -26,7 +26,7 @@ from mpm_fem.core.models.euler import IdealGas
 from mpm_fem.core.particles import Particles, PositivityError
 from mpm_fem.core.reconstruction import OFFSETS, force_quadrature
 from mpm_fem.core.shape import Shape, basis_integrals, make_shape
-from mpm_fem.core.step import SCHEMES, Dirichlet, GridState, Stages, Walls, at_times
+from mpm_fem.core.step import SCHEMES, Dirichlet, GridState, Stages, Walls, at_times, prescribed
 from mpm_fem.core.transfer import solve_consistent
 from mpm_fem.core.transfers import get as get_transfer
 from mpm_fem.core.xpic import boundary_change_rule
@@ -163,10 +163,13 @@ class FusedStep:
             a = pool[name] = np.empty(shape, dtype)
         return a
 
-    def _solve(self, shape, mass, m_i, rhs, name="v_solved"):
+    def _solve(self, shape, mass, m_i, rhs, name="v_solved", impose=None):
+        """The numpy step's nodal solve (``impose``: the boundary it then applies, whose prescribed values a
+        coupled mass's system takes: :func:`~mpm_fem.core.step.prescribed`)."""
         if self.stages.mass == "lumped":
             return _divide_by_lumped(rhs, m_i, self._empty(name, m_i.shape))
-        return solve_consistent(shape, mass, rhs)
+        fixed = prescribed(self.boundary, self.grid, self.stages.mass, impose) if impose is not None else None
+        return solve_consistent(shape, mass, rhs, fixed)
 
     def _positivity(self, flags, values, x):
         """Raise :class:`PositivityError` as the numpy model would (factor first, then energy)."""
@@ -378,7 +381,8 @@ class FusedStep:
         rows, S, G, cell = shape.nodes, shape.S, shape.G, shape.cell
         if affine is not None and particles.affine is not None:
             affine.momentum(self.nodes, rows, S, x, m, particles.affine, P_i)
-        v_i = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_i), t)
+        velocity_at_t = lambda u: self.boundary.velocity(grid, u, t)  # noqa: E731
+        v_i = velocity_at_t(self._solve(shape, m, m_i, P_i, impose=velocity_at_t))
         shape_args = (geometry, x, RowStore(rows, S, G, cell))
         if grid_volume:  # the volume reset (mpm_fem.core.volume), then the force of the reset state
             V, rho, p = self._grid_volume(geometry, RowStore(rows, S, G, cell), x, V, m, rho, e, p, chunks)
@@ -410,7 +414,8 @@ class FusedStep:
         elif self.slides:
             a_i = self.model.grid_acceleration(grid, cell, v_i)
         else:
-            a_i = self._solve(shape, m, m_i, F_i, "a_solved")
+            a_i = self._solve(shape, m, m_i, F_i, "a_solved",
+                              impose=lambda u: self.boundary.acceleration(grid, u, v_i, t, dt))
         a_i = self.boundary.acceleration(grid, a_i, v_i, t, dt)
         v_n = v_i + dt * a_i
 
@@ -437,7 +442,8 @@ class FusedStep:
         if musl:
             if affine is not None:
                 affine.momentum(self.nodes, rows, S, x, m, C_new, P_musl)
-            v_n = self.boundary.velocity(grid, self._solve(shape, m, m_i, P_musl, "v_musl"), t + dt)
+            velocity_at_end = lambda u: self.boundary.velocity(grid, u, t + dt)  # noqa: E731
+            v_n = velocity_at_end(self._solve(shape, m, m_i, P_musl, "v_musl", impose=velocity_at_end))
             self.finish(geometry, shape_args[2], v_n, old, new, dt, self.consts, chunks, checks)
         if usl or musl:
             if (flags[:, :2] >= 0).any():

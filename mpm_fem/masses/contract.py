@@ -64,6 +64,13 @@ class GridMass(ABC):
     def solver(self, system: MassSystem) -> Solve:
         """``rhs -> M^-1 rhs`` for right-hand sides (n_nodes, d); nodes without mass (``m_i = 0``) get 0."""
 
+    def constrained_solver(self, system: MassSystem, fixed: np.ndarray) -> Callable[[np.ndarray, np.ndarray],
+                                                                                       np.ndarray]:
+        """``(rhs, values) -> u`` with ``u[fixed] = values`` prescribed (a wall, a Dirichlet end) and the free
+        rows ``F`` solving ``M_FF u_F = rhs_F - M_F,fixed values`` (or the mass's approximation of it); a mass
+        that has none refuses (``NotImplementedError``)."""
+        raise NotImplementedError(f"the grid mass {self.name!r} has no solve with prescribed nodal values")
+
     def __repr__(self) -> str:
         return f"<grid mass {self.name}>"
 

@@ -28,6 +28,8 @@ as ``k`` grows, from the lumped one toward the consistent one (P1, 2 x 2 regular
 
 from __future__ import annotations
 
+import numpy as np
+
 from mpm_fem.masses.contract import GridMass, MassSystem, Solve, lumped_solve, particle_product
 
 ORDERS = (1, 2, 3, 4)  # the orders registered (fmpm1 .. fmpm4)
@@ -49,6 +51,27 @@ def series(system: MassSystem, order: int) -> Solve:
     return solve
 
 
+def constrained_series(system: MassSystem, order: int, fixed: np.ndarray):
+    """``(rhs, values) -> u``: (1) with the nodal values ``u[fixed] = values`` prescribed, as the Richardson
+    iteration that sums the series, ``u_0 = M_L^-1 rhs``, ``u_j = u_{j-1} + M_L^-1 (rhs - M u_{j-1})``, with the
+    prescribed values imposed on every iterate (so ``u_{k-1} = A_k rhs`` where nothing is prescribed). Order 1 is
+    the lumped solve with the values imposed after it; as ``k`` grows ``u`` tends to the constrained solve
+    ``M_FF u_F = rhs_F - M_F,fixed values`` on the free nodes ``F``, wherever the series converges (the lumped
+    masses of the free nodes bound the row sums of ``M_FF``)."""
+    lumped = lumped_solve(system.m_i)
+    product = particle_product(system) if order > 1 else None
+
+    def solve(rhs, values):
+        u = lumped(rhs)
+        u[fixed] = values
+        for _ in range(order - 1):
+            u = u + lumped(rhs - product(u))
+            u[fixed] = values
+        return u
+
+    return solve
+
+
 class FMPM(GridMass):
     """FMPM(k) of order ``k >= 1`` (module docstring)."""
 
@@ -64,3 +87,6 @@ class FMPM(GridMass):
 
     def solver(self, system: MassSystem) -> Solve:
         return series(system, self.order)
+
+    def constrained_solver(self, system: MassSystem, fixed: np.ndarray):
+        return constrained_series(system, self.order, fixed)
