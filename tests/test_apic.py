@@ -85,9 +85,10 @@ def _wave_run(basis, scheme, kernel, grid, steps=200):
 
 _FIELDS = ("x", "velocity", "volume", "density", "energy", "pressure", "affine")
 
-#: besides the point mass's three schemes, USL with uGIMP and the particle-domain B-spline; the smooth bases'
-#: APIC loops (0.5-1 CPU-min of numba each on a cold cache) and the other schemes run with the slow tests
-FAST_USL = {("usl", "gimp"), ("usl", "bspline_gimp")}
+#: besides the point mass's three schemes, USL with uGIMP; the smooth bases' APIC loops (0.5-1 CPU-min of numba
+#: each on a cold cache), the particle-domain B-spline's (its pass 1 alone 1-1.5 CPU-min) and the other schemes run
+#: with the slow tests
+FAST_USL = {("usl", "gimp")}
 
 
 @pytest.mark.parametrize(("basis", "scheme"), [

@@ -113,13 +113,17 @@ def test_exact_stages_without_exact_fields_stop_with_a_message():
         Stages(interpolation="exact", scheme="musl")
 
 
-@pytest.mark.parametrize("basis", ["mpm", "bspline_gimp"])
-def test_every_stage_exact_leaves_the_time_error_of_the_step(basis):
+# the particle-domain B-spline on the numpy step in the fast set; its compiled plain run (a Burgers loop variant
+# of its own, its pass 1 with the stored rows alone 1-1.5 CPU-min of numba on a cold cache) with the slow tests
+@pytest.mark.parametrize(("basis", "kernel"), [("mpm", "fused"), ("bspline_gimp", "numpy"),
+                                               pytest.param("bspline_gimp", "fused", marks=pytest.mark.slow)])
+def test_every_stage_exact_leaves_the_time_error_of_the_step(basis, kernel):
     """Burgers (h = 0.02): with every stage exact the remainder is first order in dt (halves when
     dt halves) and its dt -> 0 extrapolation is below 2% of it: no other error is left. The
     particle-domain B-spline too: its stage switches remove its projection, mass and
     interpolation errors as they do the point-mass ones."""
-    base = burgers.BurgersSettings(h=0.02, projection="exact", mass="exact", interpolation="exact", basis=basis)
+    base = burgers.BurgersSettings(h=0.02, projection="exact", mass="exact", interpolation="exact", basis=basis,
+                                   kernel=kernel)
     runs = {k: burgers.simulate(replace(base, refine=k), progress=False) for k in (1, 2)}
     points = np.linspace(0.1, 1.9, 4001)
 
@@ -134,7 +138,7 @@ def test_every_stage_exact_leaves_the_time_error_of_the_step(basis):
     assert 1.8 < ratio < 2.2, f"remainder at dt {l1(e1):.3g}, at dt/2 {l1(e2):.3g}: ratio {ratio:.3f}"
     extrapolated = l1(2 * e2 - e1)
     assert extrapolated < 0.02 * l1(e1), f"dt -> 0 remainder {extrapolated:.3g} vs {l1(e1):.3g} at dt"
-    mpm = burgers.simulate(burgers.BurgersSettings(h=0.02, basis=basis), progress=False)
+    mpm = burgers.simulate(burgers.BurgersSettings(h=0.02, basis=basis, kernel=kernel), progress=False)
     assert field_difference(mpm.particles, runs[1].particles, (0.1, 1.9)) > 0.1 * l1(e1) / 1.8
 
 
@@ -237,11 +241,15 @@ def test_time_exact_is_the_dt_to_zero_extrapolation():
     assert l1(NONE) < 0.05 * l1(frozenset({"time"})), (l1(NONE), l1(frozenset({"time"})))
 
 
-def test_the_particle_domain_bspline_runs_every_subset_and_its_shapley_values_add_up():
+# the numpy step in the fast set; the compiled runs (the particle-domain B-spline's Sod loop and exact stages,
+# its pass 1 with the stored rows alone 1-1.5 CPU-min of numba on a cold cache) with the slow tests
+@pytest.mark.parametrize("kernel", ["numpy", pytest.param("fused", marks=pytest.mark.slow)])
+def test_the_particle_domain_bspline_runs_every_subset_and_its_shapley_values_add_up(kernel):
     """E5's closest remedy, the B-spline averaged over the particle domain, in the budget: the
     sixteen subsets run (Sod, h = 0.05), its stages change the error, the Shapley values add up to
     v(all MPM) - v(all exact), and its all-MPM run is the remedy's plain run, bit for bit."""
     h, settings = SMALL["sod"]
+    settings = {**settings, "kernel": kernel}
     fields, weights, points, runs = study.subset_fields("sod", h, "bspline_gimp", settings)
     assert fields is not None and all(r["ok"] for r in runs)
     for norm, w in weights.items():

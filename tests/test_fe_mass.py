@@ -80,7 +80,9 @@ def test_the_operator_built_once_equals_scikit_fem_assembling_from_scratch(basis
     assert fe_mass_operator(grid, kernel) is fe_mass_operator(grid, kernel)  # built once
 
 
-@pytest.mark.parametrize("basis", names())
+# the cubic's compiled FE-mass entries (20-30 s of numba on a cold cache) with the slow tests; the point mass's and
+# the quadratic's compile for tests/test_budget.py's exact projection anyway
+@pytest.mark.parametrize("basis", [pytest.param(b, marks=pytest.mark.slow) if b == "cubic" else b for b in names()])
 @pytest.mark.parametrize("case", FIELDS)
 def test_scikit_fem_mass_equals_the_particle_matrix_on_gauss_points(basis, case):
     """Particles at the Gauss points of :func:`quadrature`, of mass ``w_q rho(x_q)``, give the

@@ -167,11 +167,14 @@ def test_the_reservoir_is_quiet_exactly_where_it_returns_the_particles_unchanged
     assert burgers.Reservoir(s, None, weights="cell").quiet(grid) is None
 
 
+# slow: the grid volume with the Taylor force on USL, a loop variant no other fast test compiles (10-20 CPU-s of
+# numba on a cold cache)
 @pytest.mark.parametrize(("scheme", "remedy", "runs"), [
     ("usl", {}, {"PROJECT", "MOVE"}),
     ("usf", {}, {"PROJECT", "MOVE", "UPDATE"}),
     ("musl", {"xpic": 3}, {"PROJECT", "MOVE", "FINISH", "XPIC"}),
-    ("usl", {"volume": "grid", "reconstruct": "taylor"}, {"PROJECT", "MOVE", "VOLUME", "GAS_FORCE", "TAYLOR"})])
+    pytest.param("usl", {"volume": "grid", "reconstruct": "taylor"},
+                 {"PROJECT", "MOVE", "VOLUME", "GAS_FORCE", "TAYLOR"}, marks=pytest.mark.slow)])
 def test_a_loop_variant_carries_only_the_passes_its_run_takes(scheme, remedy, runs, loop_steps, monkeypatch):
     """The scheme and the remedies are compile-time constants of the loop: a plain USL run's loop
     compiles pass 1 and pass 2 only, and each scheme or remedy adds its own passes, no other (the

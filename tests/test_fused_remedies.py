@@ -80,7 +80,8 @@ def _compare(case, stages, steps):
 
 
 # each case compiles its basis' passes for its model and schemes: the default run keeps to the gas
-# with the point mass and the particle-domain B-spline (USL, MUSL); the rest run with -m slow
+# with the point mass (USL, MUSL); the rest run with -m slow, the particle-domain B-spline's too (its
+# pass 1 with the stored rows alone takes 1-1.5 CPU-min of numba on a cold cache)
 SLOW = pytest.mark.slow
 
 
@@ -91,18 +92,17 @@ SLOW = pytest.mark.slow
     (dict(xpic=3), "usl", "lumped", "walls"),
     (dict(xpic=2), "musl", "consistent", "piston"),
     pytest.param(dict(xpic=5), "usl", "lumped", "burgers", marks=SLOW),
-    (dict(basis="bspline_gimp"), "usl", "lumped", "walls"),
+    pytest.param(dict(basis="bspline_gimp"), "usl", "lumped", "walls", marks=SLOW),
     pytest.param(dict(basis="bspline_gimp"), "usf", "consistent", "burgers", marks=SLOW),
-    (dict(basis="bspline_gimp", xpic=5), "musl", "lumped", "piston"),
+    pytest.param(dict(basis="bspline_gimp", xpic=5), "musl", "lumped", "piston", marks=SLOW),
     pytest.param(dict(basis="bspline_gimp", flip=0.9), "usl", "lumped", "burgers", marks=SLOW),
     (dict(volume="grid"), "usl", "lumped", "walls"),
     pytest.param(dict(volume="grid"), "usf", "consistent", "piston", marks=SLOW),
     pytest.param(dict(volume="grid", basis="gimp"), "musl", "lumped", "burgers", marks=SLOW),
-    # volume + particle-domain B-spline + XPIC: the fast set has it through the loop (Sod, walls; and
-    # the loop against the per-step path, MUSL); with a piston it compiles its own variants, ~100 s cold
+    # volume + particle-domain B-spline + XPIC: with a piston it compiles its own variants, ~100 s cold
     pytest.param(dict(volume="grid", basis="bspline_gimp", xpic=2), "usl", "lumped", "piston", marks=SLOW),
     (dict(reconstruct="taylor"), "usl", "lumped", "walls"),
-    (dict(reconstruct="taylor", basis="bspline_gimp"), "musl", "consistent", "piston"),
+    pytest.param(dict(reconstruct="taylor", basis="bspline_gimp"), "musl", "consistent", "piston", marks=SLOW),
     pytest.param(dict(reconstruct="taylor", volume="grid"), "usf", "lumped", "piston", marks=SLOW),
     pytest.param(dict(reconstruct="taylor"), "usf", "consistent", "burgers", marks=SLOW),
     pytest.param(dict(reconstruct="taylor", basis="bspline", volume="grid"), "usl", "lumped", "burgers", marks=SLOW),
@@ -122,12 +122,14 @@ def test_the_blend_changes_the_step():
     assert np.allclose(runs["pic"], runs["xpic1"], rtol=0, atol=1e-14)
 
 
-# slow: the volume reset with the particle-domain B-spline and XPIC, a USL loop variant of its own (its MUSL
-# loop is in the fast set: the loop against the per-step path below)
-@pytest.mark.parametrize("remedy", [dict(flip=0.99), dict(basis="bspline_gimp"), dict(xpic=5), dict(volume="grid"),
+# slow: the particle-domain B-spline's loops (its pass 1 with the stored rows alone 1-1.5 CPU-min of numba on a
+# cold cache; the volume reset with it and XPIC a USL loop variant of its own)
+@pytest.mark.parametrize("remedy", [dict(flip=0.99), pytest.param(dict(basis="bspline_gimp"), marks=SLOW),
+                                    dict(xpic=5), dict(volume="grid"),
                                     pytest.param(dict(volume="grid", basis="bspline_gimp", xpic=2), marks=SLOW),
                                     dict(reconstruct="taylor"),
-                                    dict(reconstruct="taylor", volume="grid", basis="bspline_gimp")])
+                                    pytest.param(dict(reconstruct="taylor", volume="grid", basis="bspline_gimp"),
+                                                 marks=SLOW)])
 def test_sod_through_the_compiled_loop_equals_the_numpy_step(remedy, loop_steps):
     """Sod's tube with the CFL step: every remedy runs in the compiled loop (every step but the first)."""
     settings = dict(h=0.02, ppc=4, T=0.05, cfl=0.3, **remedy)
@@ -143,7 +145,7 @@ def test_sod_through_the_compiled_loop_equals_the_numpy_step(remedy, loop_steps)
 @pytest.mark.parametrize(("remedy", "scheme", "case"), [
     (dict(xpic=3), "usl", "walls"),
     (dict(volume="grid"), "usf", "piston"),
-    (dict(volume="grid", basis="bspline_gimp", xpic=2), "musl", "walls"),
+    pytest.param(dict(volume="grid", basis="bspline_gimp", xpic=2), "musl", "walls", marks=SLOW),
     pytest.param(dict(xpic=5, basis="bspline_gimp"), "musl", "piston", marks=SLOW),
     pytest.param(dict(volume="grid", basis="bspline"), "usl", "walls", marks=SLOW),
     pytest.param(dict(xpic=5), "usl", "burgers", marks=SLOW),
@@ -229,8 +231,9 @@ def test_threads_with_the_remedies_agree_to_round_off_and_repeat_exactly():
         assert np.array_equal(v, getattr(again.particles, name)), f"{name} changes from run to run"
 
 
-# fast: the one two-thread run of the fast set (the parallel passes of the point mass and its volume
-# reset compile in about a minute); the other thread tests are slow
+# slow: the parallel passes of the point mass and its volume reset, and their threaded loop, compile in
+# 1-1.5 CPU-min on a cold cache; the fast set's two-thread run in 1D is tests/test_fused_sweep.py's refused step
+@pytest.mark.slow
 def test_the_grid_volume_on_two_threads_in_the_loop_agrees_with_one_thread_and_leaves_the_input_alone():
     """The point mass with the grid volume reset, between walls (the compiled loop), on two threads:
     a parallel variant of the reset once gave NaN particles when the loop called it (after 45 steps,

@@ -24,10 +24,12 @@ from mpm_fem.run.solve import Problem, run
 H = 0.0004  # 2,500 cells: 10,000 particles at 4 per cell, five blocks
 
 
-# the smooth bases' swept variants (1.5-3 min of numba each on a cold 2-core machine) run with the slow tests
+# the smooth bases' swept variants (1.5-3 min of numba each on a cold 2-core machine) run with the slow tests, and
+# uGIMP's on the jittered layout (its rows one node wider: a variant of its own, 20-30 CPU-s)
 @pytest.mark.parametrize(("basis", "changes"), [
     pytest.param(b, {}, marks=() if b in ("mpm", "gimp") else pytest.mark.slow) for b in names()] + [
-    ("mpm", {"flip": 0.99}), ("mpm", {"layout": "jittered", "seed": 3}), ("gimp", {"layout": "jittered", "seed": 1})])
+    ("mpm", {"flip": 0.99}), ("mpm", {"layout": "jittered", "seed": 3}),
+    pytest.param("gimp", {"layout": "jittered", "seed": 1}, marks=pytest.mark.slow)])
 def test_the_swept_loop_equals_the_per_step_path_over_several_blocks(basis, changes, loop_steps, one_at_a_time):
     """Sod's tube on 2,500 cells to T = 0.01 (about 80 steps): each node's sums run across the
     blocks' edges, the rows of the particle-domain bases are stored block by block, and the loop's
@@ -118,10 +120,10 @@ def test_a_swept_burgers_loop_equals_the_per_step_path_over_several_blocks(basis
     assert_same_run(burgers.simulate(settings, progress=False), swept)
 
 
-# fast: one point basis and one stored-row basis on one thread (each loop without the sweep is a variant no
-# other test compiles: 1-3 min of numba each on a cold cache); slow: the rest, threads included (the fast set's
-# two-thread run is tests/test_fused_remedies.py's grid volume)
-@pytest.mark.parametrize(("basis", "threads"), [("mpm", 1), ("bspline_gimp", 1),
+# fast: the point mass on one thread (each loop without the sweep is a variant no other test compiles: 1-3 min
+# of numba each on a cold cache); slow: the rest, the stored-row basis and threads included (the fast set's
+# two-thread run in 1D is the refused step in the second chunk, the last test here)
+@pytest.mark.parametrize(("basis", "threads"), [("mpm", 1), pytest.param("bspline_gimp", 1, marks=pytest.mark.slow),
                                                  pytest.param("mpm", 2, marks=pytest.mark.slow),
                                                  pytest.param("gimp", 2, marks=pytest.mark.slow),
                                                  pytest.param("bspline_gimp", 2, marks=pytest.mark.slow),
@@ -147,7 +149,7 @@ def test_the_loop_with_and_without_the_sweep_takes_the_same_steps_bit_for_bit(ba
 
 
 # both slow: each a threaded variant of its own (Sod 6 min of numba and two threads beside the other test worker);
-# the fast set keeps two threads in tests/test_fused_remedies.py and tests/test_plane_fused.py
+# the fast set keeps two threads in the refused step below and in tests/test_plane_fused.py
 @pytest.mark.parametrize("kind", [pytest.param("sod", marks=pytest.mark.slow),
                                   pytest.param("burgers", marks=pytest.mark.slow)])
 def test_the_threaded_swept_loop_equals_the_threaded_per_step_path(kind, loop_steps, one_at_a_time):
@@ -165,6 +167,7 @@ def test_the_threaded_swept_loop_equals_the_threaded_per_step_path(kind, loop_st
     assert_same_run(simulate_(settings, progress=False), swept)
 
 
+# fast: the fast set's one two-thread run in 1D (the point mass's parallel passes and threaded loop)
 def test_a_step_refused_in_the_second_chunk_fails_as_the_numpy_step_does(loop_steps):
     """The refused step above on two threads: particle 5004 is the second chunk's (5,000 to 9,999);
     the loop stops before the third step and the per-step path raises the numpy step's error."""

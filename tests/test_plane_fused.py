@@ -2,7 +2,8 @@
 round-off: ten steps of the axis-aligned solution at A = 0.05 on a periodic 16 x 16 mesh (particles
 cross cells), regular and jittered layouts, for each compiled basis; the vortex on its non-periodic
 grid; the PIC/FLIP blend; two threads; an inverted particle named as the numpy step names it; the
-stages it does not serve refused. The B-splines' variants take minutes to compile: slow."""
+stages it does not serve refused. The B-splines' variants take minutes to compile: slow; uGIMP's (15-20 CPU-s of
+numba on a cold cache) too."""
 
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ from mpm_fem.plane.step import step_with_grid
 solids = pytest.importorskip("baselines.exact.solids")
 MATERIAL = solids.Material(1e4, 0.3, 1.0)
 ROUND_OFF = 1e-12  # of each field's scale: ten steps of sums taken in another order
-FAST = ("mpm", "gimp")
+FAST = ("mpm", pytest.param("gimp", marks=pytest.mark.slow))
 SLOW = ("bspline", "cubic", "bspline_gimp")
 
 
