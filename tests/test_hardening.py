@@ -52,7 +52,7 @@ BAD = [
     (["sod", "--cfl", "1"], "(0, 0.5] with lumped mass"),
     (["sod", "--cfl", "0.3", "--mass", "consistent"], "(0, 0.25] with consistent mass"),
     (["burgers", "--cfl", "1.01"], "CFL number must lie in (0, 1]"),
-    (["burgers", "--cfl", "0.5", "--mass", "consistent"], "(0, 0.333333] with consistent mass and the calculated"),
+    (["burgers", "--cfl", "0.5", "--mass", "consistent"], "(0, 0.333333] with the consistent mass and the calculated"),
     (["sod", "--h", "1e-9"], "over the limit of"),
     (["sod", "--ppc", "100000", "--h", "0.001"], "over the limit of"),
     (["sod", "--T", "1e300"], "over the limit of"),
