@@ -69,7 +69,7 @@ def key_text(f: Finding, brief: bool = False) -> str:
 _TRUE, _FALSE = ("true", "yes", "1"), ("false", "no", "0")
 
 
-_COUNTED = re.compile(r"\bon (\d+) of (\d+) ([a-z][a-z ]*[a-z])")
+_COUNTED = re.compile(r"\bon (\d+) of (\d+) ([a-z][a-z -]*[a-z])")
 
 
 #: The verdict cell of a claim that holds on some of its cases: the count, the verdict's meaning in numbers.
@@ -85,7 +85,8 @@ def _plural(noun: str) -> str:
 def counted(f: Finding) -> str:
     """How many of a finding's cases the statement holds on, ``"holds on 3 of 4 layouts"``: from its table's
     ``holds`` column (or its first yes/no column, or its ``verdict`` column), else from an ``on k of n
-    <cases>`` of its sentence or evidence; "" when it states no count."""
+    <cases>`` of its evidence's first clause (the key number), its sentence or its evidence; "" when it
+    states no count."""
     rows = list(f.table)
     if rows:
         columns = list(rows[0])
@@ -99,7 +100,8 @@ def counted(f: Finding) -> str:
             if judged:
                 hits = sum(r.get("verdict") == CONFIRMED for r in judged)
                 return f"holds on {hits} of {len(judged)} {_plural(columns[0])}"
-    for text in (f.sentence, f.evidence):
+    key = (f.evidence or "").split(";")[0]  # the evidence's first clause holds the key number
+    for text in (key, f.sentence, f.evidence):
         m = _COUNTED.search(text or "")
         if m:
             return f"holds on {m.group(1)} of {m.group(2)} {m.group(3)}"
