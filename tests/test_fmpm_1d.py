@@ -133,6 +133,16 @@ def test_e7_follows_the_fmpm_errors_against_the_rule_and_names_a_failed_run(prob
         assert failed[0] == "confirmed" and "1 of 14 runs failed (mass = fmpm3; h = 0.005): " in failed[1], failed
 
 
+@pytest.mark.parametrize("problem", ["sod", "burgers"])
+def test_e7_does_not_count_fmpm1_the_lumped_mass_as_a_recovery(problem):
+    from claim_mutations import judge
+
+    lumped_near = _lumping(1.05, (1.05 ** -1, 1.4, 1.3, 1.2))  # only FMPM(1) = lumped within 10 % of consistent
+    verdict, evidence = judge(f"E7 ({problem})", lumped_near)
+    assert verdict == "refuted" and "fmpm1" not in evidence.split(";")[0], evidence
+    assert judge(f"E7 ({problem})", _lumping(1.05, (1.05 ** -1, 1.08, 1.3, 1.2)))[0] == "confirmed"
+
+
 # ---------------------------------------------------------------- a boundary's values in a coupled mass's system
 
 def _prescribed_dense(shape, m, rhs, nodes, values):

@@ -108,6 +108,16 @@ def test_a_count_replaces_partly_where_the_finding_states_one():
     assert verdict_text(Finding("differs", "on 1 of 2 meshes")) == "differs"
 
 
+def test_a_partial_verdict_whose_table_holds_on_none_is_counted_with_its_other_part():
+    """A table that holds on none (or all) of its rows does not by itself make a verdict partial: the count
+    names the claim's other part too, as E6's settings and remedies."""
+    none = tuple({"setting": s, "holds": "no"} for s in ("a", "b", "c", "d"))
+    evidence = "the model holds on 0 of 4 settings; not on a, b; which remedies: right on 21 of 26 remedies, not x"
+    assert verdict_text(Finding("partly", evidence, "s", none)) == "holds on 0 of 4 settings and 21 of 26 remedies"
+    some = ({"setting": "a", "holds": "yes"}, *none[1:])
+    assert verdict_text(Finding("partly", evidence, "s", some)) == "holds on 1 of 4 settings"
+
+
 def test_the_appendix_exists_and_every_section_links_to_it(written):
     report, appendix, exists = written
     assert exists and appendix.startswith("# ") and "[REPORT.md](REPORT.md)" in appendix

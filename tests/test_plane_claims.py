@@ -133,6 +133,8 @@ def test_d5_fmpm_recovers_the_consistent_mass_within_the_rule():
     assert verdict == "confirmed" and "fmpm3" in evidence, evidence
     far = _tables(mass=_mass(1.5, (1.5 ** -1, 1.4, 1.3, 1.2)))
     assert judge("D5", far)[0] == "refuted"
+    lumped_near = _tables(mass=_mass(1.05, (1.05 ** -1, 1.4, 1.3, 1.2)))  # FMPM(1) is the lumped mass: not counted
+    assert judge("D5", lumped_near)[0] == "refuted"
 
 
 def _fem_tables(mpm_factor: float) -> dict:

@@ -75,6 +75,7 @@ from mpm_fem.app.paper_results import (  # noqa: F401  (this module's interface)
     evidence_appendix,
     evidence_section,
     failed_runs,
+    further_results,
     results,
     verdict_counts,
 )

@@ -8,8 +8,8 @@ state five to eight findings, each with its number, no verdict string pasted in.
 
 from __future__ import annotations
 
-from mpm_fem.app.markdown import anchor_of, bullets, figure, markdown_table, prose, split_outside
-from mpm_fem.app.paper_findings import Found, _and, key_text, said, verdict_text
+from mpm_fem.app.markdown import bullets, figure, markdown_table, prose, split_outside
+from mpm_fem.app.paper_findings import Found, _and, claim_href, key_text, said, verdict_text
 from mpm_fem.app.paper_method import _study_setting
 from mpm_fem.app.paper_results import REPRODUCTION
 from mpm_fem.measure.claims import STATEMENTS, Claim, identification, num, select, span
@@ -51,7 +51,7 @@ def discrepancies(found: Found) -> list[str]:
     for c, _ in departing:
         by_id.setdefault(c.id, []).append(c)
     for cid, claims in by_id.items():
-        labels = _and([f"[{c.label}](#{anchor_of(c.label)})" for c in claims])
+        labels = _and([f"[{c.label}]({claim_href(c)})" for c in claims])
         lead = f"{labels} ({STATEMENTS[cid]}; the finding is in the results)."
         lines += prose(" ".join(s for s in (lead, claims[0].explanation, MEASURED_ELSEWHERE.get(cid, "")) if s))
     return lines

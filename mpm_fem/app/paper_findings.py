@@ -86,7 +86,9 @@ def counted(f: Finding) -> str:
     """How many of a finding's cases the statement holds on, ``"holds on 3 of 4 layouts"``: from its table's
     ``holds`` column (or its first yes/no column, or its ``verdict`` column), else from an ``on k of n
     <cases>`` of its evidence's first clause (the key number), its sentence or its evidence; "" when it
-    states no count."""
+    states no count. A table's count of none or all, which alone would not make the verdict partial, is
+    joined by the first other count of the evidence (the claim's other part: ``"holds on 0 of 4 settings
+    and 21 of 26 remedies"``)."""
     rows = list(f.table)
     if rows:
         columns = list(rows[0])
@@ -94,7 +96,11 @@ def counted(f: Finding) -> str:
             c for c in columns[1:] if all(str(r.get(c, "")).strip().lower() in _TRUE + _FALSE for r in rows)]
         if flags:
             hits = sum(str(r.get(flags[0], "")).strip().lower() in _TRUE for r in rows)
-            return f"holds on {hits} of {len(rows)} {_plural(columns[0])}"
+            cases = _plural(columns[0])
+            other = [m for m in _COUNTED.finditer(f.evidence or "") if m.group(3) != cases] \
+                if hits in (0, len(rows)) else []
+            more = f" and {other[0].group(1)} of {other[0].group(2)} {other[0].group(3)}" if other else ""
+            return f"holds on {hits} of {len(rows)} {cases}{more}"
         if "verdict" in columns:
             judged = [r for r in rows if r.get("verdict") in VERDICTS and r.get("verdict") != NOT_MEASURED]
             if judged:
@@ -114,10 +120,25 @@ def verdict_text(f: Finding) -> str:
     return (counted(f) or f.verdict) if f.verdict == PARTLY else f.verdict
 
 
+#: The files of the report: the main text and its appendices.
+REPORT_FILE, APPENDIX_FILE = "REPORT.md", "APPENDIX.md"
+#: The studies whose claims are said in the appendix's further results rather than in the results (the
+#: main text's summary still gives their verdicts and key numbers): the main text stays a paper's length.
+IN_APPENDIX = ("lumping", "defect")
+
+
+def claim_href(c: Claim, here: str | None = REPORT_FILE, folder: str = "") -> str:
+    """The link target of a claim's section, from the file ``here`` (``None``: from outside the folder,
+    through ``folder``, e.g. ``"figures/"``): ``#c5`` in its own file, else ``APPENDIX.md#e7-sod``; the
+    claims of :data:`IN_APPENDIX` are said in the appendix, the others in the report."""
+    file = APPENDIX_FILE if c.study in IN_APPENDIX else REPORT_FILE
+    return f"#{anchor_of(c.label)}" if file == here else f"{folder}{file}#{anchor_of(c.label)}"
+
+
 def said(c: Claim, f: Finding, link: bool = False) -> str:
-    """The finding in one sentence with the claim's label (a link to its results when ``link``): its
+    """The finding in one sentence with the claim's label (a link to its section when ``link``): its
     plain sentence, or the statement and the evidence's first clause."""
-    label = f"[{c.label}](#{anchor_of(c.label)})" if link else c.label
+    label = f"[{c.label}]({claim_href(c)})" if link else c.label
     if f.sentence:
         text = readable(f.sentence.strip().rstrip("."))
         return f"{text[:1].upper()}{text[1:]} ({label})."

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from mpm_fem.app.markdown import anchor_of, figure, markdown_table, prose, readable
 from mpm_fem.app.pages import Page, View
-from mpm_fem.app.paper_findings import Found, key_text, verdict_text
+from mpm_fem.app.paper_findings import APPENDIX_FILE, Found, claim_href, key_text, verdict_text
 
 PAGE = Page("plane", "Two dimensions: the stage-by-stage analysis on the plane",
             "Point-mass MPM, uGIMP and the quadratic and cubic B-splines run the axis-aligned manufactured solution "
@@ -65,8 +65,8 @@ def comparison_rows(found: Found) -> list[dict]:
             continue
         ones, _ = COUNTERPARTS.get(c.id, ((), ""))
         beside = [f"{one}: {_said(found[one][1])}" for one in ones if one in found and found[one][1].sentence]
-        rows.append({"claim": f"[{label}](REPORT.md#{anchor_of(label)})", "verdict": verdict_text(f), "in 2D": _said(f),
-                     "in 1D": "; ".join(beside) or "no 1D counterpart measured"})
+        rows.append({"claim": f"[{label}]({claim_href(c, APPENDIX_FILE)})", "verdict": verdict_text(f),
+                     "in 2D": _said(f), "in 1D": "; ".join(beside) or "no 1D counterpart measured"})
     return rows
 
 

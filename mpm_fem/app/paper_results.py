@@ -1,8 +1,10 @@
-"""The report's Results and the appendix of each claim's evidence.
+"""The report's Results, the appendix's further results and the appendix of each claim's evidence.
 
-The verdicts counted, then every claim in the order of its study's page: statement, verdict and source,
-its finding in words, one figure (shown once, at the first claim that reads it), the failed runs and
-the links to its evidence, its rule and its study's tables in the appendix. A finding without a
+The verdicts counted, then every claim in the order of its study's page: statement, verdict, its
+finding in words, one figure (shown once, at the first claim that reads it), the failed runs and the
+links to its evidence (with the source's words), its rule and its study's tables in the appendix. The
+claims of the studies of :data:`~mpm_fem.app.paper_findings.IN_APPENDIX` are said so in the appendix
+(:func:`further_results`), the main text pointing to them. A finding without a
 sentence is said by its evidence's first clause, whole; one without a table shows its evidence as a
 list cut at its semicolons.
 """
@@ -12,7 +14,15 @@ from __future__ import annotations
 from mpm_fem.app.markdown import anchor_of, bullets, figure, markdown_table, prose, readable, sentences, split_outside
 from mpm_fem.app.pages import Page
 from mpm_fem.app.paper_abstract import KEY_FIGURES
-from mpm_fem.app.paper_findings import COUNT_MEANING, Found, first_clause, verdict_text
+from mpm_fem.app.paper_findings import (
+    APPENDIX_FILE,
+    COUNT_MEANING,
+    IN_APPENDIX,
+    Found,
+    claim_href,
+    first_clause,
+    verdict_text,
+)
 from mpm_fem.measure.claims import STATEMENTS, Claim, Finding, claims_of
 from mpm_fem.measure.claims.base import PARTLY
 from mpm_fem.measure.claims.rules import VERDICT_MEANING
@@ -38,15 +48,15 @@ def evidence(f: Finding) -> list[str]:
 
 def claim_section(c: Claim, f: Finding, figure_lines: list[str] = (), appendix: str = "",
                   linked: bool = True) -> list[str]:
-    """A claim in the results: statement, verdict and source (a one-row table), its finding in words, one
-    figure, the failed runs, and the links to its evidence, its rule and (``linked``: a study in the folder)
-    its study's tables in the appendix."""
+    """A claim in the results: statement, verdict (a one-cell table), its finding in words, one figure, the
+    failed runs, and the links to its evidence (which gives the source's words), its rule and (``linked``: a
+    study in the folder) its study's tables in the appendix."""
     text = f.sentence.strip() or first_clause(f)
     links = (f"Evidence: [table](APPENDIX.md#evidence-{anchor_of(c.label)}), "
              f"[rule](APPENDIX.md#rule-{anchor_of(c.label)})"
              + (f", [study](APPENDIX.md#{appendix})." if appendix and linked else "."))
     return [f'<a id="{anchor_of(c.label)}"></a>', "", f"#### {c.label}: {c.statement}", "",
-            *markdown_table([{"verdict": verdict_text(f), "source": c.source}]), "",
+            *markdown_table([{"verdict": verdict_text(f)}]), "",
             *([readable(text[:1].upper() + text[1:]).rstrip(".") + ".", ""] if text else []), *figure_lines,
             *failed_runs(f), links, ""]
 
@@ -56,7 +66,7 @@ def evidence_section(c: Claim, f: Finding) -> list[str]:
     failed runs, and the link back to its results."""
     return [f'<a id="evidence-{anchor_of(c.label)}"></a>', "", f"#### {c.label}: {c.statement}", "",
             *markdown_table([{"verdict": verdict_text(f), "source": c.source}]), "", *evidence(f), *failed_runs(f),
-            f"In the report: [{c.label}](REPORT.md#{anchor_of(c.label)}).", ""]
+            f"In the report: [{c.label}]({claim_href(c, APPENDIX_FILE)}).", ""]
 
 
 def failed_runs(f: Finding) -> list[str]:
@@ -91,7 +101,8 @@ def verdict_counts(found: Found) -> list[str]:
 
 def results(tables: Tables, found: Found, pages: list[Page], captions: dict, summary) -> list[str]:
     """Every claim in the order of its study's page: the studies without a table say so. A figure is shown
-    once, at the first claim that reads it; every claim's evidence table is in the appendix."""
+    once, at the first claim that reads it; every claim's evidence table is in the appendix. The studies of
+    :data:`IN_APPENDIX` are named in one paragraph, their claims said in :func:`further_results`."""
     lines = ["## Results", "", *prose(
         "The verdicts, counted, then every claim with its key number, the source's claims first; the subsections "
         "say each finding in words, and each claim's evidence is a table of "
@@ -99,13 +110,46 @@ def results(tables: Tables, found: Found, pages: list[Page], captions: dict, sum
         "*The source's claims.*", "", *summary("C"), "", "*The extensions.*", "", *summary("E"), "",
         *prose("The two-dimensional claims D1-D9 are said in [their own section](#two-dimensions).")]
     # the 2D claims are said in the report's own section (mpm_fem.app.paper_plane), their tables in the appendix
-    shown_pages = [p for p in [*pages, REPRODUCTION] if claims_of(p.name)
-                   and not all(c.id.startswith("D") for c in claims_of(p.name))]
-    drawn = set(KEY_FIGURES)  # the first screen shows these
-    for page in shown_pages:
+    shown = [p for p in _claim_pages(pages) if p.name not in IN_APPENDIX]
+    lines += _page_sections(tables, found, shown, captions, set(KEY_FIGURES))  # the first screen shows these
+    further = [p for p in _claim_pages(pages) if p.name in IN_APPENDIX]
+    if further:
+        lines += prose(f"The summary above lists the claims of {_NUMBER.get(len(further), len(further))} further "
+                       "studies, said in full in [the appendix's further results](APPENDIX.md#appendix-further): "
+                       + "; ".join(p.title[:1].lower() + p.title[1:] for p in further) + ".")
+    return lines
+
+
+def further_results(tables: Tables, found: Found, pages: list[Page], captions: dict) -> list[str]:
+    """The appendix's further results: the claims of the studies of :data:`IN_APPENDIX`, each as in the
+    results (:func:`claim_section`); none when no page of them has claims."""
+    further = [p for p in _claim_pages(pages) if p.name in IN_APPENDIX]
+    if not further:
+        return []
+    return ['<a id="appendix-further"></a>', "", "## Appendix: further results", "",
+            *prose("The claims the main text's summary lists but does not say in full, said as in its results."),
+            *_page_sections(tables, found, further, captions, set(), "further-")]
+
+
+_NUMBER = {1: "one", 2: "two", 3: "three", 4: "four"}
+
+
+def _claim_pages(pages: list[Page]) -> list[Page]:
+    """The pages (and the record's own, :data:`REPRODUCTION`) with 1D claims: the 2D claims have their own
+    section."""
+    return [p for p in [*pages, REPRODUCTION] if claims_of(p.name)
+            and not all(c.id.startswith("D") for c in claims_of(p.name))]
+
+
+def _page_sections(tables: Tables, found: Found, pages: list[Page], captions: dict, drawn: set,
+                   prefix: str = "") -> list[str]:
+    """A subsection per page (its anchor ``prefix`` + its name, its caption's first sentence, then each
+    claim's section); a figure already in ``drawn`` (paths, updated) is not shown again."""
+    lines = []
+    for page in pages:
         present = any(tables.get(t) for c in claims_of(page.name) for t in c.tables) \
             and (page is REPRODUCTION or _has_tables(tables, page.name))
-        lines += [f'<a id="{page.name}"></a>', "", f"### {page.title}", "",
+        lines += [f'<a id="{prefix}{page.name}"></a>', "", f"### {page.title}", "",
                   *prose(sentences(page.caption)[0] + " The study's settings in full: [its appendix]"
                          f"(APPENDIX.md#appendix-{page.name})." if present and page is not REPRODUCTION else
                          page.caption if present else

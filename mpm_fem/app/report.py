@@ -29,6 +29,7 @@ from mpm_fem.app.markdown import anchor_of, bullets, cell, figure, markdown_tabl
 from mpm_fem.app.output import write_atomic
 from mpm_fem.app.pages import PAGES, Page, View  # noqa: F401  (View: part of this module's interface)
 from mpm_fem.app.paper import Found, judge, key_text, verdict_text
+from mpm_fem.app.paper_findings import APPENDIX_FILE, REPORT_FILE, claim_href
 from mpm_fem.app.plots import CAPTIONS
 from mpm_fem.app.study import NOT_JUDGED, QUICK_LEAVES_OUT
 from mpm_fem.measure.claims import STATEMENTS, Claim, select
@@ -96,7 +97,8 @@ def summary(found: Found, link: str = "", kind: str = "", brief: bool = False, s
         if not listed:
             lines.append(f"| {cid} | {statement} | not measured | no criterion registered |")
         for c, f in listed:
-            lines.append(f"| [{c.label}]({link}#{anchor(c)}) | {cell(statement)} | **{verdict_text(f)}** | "
+            href = claim_href(c, None, link.removesuffix(REPORT_FILE)) if link else claim_href(c)
+            lines.append(f"| [{c.label}]({href}) | {cell(statement)} | **{verdict_text(f)}** | "
                          f"{cell(key_text(f, brief))} |")
     if not statements:
         return [lines[0].replace(" statement |", ""), "|---|---|---|"] + [
@@ -152,7 +154,8 @@ def rules_appendix(found: Found) -> list[str]:
         items += [f"Why: {c.explanation}"] if c.explanation else []
         # the results show a finding's small table; its whole evidence line stays readable here
         items += [f"The evidence in full: {f.evidence}."] if f.table else []
-        items += [f"In the report: [{c.label}](REPORT.md#{anchor(c)}); its evidence: [table](#evidence-{anchor(c)})."]
+        items += [f"In the report: [{c.label}]({claim_href(c, APPENDIX)}); its evidence: "
+                  f"[table](#evidence-{anchor(c)})."]
         lines += [f'<a id="rule-{anchor(c)}"></a>', "", f"#### {c.label}: {c.statement}", "", *bullets(items)]
     return lines
 
@@ -249,7 +252,7 @@ def lettered(lines: list[str]) -> list[str]:
 
 APPENDIX_HEADING = re.compile(r"^## Appendix(?: [A-Z]?)?: (.*)$")
 #: The file of the appendices, beside ``REPORT.md``.
-APPENDIX = "APPENDIX.md"
+APPENDIX = APPENDIX_FILE
 
 
 class Rendered(NamedTuple):
@@ -292,6 +295,7 @@ def render_both(tables: Tables, pages, captions: dict[str, dict] | None = None, 
              f"{code_version(tables)}: each claim's verdict rule and evidence, the rule book, the source-matching "
              "settings, every study's tables and figures, the code version of each table and the deep tier.", ""]
     extra += rules_appendix(found) + paper.rule_book() + paper.evidence_appendix(found)
+    extra += paper.further_results(tables, found, pages, captions)
     extra += paper.settings_appendix(tables)
     extra += paper_plane.appendix(found)
     extra += paper.identification_appendix(tables) + paper.defect_section(tables, captions.get("defect", {}))
