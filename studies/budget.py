@@ -24,16 +24,14 @@ exactly; applied to the fields they give each stage's signed error field, which 
 ``e_MPM - e_exact`` at every point.
 
 Meshes: Sod h = 0.01 ... 0.0025 for every basis (three meshes give each basis's budget a trend, not
-only a change; a budget at 0.00125 costs 4 CPU-min for P1 and 1.4 (GIMP) to 3 (B-splines) times that
-for the others, so the full tier leaves it to the deep tier, :data:`FINEST`), the deep tier adds h =
-0.00125 for every basis and P1 at h = 0.000625 (:data:`DEEP`); Burgers 0.04 ... 0.01. A Sod case
-is 16 runs, all on the fused step (:mod:`mpm_fem.fused`): the fourteen with an exact stage run its
-compiled particle passes around the numpy step's grid stage (:mod:`mpm_fem.exact_stages`). What each
-run cost is in ``runs.csv`` (``wall_s``); ``docs/performance.md`` has the measured costs.
+only a change; :data:`FINEST`), the deep tier adds h = 0.00125 for every basis and P1 at h = 0.000625
+(:data:`DEEP`); Burgers 0.04 ... 0.01. A Sod case is 16 runs, all on the fused step (:mod:`mpm_fem.fused`):
+the fourteen with an exact stage run its compiled particle passes around the numpy step's grid stage
+(:mod:`mpm_fem.exact_stages`). What each run cost is in ``runs.csv`` (``wall_s``); the measured costs,
+and why the tiers stop where they do, are in ``docs/performance.md``.
 Round-off: the subsets with the exact mass stage and the MPM projection (``v_i = v*_i + solve(MPM) -
-solve(exact)``) amplify it, so the budget's numbers carry a round-off spread, and ``roundoff.csv``
-measures it: P1's Sod budget runs a second time on the numpy step (the reference arithmetic), and
-each Shapley share is given from both with the change in percentage points.
+solve(exact)``) amplify it; ``roundoff.csv`` measures the spread: P1's Sod budget runs a second time on
+the numpy step (the reference arithmetic), each Shapley share given from both in percentage points.
 E2: Sod, each basis in MPM form (the fused step), h = 0.01 ... 0.0003125.
 
 Particle layouts: the budget and E2 above run the study's own particles (Sod 16 per cell,
@@ -43,9 +41,7 @@ and on the Sod study's five jittered ones (seeds 1-5), every row of the tables n
 0.01, 0.005; Burgers 0.04, 0.02) and E2's four bases (P1, GIMP, the B-spline, the cubic B-spline) on
 h = 0.01 ... 0.0025; the deep tier adds the other three budget bases' budgets on those meshes, P1's
 on Sod h = 0.0025 and Burgers h = 0.01, and E2's on h = 0.00125 and 0.000625 (:data:`LAYOUT_H`,
-:data:`BASES_LAYOUT_H`). The coarse budgets cost mostly per step (the numpy grid stage of the exact-
-stage runs), hardly per particle, so 4 per cell costs about 0.7x 16 per cell there
-(:data:`BUDGET_STEP_MS`).
+:data:`BASES_LAYOUT_H`; the cost model: :data:`BUDGET_STEP_MS`).
 
 ``readout.csv``: the nodal read-out's own error on Sod (:mod:`mpm_fem.measure.readout`: the exact density
 at the exact particle positions, read out as the study reads the nodes) beside v(all exact) of the nodal norm.
@@ -55,8 +51,7 @@ without node crossings, the neo-Hookean bar of the 1D control at amplitude 1e-4 
 cfl 0.25, one period; :mod:`mpm_fem.measure.control`, :mod:`mpm_fem.run.bar_stages`), on h = 1/8, 1/16,
 1/32 at 4 and 8 per cell on the regular layout and the five jittered ones (full and deep tiers; the quick
 tier runs none). Its cases run through their own case function in a second sweep, so that the cached
-budget cases keep their key; their cost (about 1.5 CPU-min in all, measured 2026-12-02) is not in the
-study's estimate.
+budget cases keep their key; their cost is not in the study's estimate.
 """
 
 from __future__ import annotations
@@ -81,8 +76,7 @@ from mpm_fem.run.bar_stages import ControlSettings
 NAME = "budget"
 BASES = ("mpm", "gimp", "bspline", "cubic")  # E2's bases
 #: the budget's bases: P1, GIMP, the C1 B-spline and the closest remedy of E5, the B-spline averaged over the
-#: particle domain (the cubic B-spline, added to E2 on 2026-11-28, has no budget: its 16 runs a mesh cost 1.3x the
-#: B-spline's)
+#: particle domain (the cubic B-spline, in E2, has no budget: its cost is in docs/performance.md)
 BUDGET_BASES = ("mpm", "gimp", "bspline", "bspline_gimp")
 STAGES = ("projection", "mass", "interpolation", "time")
 EXACT_FORM = {"projection": {"projection": "exact"}, "mass": {"mass": "exact"},
@@ -97,8 +91,7 @@ H = {"sod": (0.01, 0.005, 0.0025, 0.00125), "burgers": (0.04, 0.02, 0.01)}
 #: the deep tier's further budgets, (problem, h, basis): every basis on Sod's finest mesh of H, P1 one mesh finer
 DEEP = (("sod", 0.00125, "mpm"), ("sod", 0.000625, "mpm"), ("sod", 0.00125, "gimp"), ("sod", 0.00125, "bspline"),
         ("sod", 0.00125, "bspline_gimp"))
-#: (problem, basis): the finest mesh of the full tier's budget of a basis that stops above H's finest (P1's Sod
-#: budget at h = 0.00125 cost 4 of the full tier's CPU-min: moved to the deep tier on 2026-11-28)
+#: (problem, basis): the full tier's finest budget mesh where it stops above H's finest (docs/performance.md)
 FINEST = {("sod", b): 0.0025 for b in ("mpm", "gimp", "bspline", "bspline_gimp")}
 BASES_H = (0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125)  # E2: Sod with each basis, MPM stages only (fused)
 REGION_HALF_WIDTH = 0.02  # C12's regions (the Sod study)
@@ -106,9 +99,8 @@ FIELD_POINTS = 2001  # the Shapley fields kept for the figure
 #: the quick tier: P1 on one coarse mesh a problem (E1 is judged on the finest mesh of each basis)
 QUICK = {"h": {"sod": (0.02,), "burgers": (0.04,)}, "bases": ("mpm",), "bases_h": ()}
 GAP = "all MPM - all exact"
-#: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring): the
-#: full tier on the meshes of ROUNDOFF_H (at h = 0.0025 the numpy step costs 1.7 P1 budgets there), the
-#: deep tier on every mesh, the quick tier on none (it would be 40 % of the quick budget's cost)
+#: (problem, basis) whose budget also runs on the numpy step (``roundoff.csv``, module docstring): the full tier
+#: on the meshes of ROUNDOFF_H, the deep tier on every mesh, the quick tier on none (docs/performance.md)
 ROUNDOFF, ROUNDOFF_H = ("sod", "mpm"), H["sod"][:2]
 COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:green", "time": "tab:red"}
 
@@ -120,10 +112,9 @@ COLORS = {"projection": "tab:blue", "mass": "tab:orange", "interpolation": "tab:
 LAYOUT_PPC = (4, 8, 16)
 SEEDS = (1, 2, 3, 4, 5)
 LAYOUTS = (("regular", 0),) + tuple(("jittered", s) for s in SEEDS)
-#: per tier, ``{(problem, basis): meshes}`` of the budgets run at every LAYOUT_PPC and layout. The full tier: P1 on
-#: the two coarsest meshes of each problem (:data:`BUDGET_STEP_MS`: a Sod budget at h = 0.005 costs 15-25 CPU-s a
-#: setting, the other bases 1.3-2x more, hence deep); the deep tier adds the other bases on those meshes and P1's on
-#: the next finer one. The quick tier runs none (its budget of 45 s warm: the layouts' budgets cost 9 CPU-s there).
+#: per tier, ``{(problem, basis): meshes}`` of the budgets run at every LAYOUT_PPC and layout: the full tier P1 on
+#: the two coarsest meshes of each problem, the deep tier the other bases on those meshes and P1's on the next finer
+#: one, the quick tier none (the costs that set this: docs/performance.md)
 LAYOUT_H = {"quick": {},
             "full": {("sod", "mpm"): H["sod"][:2], ("burgers", "mpm"): H["burgers"][:2]},
             "deep": {**{("sod", b): H["sod"][:2] for b in BUDGET_BASES}, ("sod", "mpm"): H["sod"][:3],

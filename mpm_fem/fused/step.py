@@ -273,9 +273,7 @@ class FusedStep:
         ``dt``; twice the rows of the last table (from one, at most :data:`_TABLE_ROWS` rows and
         :data:`_TABLE_VALUES` exact accelerations) when that ``dt`` is the one the last table was built
         with, else one row ahead; and never more than twice the steps the run took (``steps``, counted
-        from the run's start) since the last table was built, plus one. So a changing time step costs
-        one evaluation at ``t`` per call, as without a table, a steady one reaches the longest table
-        in a few calls, and the rows built never exceed about three per step taken."""
+        from the run's start) since the last table was built, plus one (why: ``docs/performance.md``)."""
         times, table, accelerations = self._table
         row = int(np.searchsorted(times, t))
         if row < times.size and times[row] == t and times.size - row > 1:
