@@ -14,7 +14,7 @@ import math
 from typing import NamedTuple
 
 from mpm_fem.app.markdown import prose, readable, sentences
-from mpm_fem.app.paper_findings import Found, _and, _clause, _lower, _number, _range
+from mpm_fem.app.paper_findings import Found, _and, _clause, _lower, _number, _range, labelled
 from mpm_fem.measure.claims import STATEMENTS, num
 from mpm_fem.measure.claims.base import NOT_MEASURED
 from mpm_fem.measure.claims.rows import CONVERGING_ORDER, GROWTH_ORDER
@@ -31,7 +31,7 @@ def _growth_sentence(tables: Tables, found: Found) -> str:
     if f is None or f.verdict == NOT_MEASURED:
         return ("whether Sod's particle density error keeps converging under refinement is not measured in this "
                 "folder (C11)")
-    return f"on Sod {_lower(_clause(f))} (C11)"
+    return labelled(f"on Sod {_lower(_clause(f))}", "C11")
 
 
 class StageOrders(NamedTuple):
@@ -90,9 +90,10 @@ def _stage_sentence(tables: Tables, found: Found) -> str:
     stages = list(dict.fromkeys(o.stage for _, o in found_))
     name = _and([f"the {s} stage" for s in stages]) + (" (a particle quadrature)" if "projection" in stages else "")
     stops = all(o.lo > GROWTH_ORDER for _, o in found_ if o.growing)
-    return (f"Making {name} exact alone {'stops' if stops else 'does not stop'} the growth: the particle error's "
-            f"order between successive meshes goes {_and(parts)}, with every stage in MPM form and with that stage "
-            "exact (E6a)")
+    verb = "stops" if stops else "does not stop"
+    return labelled(f"Making {name} exact alone, every other stage in MPM form, {verb} "
+                    "the growth: the particle error's order between successive meshes (all MPM, then with that stage "
+                    f"exact) goes {_and(parts)}", "E6a")
 
 
 def _remedy_sentence_abstract(found: Found) -> str:
@@ -100,7 +101,7 @@ def _remedy_sentence_abstract(found: Found) -> str:
     if f is None or f.verdict == NOT_MEASURED:
         return "Whether a remedy removes the growth is not measured in this folder (E5)"
     tried = f"Of the {len(f.table)} remedies tried, " if f.table else ""
-    return f"{tried}{_lower(_clause(f)) if tried else _clause(f)} (E5)"
+    return labelled(f"{tried}{_lower(_clause(f)) if tried else _clause(f)}", "E5")
 
 
 def _separation_sentence(found: Found) -> str:
@@ -132,7 +133,12 @@ def _fem_sentence(tables: Tables, found: Found) -> str:
     fem = (f"the fixed-mesh FEM's density error falls on {sum(o > GROWTH_ORDER for o in orders)} of {len(orders)} "
            f"refinements (orders {min(orders):.2f} to {max(orders):.2f}), while " if orders else "")
     key = readable(f.key[0]) if f.key else _clause(f)
-    return f"On the same meshes {fem}{_lower(key)} (E3)"
+    column = "MPM/FEM at the particles, finest over coarsest"
+    growth = [_number(str(r.get(column, "")).split()[0]) for r in f.table if str(r.get(column, "")).strip()]
+    growth = [g for g in growth if math.isfinite(g)]
+    trend = ("; so MPM falls further behind the FEM as the mesh is refined" if growth and min(growth) > 1 else
+             "; so MPM gains on the FEM as the mesh is refined" if growth and max(growth) < 1 else "")
+    return f"On the same meshes {fem}{_lower(key)}{trend} (E3)"
 
 
 def abstract(tables: Tables, found: Found) -> list[str]:
@@ -148,14 +154,15 @@ def abstract(tables: Tables, found: Found) -> list[str]:
 
 def introduction(found: Found) -> list[str]:
     n_claims = sum(cid.startswith("C") for cid in STATEMENTS)
+    n_one, n_plane = (sum(cid.startswith(k) for cid in STATEMENTS) for k in ("E", "D"))
     return ["## Introduction", "", *prose(
         "Where does the error of the material point method come from? Tran and Berzins' error analysis of explicit "
         "one-dimensional MPM names four sources (projection, finite elements with mass lumping, interpolation, time "
         "integration) and shows that on Sod's shock tube the density error stops "
         "converging as the mesh is refined while on viscous Burgers both accelerations converge at first order. "
-        f"We judge the slides' {n_claims} claims and {len(STATEMENTS) - n_claims} extensions (an error budget "
-        "over the stages, smoother bases, MPM beside FEM on one mesh, reproducibility, remedies, the growth's "
-        "stage and its defect model) by written rules on tables one command regenerates; the tables, each "
+        f"We judge the slides' {n_claims} claims, {n_one} extensions in 1D (an error budget "
+        "over the stages, smoother bases, MPM beside FEM, remedies, grid masses and more) and "
+        f"{n_plane} in 2D by written rules on tables one command regenerates; the tables, each "
         "claim's evidence and the rule book are in [the appendix](APPENDIX.md).")]
 
 

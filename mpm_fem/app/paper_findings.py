@@ -135,13 +135,19 @@ def claim_href(c: Claim, here: str | None = REPORT_FILE, folder: str = "") -> st
     return f"#{anchor_of(c.label)}" if file == here else f"{folder}{file}#{anchor_of(c.label)}"
 
 
+def labelled(text: str, label: str) -> str:
+    """``text (label)``; a text ending in a parenthesis takes the label inside it, ``(mean orders ...; C11)``,
+    not two parentheses in a row."""
+    return f"{text[:-1]}; {label})" if text.endswith(")") and "(" in text else f"{text} ({label})"
+
+
 def said(c: Claim, f: Finding, link: bool = False) -> str:
     """The finding in one sentence with the claim's label (a link to its section when ``link``): its
     plain sentence, or the statement and the evidence's first clause."""
     label = f"[{c.label}]({claim_href(c)})" if link else c.label
     if f.sentence:
         text = readable(f.sentence.strip().rstrip("."))
-        return f"{text[:1].upper()}{text[1:]} ({label})."
+        return labelled(f"{text[:1].upper()}{text[1:]}", label) + "."
     statement = c.statement[0].upper() + c.statement[1:]
     return f"{statement} ({label}): {readable(first_clause(f))}."
 

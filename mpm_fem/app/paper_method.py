@@ -9,10 +9,11 @@ from __future__ import annotations
 import json
 import re
 
-from mpm_fem.app.markdown import markdown_table, prose
+from mpm_fem.app.markdown import MAX_WORDS, bullets, markdown_table, prose, split_outside
 from mpm_fem.app.paper_findings import COUNT_MEANING, _and
 from mpm_fem.measure.claims import identification
 from mpm_fem.measure.claims.base import PARTLY
+from mpm_fem.measure.claims.rows import CONVERGING_ORDER, GROWTH_ORDER
 from mpm_fem.measure.claims.rules import RULES, VERDICT_MEANING
 from mpm_fem.measure.tables import Tables
 
@@ -142,8 +143,25 @@ def identification_section(tables: Tables) -> list[str]:
         "continuous settings (the CFL numbers, the Burgers solutions' parameters) are fitted by a bracketed "
         "search to a stated tolerance, on part of the table; `misfit_held_out` is the rest (Sod: the L2 column; "
         "Burgers: two of the five eps). The best candidate and those within the rule book's band of it are the "
-        "source-matching settings ([their table and the refinement test](APPENDIX.md#identification)). "
-        + identification_sentence(tables))
+        "source-matching settings ([their table and the refinement test](APPENDIX.md#identification)).") \
+        + identification_lines(tables)
+
+
+def identification_lines(tables: Tables) -> list[str]:
+    """Each problem's identification sentence: a paragraph, or (past a paragraph's length) its first clause
+    as the lead and the rest as a list cut at its semicolons, so that no sentence runs over paragraphs."""
+    lines = []
+    for problem, name in identification.IDENTIFICATION.items():
+        text = identification.identification_sentence(tables, problem).strip().rstrip(".") if tables.get(name) else ""
+        if not text:
+            continue
+        text = text[:1].upper() + text[1:]
+        if len(text.split()) <= MAX_WORDS:
+            lines += prose(text + ".")
+            continue
+        lead, *rest = split_outside(text)
+        lines += prose(lead.rstrip(",;") + ":") + bullets([r.strip() for r in rest])
+    return lines
 
 
 def identification_appendix(tables: Tables) -> list[str]:
@@ -223,6 +241,15 @@ def terms(tables: Tables) -> list[str]:
          "field through them) or of the grid-node values, against the exact solution"),
         ("order", "p = log(e_coarse / e_fine) / log(h_coarse / h_fine) between successive meshes, or the "
          "least-squares slope where named; negative: the error grows under refinement"),
+        ("converges, levels off, grows", f"an order of at least {CONVERGING_ORDER:g} (the converging order) "
+         f"converges, one below {GROWTH_ORDER:g} grows, one between them levels off (a plateau; the rule book's "
+         "CONVERGING_ORDER and GROWTH_ORDER)"),
+        ("methods", "P1: MPM's point-mass linear basis; GIMP, uGIMP: the hat averaged over the particle's domain; "
+         "B-spline (C1 quadratic, C2 cubic) and B-spline domain (the quadratic averaged over the particle's "
+         "domain); PIC/FLIP: the particle velocity from the grid velocity or its change; XPIC(m): extended PIC of "
+         "order m; APIC: affine PIC; FMPM(k): the particle mass matrix's inverse by k terms of its series "
+         "(FMPM(1) is the lumped mass); FEM, FV: the fixed-mesh finite element and finite-volume baselines"),
+        ("ppc, CFL, eps", "particles per cell; the time step's Courant number; Burgers' viscosity"),
         ("misfit, misfit_raw", "the mean of |log(measured / source)| over a source table's entries, against the "
          "corrected and the printed table"),
     ]
