@@ -20,7 +20,7 @@ def test_the_section_sets_each_2d_finding_beside_its_1d_counterpart():
     lines = paper_plane.section(found, {"convergence_axis.png": "the caption"})
     text = "\n".join(lines)
     assert "## Two dimensions" in text and "![the caption](plane/convergence_axis.png)" in text
-    assert "**D1 (axis-0.05)** (" in text and "axis-0.05: P1's last order -0.50 [" in text, text
+    assert "**D1 (axis-0.05)** (" in text and "axis-0.05: P1 grows on " in text and "last order -0.50 [" in text, text
     assert '<a id="d1-axis-0.05"></a>' in text and "(APPENDIX.md#evidence-d1-axis-0.05)" in text
     e3 = key_text(found["E3"][1], brief=True)
     assert e3 and f"in 1D {e3}" in text, e3

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from claim_mutations import judge, mutate
+from claim_mutations import claim_named, judge, mutate
 
 from mpm_fem.measure.claims.plane import orders, series
 
@@ -35,6 +35,21 @@ def _tables(**parts) -> dict:
 
 def test_an_order_is_minus_infinity_where_the_finer_run_stopped():
     assert orders([(0.1, 1.0), (0.05, 0.25), (0.025, math.nan)]) == [pytest.approx(2.0), -math.inf]
+
+
+def test_a_mixed_series_is_said_by_its_runs_and_one_finite_order_is_not_a_spread():
+    """Five of six P1 runs stop on the two finest meshes (a particle inverted on both), one grows: the key
+    says the runs by behaviour, not "mixed", and the one finite order is not given a spread."""
+    rows = _growth(-0.5)
+    coarse = max(float(r["h"]) for r in rows)
+    for r in rows:
+        if r["basis"] == "mpm" and r["seed"] != "0" and float(r["h"]) < coarse:
+            r["ok"], r["L2"] = "False", ""
+    found = claim_named("D1 (axis-0.05)").finding(_tables(growth=rows))
+    assert found.verdict == "partly", found
+    assert found.key[-1].startswith("axis-0.05: P1 grows on 1 of 6 runs, 5 stop on both meshes; last order -0.50 "
+                                    "(one run)"), found.key
+    assert "mixed" not in found.key[-1] and "mixed" not in found.evidence.split(";")[0]
 
 
 def test_a_series_is_judged_on_the_meshes_every_run_has():

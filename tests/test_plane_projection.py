@@ -143,6 +143,15 @@ def test_d8_counts_the_orders_inside_the_bands():
     assert claim_named("D8").finding(none).verdict == "refuted"
 
 
+def test_d8s_verdict_counts_the_orders_its_verdict_is_judged_on():
+    """The verdict cell counts the orders (38 of 40), not the quantity-layout rows that hold on every count."""
+    from mpm_fem.app.paper_findings import verdict_text
+
+    bad = {PLANE_PROJECTION_ORDERS.name: _orders_table(
+        lambda q, lay, n: 0.0 if (q, lay, n) == ("E_F", "random", 2) else 1.0 if q in ("E_m", "E_P", "E_F") else 0.5)}
+    assert verdict_text(claim_named("D8").finding(bad)).startswith("holds on 39 of 40 orders")
+
+
 def test_d9_needs_the_bound_on_every_entry():
     rows = [{"check": c, "layout": lay, "ppc": "2", "h": "0.0625", "min_ratio": "1.2", "entries": "100",
              "holds": "yes"} for c in ("cell_rho", "node_m", "node_F") for lay in ("jittered", "random")]

@@ -93,7 +93,8 @@ def series(rows: list[dict], **where) -> dict:
 
 def _order_text(s: dict) -> str:
     last = s["last"]
-    text = f"{last.mean:.2f} [{last.lo:.2f}, {last.hi:.2f}]" if last.n else "-"
+    text = (f"{last.mean:.2f} [{last.lo:.2f}, {last.hi:.2f}]" if last.n > 1 else f"{last.mean:.2f} (one run)"
+            if last.n else "-")
     if s["stopped"]:
         text += f", {s['stopped']} stopped (a particle inverted)"
     return text
@@ -101,6 +102,11 @@ def _order_text(s: dict) -> str:
 
 def _counts_text(counts: dict) -> str:
     return ", ".join(f"{n} {b}" for b, n in counts.items())
+
+
+def _behaviour_text(s: dict) -> str:
+    """The series' behaviour, or for a mixed one its runs by behaviour."""
+    return s["verdict"] if s["verdict"] != "mixed" else _counts_text(s["counts"])
 
 
 def growth_table(rows: list[dict], solution: str) -> tuple[dict, ...]:
@@ -137,15 +143,16 @@ def _d1(solution: str):
         verdict = (CONFIRMED if grows and len(grows) == len(p1) and smooth_ok else PARTLY if some else DIFFERS)
         table = growth_table(rows, solution)
         evidence = "; ".join(f"{b} {p}x{p}: last order {_order_text(s)} over {s['runs']} runs to h = "
-                             f"1/{round(1 / s['finest'])}, {s['verdict']}" for (b, p), s in judged.items())
+                             f"1/{round(1 / s['finest'])}, {_behaviour_text(s)}" for (b, p), s in judged.items())
         first = p1[min(p1)]
         smooth = {b: judged.get((b, min(p1))) for b in SMOOTH}
         sentence = (f"on the {solution} solution point-mass MPM's last order at {min(p1)}x{min(p1)} per cell is "
                     f"{_order_text(first)} ({_counts_text(first['counts'])} of {first['runs']} runs), the cubic "
                     f"B-spline's {_order_text(smooth['cubic']) if smooth['cubic'] else '-'}; P1 grows on "
                     f"{first['counts'].get('grows', 0)} of {first['runs']} runs")
-        key = short(sentence, f"{solution}: P1's last order {_order_text(first)}, {first['verdict']}; grows on "
-                              f"{first['counts'].get('grows', 0)} of {first['runs']} runs")
+        rest = _counts_text({k: n for k, n in first["counts"].items() if k != "grows"})
+        key = short(sentence, f"{solution}: P1 grows on {first['counts'].get('grows', 0)} of {first['runs']} runs"
+                              + (f", {rest}" if rest else "") + f"; last order {_order_text(first)}")
         return Finding(verdict, evidence, sentence, table, key=key)
     return criterion
 
