@@ -79,7 +79,8 @@ def test_quick_report_has_no_nan_and_its_first_screen_answers_the_headline_quest
         hits = re.findall(r".{30}(?<![\w.])nan(?![\w.]).{0,30}", text, re.IGNORECASE)
         assert not hits, (name, hits)
     first = "\n".join((quick / "REPORT.md").read_text().splitlines()[:40]).split("## 1 Introduction")[0]
-    assert re.search(r"Making the projection stage \(a particle quadrature\) exact alone stops the growth: .*"
+    assert re.search(r"Making the projection stage \(a particle quadrature\) exact alone, every other stage in MPM "
+                     r"form, stops the growth: .*"
                      r"to \[\d\.\d\d, \d\.\d\d\] on Sod \(h = 0\.01 to 0\.005", first), first
     assert re.search(r"fixed-mesh FEM's density error falls on \d+ of \d+ refinements", first), first
 

@@ -213,7 +213,7 @@ def identification_sentence(tables: Tables, problem: str) -> str:
     meshes = sorted({float(h) for r in rows for h in str(r.get("meshes", "")).split()}, reverse=True)
     layout = next((r["value"] for r in tables.get("settings", []) if r["table"] == IDENTIFICATION[problem]
                    and r["key"] == "layout"), "")
-    where = (f" ({f'the {layout} layout, ' if layout else ''}on {len(meshes)} of the source's "
+    where = (f" (the search on {f'the {layout} layout and ' if layout else ''}{len(meshes)} of the source's "
              f"{len(SOURCE_H[problem])} meshes, h = {meshes[0]:g} to {meshes[-1]:g})") if meshes else ""
     refined = [r for r in tables.get("identification/refinement", []) if r.get("problem") == problem
                and r.get("tolerance") == "halved"]
