@@ -173,8 +173,8 @@ class _Future:
         return self._done
 
 
-def test_a_group_compiling_its_kernels_is_held_back_until_its_first_task_ends_or_compile_s_passes():
-    """Tasks 0, 1 of group a, 2 of group b: while a's first task runs (started 1 s ago) the pool takes
+def test_a_group_compiling_its_kernels_is_held_back_until_its_latest_task_ends_or_compile_s_passes():
+    """Tasks 0, 1 of group a, 2 of group b: while a's latest task runs (started 1 s ago) the pool takes
     b's task; once it ended, or COMPILE_S after it started, the order again; with every group held
     back, the first task (a worker never idles)."""
     from collections import deque
@@ -189,6 +189,22 @@ def test_a_group_compiling_its_kernels_is_held_back_until_its_first_task_ends_or
     assert _next_task(deque(todo), groups, running, 100.0 + COMPILE_S) == (0, None)
     waiting = deque(todo[:2])
     assert _next_task(waiting, groups, running, 101.0) == (0, None) and list(waiting) == [(1, None)]
+
+
+def test_with_every_group_held_back_the_pool_takes_the_group_with_the_most_ended_tasks():
+    """Tasks 0 of group a (one ended task), 1 of group b (five ended): both groups' latest tasks run
+    (started 1 s ago), so both may be compiling; the pool takes b's task, whose kernels are the likelier
+    compiled, not the first in the order (a second worker compiling a's kernels again)."""
+    from collections import deque
+
+    from mpm_fem.app.sweep import _next_task
+
+    groups, todo = {0: "a", 1: "b"}, [(0, None), (1, None)]
+    running = {"a": (100.0, _Future(False)), "b": (100.0, _Future(False))}
+    waiting = deque(todo)
+    assert _next_task(waiting, groups, running, 101.0, {"a": 1, "b": 5}) == (1, None) and list(waiting) == [(0, None)]
+    assert _next_task(deque(todo), groups, running, 101.0, {"a": 5, "b": 5}) == (0, None)
+    assert _next_task(deque(todo), groups, running, 101.0) == (0, None)
 
 
 def test_the_kernel_group_is_the_function_and_the_keys_that_choose_kernels():

@@ -101,10 +101,13 @@ def _worker_init(parent: int, compiling=None) -> None:
 #: group (:func:`kernel_group`). A guess from the studies' cases: a wrong one costs compiling time,
 #: never a number.
 KERNEL_KEYS = ("solver", "problem", "kind", "basis", "scheme", "mass", "transfer")
-#: For this long after a group's first task starts (or until it ends), the pool starts the group's
-#: other tasks only when no other task can start: numba compiles a group's kernels at its first task's
-#: start and caches them on disk, and a second worker starting the group meanwhile would compile them
-#: again (a cold quick tier's two workers did so, each compiling every kernel).
+#: For this long after a group's latest task starts (or until it ends), the pool starts the group's
+#: other tasks only when a task of another group can start: numba compiles a kernel at the first task
+#: that calls it and caches it on disk, and a second worker starting the group meanwhile would compile it
+#: again (a cold quick tier's two workers did so, each compiling every kernel). The latest task, not
+#: only the first: a group's first task need not call every kernel of the group (the mechanism study's
+#: first subset makes time exact; its next two, the projection and the mass, both compile the exact
+#: projection's kernels).
 COMPILE_S = 45.0
 
 
@@ -113,21 +116,28 @@ def kernel_group(task: Task) -> tuple:
     return (task.fn.__module__, task.fn.__qualname__, *(repr(task.case.get(key)) for key in KERNEL_KEYS))
 
 
-def _next_task(waiting: deque, groups: dict, first: dict, now: float):
-    """Take from ``waiting`` (``(k, path)`` in their order) the first task whose group ``groups[k]`` is
-    not being compiled: its first task (``first[group] = (start time, future)``) has ended or started
-    :data:`COMPILE_S` ago or more, or it has none; the first task when every group is."""
+def _next_task(waiting: deque, groups: dict, latest: dict, now: float, ended: dict | None = None):
+    """Take from ``waiting`` (``(k, path)`` in their order) the first task whose group ``groups[k]`` may
+    not be compiling: its latest task (``latest[group] = (start time, future)``) has ended or started
+    :data:`COMPILE_S` ago or more, or it has none. When every group may be, the first task of the group
+    with the most ended tasks (``ended[group]``, the likeliest to have its kernels compiled): a worker
+    never idles."""
     for i, (k, path) in enumerate(waiting):
-        started = first.get(groups[k])
+        started = latest.get(groups[k])
         if started is None or started[1].done() or now - started[0] >= COMPILE_S:
             del waiting[i]
             return k, path
-    return waiting.popleft()
+    ended = ended or {}
+    most = max(ended.get(groups[k], 0) for k, _ in waiting)
+    i = next(i for i, (k, _) in enumerate(waiting) if ended.get(groups[k], 0) == most)
+    k, path = waiting[i]
+    del waiting[i]
+    return k, path
 
 
 def _run_pool(tasks, todo, jobs: int, finish, followups=(), notice: bool = False) -> None:
     """The tasks of ``todo`` in ``jobs`` worker processes, started in their order (but a group's tasks
-    held back while its first task compiles its kernels: :func:`_next_task`) and at most ``jobs + 1``
+    held back while its latest task may compile kernels: :func:`_next_task`) and at most ``jobs + 1``
     at a time, so that a follow-up (a function of no arguments: ``followups``, and what ``finish``
     returns) starts ahead of the tasks still waiting. If the parent is interrupted (Ctrl-C) or fails,
     the workers are ended at once instead of finishing their cases. ``notice``: the first worker to
@@ -135,17 +145,17 @@ def _run_pool(tasks, todo, jobs: int, finish, followups=(), notice: bool = False
     compiling = multiprocessing.Value("b", 0) if notice else None
     pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(), compiling))
     waiting, ahead, running = deque(todo), deque(followups), {}
-    groups, first = {k: kernel_group(tasks[k]) for k, _ in todo}, {}
+    groups, latest, ended = {k: kernel_group(tasks[k]) for k, _ in todo}, {}, {}
 
     def start() -> None:
         while len(running) <= jobs and (ahead or waiting):
             if ahead:
                 running[pool.submit(ahead.popleft())] = None
             else:
-                k, path = _next_task(waiting, groups, first, time.perf_counter())
+                k, path = _next_task(waiting, groups, latest, time.perf_counter(), ended)
                 future = pool.submit(timed, tasks[k].fn, tasks[k].case)
                 running[future] = (k, path)
-                first.setdefault(groups[k], (time.perf_counter(), future))
+                latest[groups[k]] = (time.perf_counter(), future)
 
     try:
         start()
@@ -154,6 +164,8 @@ def _run_pool(tasks, todo, jobs: int, finish, followups=(), notice: bool = False
             for future in finished:
                 item = running.pop(future)
                 result = future.result()
+                if item is not None:
+                    ended[groups[item[0]]] = ended.get(groups[item[0]], 0) + 1
                 then = finish(*item, result) if item is not None else None
                 if then is not None:
                     ahead.append(then)
