@@ -98,9 +98,9 @@ def nodal_plateau(rows: list[dict]) -> Finding:
        thresholds=f"at the identified Sod setting, over the regular and the jittered layouts (at least {MIN_RUNS} "
                   f"runs a mesh), the nodal density's L1 orders between successive meshes: on the steps where the "
                   f"source's order is at least {CONVERGING_ORDER} every run's too, and on those where it is below "
-                  f"{FLOOR_ORDER} every run's in [{GROWTH_ORDER:g}, {FLOOR_ORDER}) -> confirmed; every run's order "
-                  f"on every levelling step at least {CONVERGING_ORDER} or below {GROWTH_ORDER:g} -> differs; else "
-                  "partly")
+                  f"{FLOOR_ORDER} every run's in [{GROWTH_ORDER:g}, {FLOOR_ORDER}) -> {CONFIRMED}; every run's order "
+                  f"on every levelling step at least {CONVERGING_ORDER} or below {GROWTH_ORDER:g} -> {DIFFERS}; else "
+                  f"{PARTLY}")
 def _c11_nodes(t: Tables) -> Finding:
     """The plateau the source's table shows is the nodal density's (the identification matches it there);
     it is reproduced only if every seed levels where the source levels."""

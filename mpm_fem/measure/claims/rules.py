@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from mpm_fem.measure.claims.base import VERDICTS
+from mpm_fem.measure.claims.base import DIFFERS, VERDICTS
 
 #: One meaning per verdict word (:data:`~mpm_fem.measure.claims.base.VERDICTS`, in their order), written
 #: once; the report's Method section prints them.
@@ -105,7 +105,7 @@ _add("SATURATION", 0.05,
 _add("LUMPING_BAND", 0.9,
      "C15 (second reading): a consistent/lumped error ratio below this means lumping is a source of error, above "
      "its inverse that it compensates; above its inverse on every mesh where the direct reading is swamped: C15 "
-     "differs",
+     + DIFFERS,
      _STUDY + ": the slides name FE + mass lumping a source without a size; a 10 % change is well outside the "
      "spread over meshes of the FEM's own ratio (0.996-0.998)", ("C15",))
 _add("SOURCE_SHARE", 0.1,
