@@ -25,7 +25,8 @@ MPM's growth into convergence on every run where it grows, :func:`mpm_fem.measur
 
 Tiers: the quick tier runs Sod on h = 0.01 and 0.005 and Burgers on its two coarsest meshes at 4 per cell,
 on the regular layout and seeds 1 and 2, every subset of :data:`CASES` (:data:`QUICK`), on the numpy step
-(:func:`run_numpy_case`: about 15 CPU-s, and no exact-stage kernel to compile). The full tier runs Sod on h = 0.01 ...
+(:func:`run_numpy_case`: no fused exact-stage variant to compile, only the exact grid stage's kernels,
+:mod:`mpm_fem.exact_stages.grid_kernels`). The full tier runs Sod on h = 0.01 ...
 0.00125 and Burgers on h = 0.08 ... 0.01, four meshes each, every layout, without the all-exact subset
 (:data:`FULL`). Burgers at h = 0.005 (its viscous step, dt ~ h^2, makes one run there cost as much as
 the full tier's Burgers runs together), Sod at h = 0.000625, 16 per cell (whose growth starts near
@@ -66,7 +67,8 @@ CASES = ("time", "projection", "mass", "interpolation", "all")
 LAYOUTS = (("regular", 0),) + tuple(("jittered", s) for s in SEEDS)
 #: The quick tier, where the error comes from at a glance: Sod on h = 0.01 and 0.005 and Burgers on its two
 #: coarsest meshes, 4 per cell, the regular layout and seeds 1 and 2, each stage alone exact and every stage
-#: exact, on the numpy step (``kernel``: :func:`run_numpy_case`, which compiles no exact-stage variant).
+#: exact, on the numpy step (``kernel``: :func:`run_numpy_case`, which compiles no fused exact-stage variant; the
+#: exact grid stage's kernels it compiles, :mod:`mpm_fem.exact_stages.grid_kernels`).
 QUICK = {"ppc": (4,), "h": {"sod": (0.01, 0.005), "burgers": (0.08, 0.04)}, "layouts": LAYOUTS[:3],
          "cases": CASES, "kernel": "numpy"}
 #: The full tier: four meshes a problem, every layout, the subsets of all MPM and each stage alone exact.
@@ -146,8 +148,9 @@ def run_case(case: dict) -> dict:
 def run_numpy_case(case: dict) -> dict:
     """:func:`run_case` on the numpy step (:mod:`mpm_fem.core.step`: ``kernel="numpy"`` in every run's settings,
     stepped by :func:`mpm_fem.run.solve.run`): the same runs, subsets and errors, the fused step's arithmetic to
-    round-off, but no compiled particle pass, so that a cold cache compiles no exact-stage variant (the quick
-    tier's cases, :data:`QUICK`)."""
+    round-off, but no compiled particle pass, so that a cold cache compiles no fused exact-stage variant (the quick
+    tier's cases, :data:`QUICK`); the exact grid stage (:class:`~mpm_fem.exact_stages.stage.ExactGridStage`)
+    still runs its compiled sums, :mod:`mpm_fem.exact_stages.grid_kernels`."""
     problem, h = case["problem"], case["h"]
     changes = {k: case[k] for k in ("ppc", "layout", "seed") if k in case}
     exact = () if case["made_exact"] == "time" else STAGES[:3] if case["made_exact"] == "all" else (case["made_exact"],)

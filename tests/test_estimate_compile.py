@@ -110,3 +110,26 @@ def test_the_blended_time_left_does_not_swing_past_two_after_a_tenth():
         rate.append(by_rate.max() / by_rate.min())
     assert max(blended) < 2.0, max(blended)
     assert max(rate) > 2.0, max(rate)
+
+
+def test_the_costliest_case_of_each_compiling_group_carries_the_compile(tmp_path, monkeypatch):
+    """The Sod study's quick tier, a table giving each kernel group one variant of its own: from an empty
+    numba cache one case per group carries a compile (:func:`mpm_fem.app.case_tasks.compiles`), its costliest;
+    from a cache that holds them none does."""
+    from mpm_fem.app.case_tasks import compiles
+    from mpm_fem.app.case_tasks import tasks as case_tasks
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "numba"))
+    options = StudyOptions(quick=True, out=tmp_path / "figures")
+    found = case_tasks("sod", options)
+    groups = sorted({"|".join(kernel_group(t)) for _, t in found})
+    name = "mpm_fem/fused/loop.py::loop._advance_carry{k}_{{digest}}"
+    monkeypatch.setattr(compile_times, "GROUPS", {g: [name.format(k=k)] for k, g in enumerate(groups)})
+    monkeypatch.setattr(compile_times, "SECONDS", {name.format(k=k): 3.0 for k in range(len(groups))})
+    carried = compiles("sod", options)
+    assert len(carried) == len(found) and sum(carried) == len(groups) >= 3
+    for group in groups:
+        mine = [(s, c) for (s, t), c in zip(found, carried, strict=True) if "|".join(kernel_group(t)) == group]
+        assert [c for _, c in mine].count(True) == 1 and max(mine)[1], (group, mine)
+    _fill([name.format(k=k) for k in range(len(groups))])
+    assert not any(compiles("sod", options))

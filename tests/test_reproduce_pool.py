@@ -32,6 +32,7 @@ def test_each_study_is_written_once_after_its_last_case_the_cheapest_study_first
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", run_study)
     monkeypatch.setattr(case_tasks, "tasks", tasks)
+    monkeypatch.setattr(case_tasks, "compiles", lambda name, options: None)
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))
     started = [int(n) for n in trace.read_text().split()]
@@ -41,6 +42,27 @@ def test_each_study_is_written_once_after_its_last_case_the_cheapest_study_first
     written.clear()
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))  # all cached: every study at once
     assert sorted(written) == [("a", 2), ("b", 1), ("c", 0)] and len(trace.read_text().split()) == 3
+
+
+def test_the_cases_that_compile_start_first_the_longest_first(tmp_path, monkeypatch):
+    """Study a's 1-s case and study c's 0.5-s case compile kernels (:func:`mpm_fem.app.case_tasks.compiles`):
+    they start first, the longer first, ahead of the cheaper study b; then the studies in order of their cost."""
+    trace = tmp_path / "trace"
+    cost = {"a": (3.0, 1.0), "b": (2.0,), "c": (0.5, 0.25)}
+    carries = {"a": [False, True], "b": [False], "c": [True, False]}
+
+    def tasks(name, options):
+        return [(s, Task(square, {"n": int(100 * s) + ord(name), "trace": str(trace)}, tmp_path / name))
+                for s in cost[name]]
+
+    monkeypatch.setattr(study, "STUDIES", tuple(cost))
+    monkeypatch.setattr(study, "run_study", lambda name, options: name)
+    monkeypatch.setattr(case_tasks, "tasks", tasks)
+    monkeypatch.setattr(case_tasks, "compiles", lambda name, options: carries[name])
+    monkeypatch.setattr(report, "write_report", lambda out: out)
+    report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))
+    started = [int(n) for n in trace.read_text().split()]
+    assert started == [100 + ord("a"), 50 + ord("c"), 25 + ord("c"), 200 + ord("b"), 300 + ord("a")]
 
 
 def write_study(name, options):
@@ -69,6 +91,7 @@ def test_with_two_workers_a_worker_writes_each_study_once_its_cases_are_in(tmp_p
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", write_study)
     monkeypatch.setattr(case_tasks, "tasks", tasks)
+    monkeypatch.setattr(case_tasks, "compiles", lambda name, options: None)
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=2, progress=False))
     written = [line.split() for line in (tmp_path / "written").read_text().splitlines()]

@@ -214,3 +214,62 @@ def test_the_kernel_group_is_the_function_and_the_keys_that_choose_kernels():
     assert kernel_group(Task(square, sod)) == kernel_group(Task(square, {**sod, "h": 0.005, "seed": 3}))
     assert kernel_group(Task(square, sod)) != kernel_group(Task(square, {**sod, "basis": "gimp"}))
     assert kernel_group(Task(square, sod)) != kernel_group(Task(cube, sod))
+
+
+def test_groups_sharing_an_uncached_compile_of_shared_s_or_more_are_one_family():
+    """a and b share 1.5 s of uncached variants (one family); c shares 0.5 s with b (below SHARED_S: its own);
+    d shares 2 s with a, but cached (its own); e is joined to a through b; f is not in the table (its own).
+    With every variant cached, each group is its own family."""
+    from mpm_fem.app.compiling import SHARED_S, families
+
+    assert SHARED_S == 1.0
+    seconds = {"ab": 1.5, "bc": 0.5, "ad": 2.0, "be": 1.0, "a": 9.0}
+    table = {"a": ["a", "ab", "ad"], "b": ["ab", "bc", "be"], "c": ["bc"], "d": ["ad"], "e": ["be"]}
+    groups = [(g,) for g in "abcdef"]
+    got = families(groups, table, seconds, is_cached=lambda v: v == "ad")
+    assert got == {("a",): ("a",), ("b",): ("a",), ("c",): ("c",), ("d",): ("d",), ("e",): ("a",), ("f",): ("f",)}
+    assert families(groups, table, seconds, is_cached=lambda v: True) == {g: g for g in groups}
+    assert families(groups, table, {**seconds, "ab": 0.9}, is_cached=lambda v: v == "ad")[("b",)] == ("b",)
+
+
+def negate(case):
+    return {"y": -case.get("x", 0)}
+
+
+def test_the_pool_holds_back_a_family_not_only_a_group(monkeypatch):
+    """Two groups (two functions) sharing an uncached compile: while the first's task may compile, the pool
+    starts a task of a third group, not the second's (it would compile the shared variants again)."""
+    import mpm_fem.app.sweep as sweep
+
+    started = []
+
+    class Pool:
+        def __init__(self, **_):
+            pass
+
+        def submit(self, fn, *args):
+            started.append(args[0].__name__ if args else "followup")
+            return _Future(False)
+
+        def shutdown(self, **_):
+            pass
+
+    from functools import partial
+
+    from mpm_fem.app.compiling import families
+
+    table = {"|".join(sweep.kernel_group(sweep.Task(f, {}))): ["shared"] for f in (square, cube)}
+    monkeypatch.setattr(sweep, "families", partial(families, table=table, seconds={"shared": 5.0},
+                                                   is_cached=lambda v: False))
+    monkeypatch.setattr(sweep, "ProcessPoolExecutor", Pool)
+    class Started(Exception):
+        """Raised where the pool would wait: the first two tasks have started."""
+
+    def wait(running, return_when):
+        raise Started
+
+    monkeypatch.setattr(sweep, "wait", wait)
+    tasks = [sweep.Task(square, {}), sweep.Task(cube, {}), sweep.Task(negate, {})]
+    with pytest.raises(Started):
+        sweep._run_pool(tasks, [(0, None), (1, None), (2, None)], 1, lambda *a: None)
+    assert started == ["square", "negate"]

@@ -7,7 +7,7 @@ cases through another function names it per case:
                                              ``studies/<name>.py``; default: its ``run_case``)
 
 (the mechanism study's quick tier runs :func:`studies.mechanism.run_numpy_case`, the numpy step, which
-compiles no exact-stage kernel). :func:`tasks` and :func:`estimate` are those of
+compiles no fused exact-stage variant). :func:`tasks` and :func:`estimate` are those of
 :mod:`mpm_fem.app.estimate` (the same cost models, cached cases and compile pricing by kernel group,
 :func:`mpm_fem.app.estimate.compile_seconds`) with that function in each task, so that ``reproduce``
 runs, and prices, the tasks the study's ``run`` reads from its cache. They live beside the estimate
@@ -43,6 +43,16 @@ def tasks(name: str, options, seen: set | None = None) -> list[tuple[float, Task
     updated); ``None`` if the study does not state its cost model."""
     found = _priced(name, options.tier)
     return None if found is None else _with_compile(_plain(found, options), set() if seen is None else seen)
+
+
+def compiles(name: str, options) -> list[bool] | None:
+    """Per task of :func:`tasks` (in its order), whether its estimate carries the compile of variants numba's
+    cache lacks: the costliest case to run of each kernel group that compiles; ``None`` as :func:`tasks`."""
+    found = _priced(name, options.tier)
+    if found is None:
+        return None
+    plain = _plain(found, options)
+    return [s > p for (s, _), (p, _) in zip(_with_compile(plain, set()), plain, strict=True)]
 
 
 def estimate(name: str, options, seen: set | None = None) -> Estimate | None:

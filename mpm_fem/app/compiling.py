@@ -141,3 +141,43 @@ def uncached_seconds(variants) -> float:
     from mpm_fem.app.compile_times import SECONDS
 
     return sum(SECONDS.get(v, 0.0) for v in set(variants) if not cached(v))
+
+
+#: Two kernel groups share a compile when the variants both run through and numba's cache lacks cost at
+#: least this many CPU seconds to compile (:data:`mpm_fem.app.compile_times.SECONDS`): below it, a second
+#: worker compiling them again costs less than holding its group back.
+SHARED_S = 1.0
+
+
+def families(groups, table=None, seconds=None, is_cached=None) -> dict:
+    """Each kernel group of ``groups`` (tuples, :func:`mpm_fem.app.sweep.kernel_group`) -> its *compile
+    family*, a representative group: two groups are in one family when the variants they both run through
+    (``table``: group joined by ``|`` -> its variants, default :data:`mpm_fem.app.compile_times.GROUPS`)
+    and ``is_cached`` says the cache lacks (default :func:`cached`) cost :data:`SHARED_S` or more of
+    ``seconds`` (default :data:`~mpm_fem.app.compile_times.SECONDS`), and a family holds every group
+    joined to it through others. A group the table does not hold, or one that shares no such compile, is
+    its own family; with every variant cached each group is. The pool holds a family's other tasks back
+    while one of them may compile (:func:`mpm_fem.app.sweep._next_task`)."""
+    if table is None or seconds is None:
+        from mpm_fem.app.compile_times import GROUPS, SECONDS
+
+        table, seconds = GROUPS if table is None else table, SECONDS if seconds is None else seconds
+    is_cached = cached if is_cached is None else is_cached
+    groups = sorted(set(groups))
+    missing = {}
+    for group in groups:
+        variants = table.get("|".join(group), ())
+        missing[group] = {v for v in variants if not is_cached(v)}
+    parent = {group: group for group in groups}
+
+    def root(group):
+        while parent[group] != group:
+            parent[group] = parent[parent[group]]
+            group = parent[group]
+        return group
+
+    for i, a in enumerate(groups):
+        for b in groups[i + 1:]:
+            if sum(seconds.get(v, 0.0) for v in missing[a] & missing[b]) >= SHARED_S:
+                parent[max(root(a), root(b))] = min(root(a), root(b))
+    return {group: root(group) for group in groups}

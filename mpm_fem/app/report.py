@@ -355,7 +355,7 @@ def reproduce(options) -> Path:
     worker writes
     that study's tables and figures from the cache, ahead of the cases still waiting (this process
     does, with one job or a Dask scheduler: :func:`mpm_fem.app.sweep.run_tasks`)."""
-    from mpm_fem.app.case_tasks import estimate, tasks
+    from mpm_fem.app.case_tasks import compiles, estimate, tasks
     from mpm_fem.app.estimate import describe
     from mpm_fem.app.study import check_folder, reproduced, run_study
     from mpm_fem.app.sweep import default_jobs, run_tasks
@@ -366,11 +366,14 @@ def reproduce(options) -> Path:
         workers = options.jobs or default_jobs()
         print(describe({name: estimate(name, options) for name in studies}, workers), file=sys.stderr, flush=True)
     found = {name: tasks(name, options) or [] for name in studies}
+    carries = {name: compiles(name, options) or [False] * len(found[name]) for name in studies}
     total = {name: sum(s for s, _ in found[name]) for name in studies}
-    # the studies in order of their total cost, each one's cases the longest first: a cheap study's tables and
-    # figures are written while the costly studies' cases run, not after the last case
-    planned = sorted((Planned(s, name, t) for name in studies for s, t in found[name]),
-                     key=lambda p: (total[p.study], -p.cost))
+    # first the cases that compile kernels, the longest first, so that the compiles (most of a cold run) start
+    # early and overlap; then the studies in order of their total cost, each one's cases the longest first: a
+    # cheap study's tables and figures are written while the costly studies' cases run, not after the last case
+    keyed = [((0, 0.0, -s) if carrier else (1, total[name], -s), Planned(s, name, t))
+             for name in studies for (s, t), carrier in zip(found[name], carries[name], strict=True)]
+    planned = [p for _, p in sorted(keyed, key=lambda kp: kp[0])]
     left = {name: sum(1 for p in planned if p.study == name) for name in studies}
     published = []
     # a study's tables and figures, in a worker: every case is in the cache by then, so it runs none

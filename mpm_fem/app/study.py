@@ -207,7 +207,8 @@ STUDIES = ("projection", "sod", "burgers", "identification", "budget", "time", "
 #: The studies the quick reproduction leaves out: their questions (E5, the mechanism of C11, E1 and the defect) are
 #: about the plateau of Sod's particle error, which the quick tier's meshes reach at one setting only
 #: (C11's). ``mpm-fem study NAME --quick`` still runs them. The mechanism study's small stage-exact set stays in
-#: (on the numpy step, which compiles no exact-stage kernel): it says which stage the error comes from.
+#: (on the numpy step, which compiles no fused exact-stage variant, only the exact grid stage's kernels of
+#: :mod:`mpm_fem.exact_stages.grid_kernels`): it says which stage the error comes from.
 QUICK_LEAVES_OUT = ("remedies", "drift", "budget", "defect")
 _NO_BUDGET = ("the quick reproduction leaves out the error budget (its exact-stage kernels take about a minute to "
               "compile)")

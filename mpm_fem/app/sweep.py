@@ -41,7 +41,7 @@ from typing import Callable
 
 from tqdm.auto import tqdm
 
-from mpm_fem.app.compiling import compile_notice, notice_once
+from mpm_fem.app.compiling import compile_notice, families, notice_once
 from mpm_fem.app.output import write_json
 from mpm_fem.measure.version import case_version, code_version
 
@@ -101,13 +101,14 @@ def _worker_init(parent: int, compiling=None) -> None:
 #: group (:func:`kernel_group`). A guess from the studies' cases: a wrong one costs compiling time,
 #: never a number.
 KERNEL_KEYS = ("solver", "problem", "kind", "basis", "scheme", "mass", "transfer")
-#: For this long after a group's latest task starts (or until it ends), the pool starts the group's
-#: other tasks only when a task of another group can start: numba compiles a kernel at the first task
-#: that calls it and caches it on disk, and a second worker starting the group meanwhile would compile it
-#: again (a cold quick tier's two workers did so, each compiling every kernel). The latest task, not
-#: only the first: a group's first task need not call every kernel of the group (the mechanism study's
-#: first subset makes time exact; its next two, the projection and the mass, both compile the exact
-#: projection's kernels).
+#: For this long after a compile family's latest task starts (or until it ends), the pool starts the family's
+#: other tasks only when a task of another family can start: numba compiles a kernel at the first task
+#: that calls it and caches it on disk, and a second worker starting the family meanwhile would compile it
+#: again (a cold quick tier's two workers did so, each compiling every kernel). A family is a kernel group
+#: with the groups it shares uncached compiles with (:func:`mpm_fem.app.compiling.families`: the Sod and
+#: Burgers loops share their projection and scatter passes). The latest task, not only the first: a
+#: group's first task need not call every kernel of the group (the mechanism study's first subset makes
+#: time exact; its next two, the projection and the mass, both compile the exact projection's kernels).
 COMPILE_S = 45.0
 
 
@@ -117,11 +118,11 @@ def kernel_group(task: Task) -> tuple:
 
 
 def _next_task(waiting: deque, groups: dict, latest: dict, now: float, ended: dict | None = None):
-    """Take from ``waiting`` (``(k, path)`` in their order) the first task whose group ``groups[k]`` may
-    not be compiling: its latest task (``latest[group] = (start time, future)``) has ended or started
-    :data:`COMPILE_S` ago or more, or it has none. When every group may be, the first task of the group
-    with the most ended tasks (``ended[group]``, the likeliest to have its kernels compiled): a worker
-    never idles."""
+    """Take from ``waiting`` (``(k, path)`` in their order) the first task whose group ``groups[k]`` (the
+    pool's: a compile family) may not be compiling: its latest task (``latest[group] = (start time,
+    future)``) has ended or started :data:`COMPILE_S` ago or more, or it has none. When every group may
+    be, the first task of the group with the most ended tasks (``ended[group]``, the likeliest to have its
+    kernels compiled): a worker never idles."""
     for i, (k, path) in enumerate(waiting):
         started = latest.get(groups[k])
         if started is None or started[1].done() or now - started[0] >= COMPILE_S:
@@ -136,8 +137,8 @@ def _next_task(waiting: deque, groups: dict, latest: dict, now: float, ended: di
 
 
 def _run_pool(tasks, todo, jobs: int, finish, followups=(), notice: bool = False) -> None:
-    """The tasks of ``todo`` in ``jobs`` worker processes, started in their order (but a group's tasks
-    held back while its latest task may compile kernels: :func:`_next_task`) and at most ``jobs + 1``
+    """The tasks of ``todo`` in ``jobs`` worker processes, started in their order (but a compile family's
+    tasks held back while its latest task may compile kernels: :func:`_next_task`) and at most ``jobs + 1``
     at a time, so that a follow-up (a function of no arguments: ``followups``, and what ``finish``
     returns) starts ahead of the tasks still waiting. If the parent is interrupted (Ctrl-C) or fails,
     the workers are ended at once instead of finishing their cases. ``notice``: the first worker to
@@ -145,7 +146,8 @@ def _run_pool(tasks, todo, jobs: int, finish, followups=(), notice: bool = False
     compiling = multiprocessing.Value("b", 0) if notice else None
     pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init, initargs=(os.getpid(), compiling))
     waiting, ahead, running = deque(todo), deque(followups), {}
-    groups, latest, ended = {k: kernel_group(tasks[k]) for k, _ in todo}, {}, {}
+    family = families(kernel_group(tasks[k]) for k, _ in todo)
+    groups, latest, ended = {k: family[kernel_group(tasks[k])] for k, _ in todo}, {}, {}
 
     def start() -> None:
         while len(running) <= jobs and (ahead or waiting):
