@@ -18,7 +18,7 @@ def test_each_study_is_written_once_after_its_last_case_the_cheapest_study_first
     trace = tmp_path / "trace"
     cost = {"a": (3.0, 1.0), "b": (2.0,), "c": ()}  # estimated seconds of each study's cases; c has none
 
-    def tasks(name, options):
+    def tasks(name, options, seen=None):
         return [(s, Task(square, {"n": int(10 * s) + ord(name), "trace": str(trace)}, tmp_path / name))
                 for s in cost[name]]
 
@@ -32,7 +32,7 @@ def test_each_study_is_written_once_after_its_last_case_the_cheapest_study_first
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", run_study)
     monkeypatch.setattr(case_tasks, "tasks", tasks)
-    monkeypatch.setattr(case_tasks, "compiles", lambda name, options: None)
+    monkeypatch.setattr(case_tasks, "compiles", lambda name, options, seen=None: None)
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))
     started = [int(n) for n in trace.read_text().split()]
@@ -51,18 +51,43 @@ def test_the_cases_that_compile_start_first_the_longest_first(tmp_path, monkeypa
     cost = {"a": (3.0, 1.0), "b": (2.0,), "c": (0.5, 0.25)}
     carries = {"a": [False, True], "b": [False], "c": [True, False]}
 
-    def tasks(name, options):
+    def tasks(name, options, seen=None):
         return [(s, Task(square, {"n": int(100 * s) + ord(name), "trace": str(trace)}, tmp_path / name))
                 for s in cost[name]]
 
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", lambda name, options: name)
     monkeypatch.setattr(case_tasks, "tasks", tasks)
-    monkeypatch.setattr(case_tasks, "compiles", lambda name, options: carries[name])
+    monkeypatch.setattr(case_tasks, "compiles", lambda name, options, seen=None: carries[name])
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))
     started = [int(n) for n in trace.read_text().split()]
     assert started == [100 + ord("a"), 50 + ord("c"), 25 + ord("c"), 200 + ord("b"), 300 + ord("a")]
+
+
+def test_a_variant_two_studies_share_is_priced_once(tmp_path, monkeypatch):
+    """``reproduce`` hands every study's estimate, tasks and compiles one set of the variants priced already
+    (one per use), so that a kernel two studies run through is priced in the first that meets it."""
+    calls = {"estimate": [], "tasks": [], "compiles": []}
+
+    def recorder(kind, result):
+        def call(name, options, seen=None):
+            calls[kind].append((name, id(seen), set(seen)))
+            seen.add(name)
+            return result(name)
+        return call
+
+    monkeypatch.setattr(study, "STUDIES", ("a", "b"))
+    monkeypatch.setattr(study, "run_study", lambda name, options: name)
+    monkeypatch.setattr(case_tasks, "estimate", recorder("estimate", lambda name: None))
+    monkeypatch.setattr(case_tasks, "tasks", recorder("tasks", lambda name: []))
+    monkeypatch.setattr(case_tasks, "compiles", recorder("compiles", lambda name: []))
+    monkeypatch.setattr(report, "write_report", lambda out: out)
+    report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=None))
+    for kind, got in calls.items():
+        assert [(name, before) for name, _, before in got] == [("a", set()), ("b", {"a"})], kind
+        assert got[0][1] == got[1][1], kind
+    assert len({got[0][1] for got in calls.values()}) == 3
 
 
 def write_study(name, options):
@@ -84,14 +109,14 @@ def test_with_two_workers_a_worker_writes_each_study_once_its_cases_are_in(tmp_p
     trace = tmp_path / "trace"
     cost = {"a": (3.0, 1.0, 0.5), "b": (2.0,), "c": ()}
 
-    def tasks(name, options):
+    def tasks(name, options, seen=None):
         return [(s, Task(square, {"n": int(10 * s) + ord(name), "trace": str(trace)}, tmp_path / name))
                 for s in cost[name]]
 
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", write_study)
     monkeypatch.setattr(case_tasks, "tasks", tasks)
-    monkeypatch.setattr(case_tasks, "compiles", lambda name, options: None)
+    monkeypatch.setattr(case_tasks, "compiles", lambda name, options, seen=None: None)
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=2, progress=False))
     written = [line.split() for line in (tmp_path / "written").read_text().splitlines()]

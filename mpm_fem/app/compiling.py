@@ -164,10 +164,9 @@ def families(groups, table=None, seconds=None, is_cached=None) -> dict:
         table, seconds = GROUPS if table is None else table, SECONDS if seconds is None else seconds
     is_cached = cached if is_cached is None else is_cached
     groups = sorted(set(groups))
-    missing = {}
-    for group in groups:
-        variants = table.get("|".join(group), ())
-        missing[group] = {v for v in variants if not is_cached(v)}
+    variants = {group: set(table.get("|".join(group), ())) for group in groups}
+    lacked = {v for v in set().union(*variants.values()) if not is_cached(v)}  # each variant looked up once
+    missing = {group: variants[group] & lacked for group in groups}
     parent = {group: group for group in groups}
 
     def root(group):

@@ -362,11 +362,14 @@ def reproduce(options) -> Path:
 
     check_folder(options)
     studies = reproduced(options.tier)
+    # a variant two studies run through is compiled once: priced in the first study that meets it
     if options.progress is not False:
-        workers = options.jobs or default_jobs()
-        print(describe({name: estimate(name, options) for name in studies}, workers), file=sys.stderr, flush=True)
-    found = {name: tasks(name, options) or [] for name in studies}
-    carries = {name: compiles(name, options) or [False] * len(found[name]) for name in studies}
+        workers, seen = options.jobs or default_jobs(), set()
+        print(describe({name: estimate(name, options, seen) for name in studies}, workers), file=sys.stderr,
+              flush=True)
+    seen, compiled = set(), set()
+    found = {name: tasks(name, options, seen) or [] for name in studies}
+    carries = {name: compiles(name, options, compiled) or [False] * len(found[name]) for name in studies}
     total = {name: sum(s for s, _ in found[name]) for name in studies}
     # first the cases that compile kernels, the longest first, so that the compiles (most of a cold run) start
     # early and overlap; then the studies in order of their total cost, each one's cases the longest first: a
