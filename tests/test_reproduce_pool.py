@@ -32,7 +32,7 @@ def test_each_study_is_written_once_after_its_last_case_the_cheapest_study_first
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", run_study)
     monkeypatch.setattr(case_tasks, "tasks", tasks)
-    monkeypatch.setattr(case_tasks, "compiles", lambda name, options, seen=None: None)
+    monkeypatch.setattr(case_tasks, "compiles", lambda name, options, priced: None)
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))
     started = [int(n) for n in trace.read_text().split()]
@@ -58,7 +58,7 @@ def test_the_cases_that_compile_start_first_the_longest_first(tmp_path, monkeypa
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", lambda name, options: name)
     monkeypatch.setattr(case_tasks, "tasks", tasks)
-    monkeypatch.setattr(case_tasks, "compiles", lambda name, options, seen=None: carries[name])
+    monkeypatch.setattr(case_tasks, "compiles", lambda name, options, priced: carries[name])
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=False))
     started = [int(n) for n in trace.read_text().split()]
@@ -66,9 +66,11 @@ def test_the_cases_that_compile_start_first_the_longest_first(tmp_path, monkeypa
 
 
 def test_a_variant_two_studies_share_is_priced_once(tmp_path, monkeypatch):
-    """``reproduce`` hands every study's estimate, tasks and compiles one set of the variants priced already
-    (one per use), so that a kernel two studies run through is priced in the first that meets it."""
-    calls = {"estimate": [], "tasks": [], "compiles": []}
+    """``reproduce`` hands every study's estimate one set of the variants priced already, and every study's
+    tasks another, so that a kernel two studies run through is priced in the first that meets it; the compile
+    carriers are read from the tasks as priced."""
+    calls = {"estimate": [], "tasks": []}
+    got_priced = []
 
     def recorder(kind, result):
         def call(name, options, seen=None):
@@ -77,17 +79,23 @@ def test_a_variant_two_studies_share_is_priced_once(tmp_path, monkeypatch):
             return result(name)
         return call
 
+    def compiles(name, options, priced):
+        got_priced.append((name, priced))
+        return [False] * len(priced)
+
     monkeypatch.setattr(study, "STUDIES", ("a", "b"))
     monkeypatch.setattr(study, "run_study", lambda name, options: name)
     monkeypatch.setattr(case_tasks, "estimate", recorder("estimate", lambda name: None))
-    monkeypatch.setattr(case_tasks, "tasks", recorder("tasks", lambda name: []))
-    monkeypatch.setattr(case_tasks, "compiles", recorder("compiles", lambda name: []))
+    monkeypatch.setattr(case_tasks, "tasks", recorder("tasks", lambda name: [(1.0, Task(square, {"n": ord(name),
+                                                      "trace": str(tmp_path / "trace")}, tmp_path / name))]))
+    monkeypatch.setattr(case_tasks, "compiles", compiles)
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=1, progress=None))
     for kind, got in calls.items():
         assert [(name, before) for name, _, before in got] == [("a", set()), ("b", {"a"})], kind
         assert got[0][1] == got[1][1], kind
-    assert len({got[0][1] for got in calls.values()}) == 3
+    assert calls["estimate"][0][1] != calls["tasks"][0][1]
+    assert [(name, [t.case["n"] for _, t in priced]) for name, priced in got_priced] == [("a", [97]), ("b", [98])]
 
 
 def write_study(name, options):
@@ -116,7 +124,7 @@ def test_with_two_workers_a_worker_writes_each_study_once_its_cases_are_in(tmp_p
     monkeypatch.setattr(study, "STUDIES", tuple(cost))
     monkeypatch.setattr(study, "run_study", write_study)
     monkeypatch.setattr(case_tasks, "tasks", tasks)
-    monkeypatch.setattr(case_tasks, "compiles", lambda name, options, seen=None: None)
+    monkeypatch.setattr(case_tasks, "compiles", lambda name, options, priced: None)
     monkeypatch.setattr(report, "write_report", lambda out: out)
     report.reproduce(StudyOptions(out=tmp_path, jobs=2, progress=False))
     written = [line.split() for line in (tmp_path / "written").read_text().splitlines()]

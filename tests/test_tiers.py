@@ -129,7 +129,7 @@ def test_the_quick_reproduction_leaves_out_the_plateau_studies_and_says_so(tmp_p
     monkeypatch.setattr(study, "run_study", lambda name, options: started.append(name))
     monkeypatch.setattr(report, "write_report", lambda out: out)
     monkeypatch.setattr("mpm_fem.app.case_tasks.tasks", lambda name, options, seen=None: [])
-    monkeypatch.setattr("mpm_fem.app.case_tasks.compiles", lambda name, options, seen=None: [])
+    monkeypatch.setattr("mpm_fem.app.case_tasks.compiles", lambda name, options, priced: [])
     report.reproduce(StudyOptions(quick=True, out=tmp_path, jobs=1, progress=False))
     assert started == list(study.reproduced("quick"))
     text = "\n".join(report.caveats({"versions": [{"table": "sod/convergence", "code": "x", "tier": "quick"}]}, "x"))

@@ -45,16 +45,14 @@ def tasks(name: str, options, seen: set | None = None) -> list[tuple[float, Task
     return None if found is None else _with_compile(_plain(found, options), set() if seen is None else seen)
 
 
-def compiles(name: str, options, seen: set | None = None) -> list[bool] | None:
-    """Per task of :func:`tasks` (in its order), whether its estimate carries the compile of variants numba's
-    cache lacks and ``seen`` does not hold (updated, as in :func:`tasks`): the costliest case to run of each
-    kernel group that compiles; ``None`` as :func:`tasks`."""
+def compiles(name: str, options, priced: list[tuple[float, Task]]) -> list[bool] | None:
+    """Per task of ``priced`` (what :func:`tasks` returned for study ``name``, in its order), whether its
+    estimate carries the compile of variants numba's cache lacks: the costliest case to run of each kernel
+    group that compiles, its price above the case's own; ``None`` as :func:`tasks`."""
     found = _priced(name, options.tier)
     if found is None:
         return None
-    plain = _plain(found, options)
-    priced = _with_compile(plain, set() if seen is None else seen)
-    return [s > p for (s, _), (p, _) in zip(priced, plain, strict=True)]
+    return [s > p for (s, _), (p, _) in zip(priced, _plain(found, options), strict=True)]
 
 
 def estimate(name: str, options, seen: set | None = None) -> Estimate | None:

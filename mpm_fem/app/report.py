@@ -367,9 +367,9 @@ def reproduce(options) -> Path:
         workers, seen = options.jobs or default_jobs(), set()
         print(describe({name: estimate(name, options, seen) for name in studies}, workers), file=sys.stderr,
               flush=True)
-    seen, compiled = set(), set()
+    seen = set()
     found = {name: tasks(name, options, seen) or [] for name in studies}
-    carries = {name: compiles(name, options, compiled) or [False] * len(found[name]) for name in studies}
+    carries = {name: compiles(name, options, found[name]) or [False] * len(found[name]) for name in studies}
     total = {name: sum(s for s, _ in found[name]) for name in studies}
     # first the cases that compile kernels, the longest first, so that the compiles (most of a cold run) start
     # early and overlap; then the studies in order of their total cost, each one's cases the longest first: a
